@@ -1,0 +1,565 @@
+//! The distance query: the paper's Numerical Algorithm (Section 6) run in the
+//! pair's relative frame, with certified bounds, margins and warm start.
+
+use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
+
+use crate::Error;
+use crate::johnson::{Simplex, Solution, Vertex};
+use crate::shape::{Convex, Shape, pose_is_finite};
+
+/// How hard to work, and when to stop early.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Relative tolerance `ε` of the stopping rule (6.2), `g(v) <= ε·D²`. The
+    /// default, 100 × machine epsilon, is the paper's; larger is faster and
+    /// looser (the bounds in the answer say by how much). Must be finite and
+    /// `>= 0`; 0 runs until round-off stops progress.
+    pub tolerance: f64,
+    /// Iteration cap (subalgorithm runs), at least 1. Polytopes converge in a
+    /// few iterations; the cap only guards against a pathological input.
+    pub max_iterations: u32,
+    /// Early exit: stop as soon as the certified bounds decide that the
+    /// distance (after radii) is greater than this margin ([`Status::Farther`])
+    /// or at most this margin ([`Status::Closer`]). `None` runs to convergence.
+    pub margin: Option<f64>,
+    /// Use a warm start when one is given. Off, the query always starts from
+    /// the single-point initialisation of Section 6.
+    pub warm_start: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            tolerance: 100.0 * f64::EPSILON,
+            max_iterations: 128,
+            margin: None,
+            warm_start: true,
+        }
+    }
+}
+
+impl Options {
+    fn validate(&self) -> Result<(), Error> {
+        if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
+            return Err(Error::InvalidOption("tolerance must be finite and >= 0"));
+        }
+        if self.max_iterations == 0 {
+            return Err(Error::InvalidOption("max_iterations must be at least 1"));
+        }
+        if let Some(m) = self.margin
+            && !m.is_finite()
+        {
+            return Err(Error::InvalidOption("margin must be finite"));
+        }
+        Ok(())
+    }
+}
+
+/// How a query ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// The stopping rule `g <= ε·D²` held (or the cores were found to touch or
+    /// intersect): the distance is exact to the tolerance.
+    Converged,
+    /// Early exit: the lower bound proved the distance greater than the margin.
+    Farther,
+    /// Early exit: the upper bound proved the distance at most the margin.
+    Closer,
+    /// The iteration cap was reached first; the bounds still hold.
+    IterationCap,
+    /// Round-off stopped progress before the tolerance was met, even with the
+    /// Backup Procedure (step 5 of the Numerical Algorithm); the bounds hold.
+    ToleranceNotMet,
+}
+
+/// The final simplex of a query, as vertex index pairs (Section 8), plus the
+/// pieces it belongs to. Keep it per object pair and hand it back with the next
+/// query of the same pair: it changes the time, never the answer beyond `ε`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct WarmStart {
+    pieces: [u32; 2],
+    len: u8,
+    pairs: [[u32; 2]; 4],
+}
+
+impl WarmStart {
+    /// A warm start from explicit `[vertex of A, vertex of B]` index pairs (at
+    /// most 4; more return `None`) in the given pieces (`[0, 0]` for two convex
+    /// shapes). Indices are checked against the shapes at query time.
+    pub fn new(pieces: [u32; 2], pairs: &[[u32; 2]]) -> Option<Self> {
+        if pairs.len() > 4 {
+            return None;
+        }
+        let mut w = WarmStart {
+            pieces,
+            len: pairs.len() as u8,
+            pairs: [[0; 2]; 4],
+        };
+        w.pairs[..pairs.len()].copy_from_slice(pairs);
+        Some(w)
+    }
+
+    /// The `[vertex of A, vertex of B]` index pairs of the simplex.
+    pub fn pairs(&self) -> &[[u32; 2]] {
+        &self.pairs[..self.len as usize]
+    }
+
+    /// The `[piece of A, piece of B]` the simplex belongs to.
+    pub fn pieces(&self) -> [u32; 2] {
+        self.pieces
+    }
+}
+
+/// Everything a query returns. Distances are after radii; points are in world
+/// coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Answer {
+    /// The distance between the (rounded) shapes, `>= 0`.
+    pub distance: f64,
+    /// Certified lower bound on the true distance (Theorem 4.1, widened by a
+    /// bound on floating-point error).
+    pub lower: f64,
+    /// Certified upper bound on the true distance.
+    pub upper: f64,
+    /// Nearest point on A. When the shapes overlap, the deepest point of A's
+    /// surface along `normal` (so `point_b - point_a = -penetration·normal`).
+    pub point_a: Point3<f64>,
+    /// Nearest point on B, as `point_a`.
+    pub point_b: Point3<f64>,
+    /// Unit vector from A's nearest point towards B's; zero when the cores
+    /// touch or intersect and no direction is defined.
+    pub normal: Vector3<f64>,
+    /// Lower bound on the penetration depth (the smallest translation that
+    /// separates the shapes): 0 when separated, exact when only the rounded
+    /// shells overlap, the inner radius of the final simplex (5.9) plus the
+    /// radii when the cores intersect.
+    pub penetration: f64,
+    /// Subalgorithm iterations, summed over piece pairs for compounds.
+    pub iterations: u32,
+    /// How the query ended.
+    pub status: Status,
+    /// Whether the Backup Procedure (6.5) was needed.
+    pub backup_used: bool,
+    /// `[piece of A, piece of B]` that realise the distance (`[0, 0]` for two
+    /// convex shapes).
+    pub pieces: [u32; 2],
+    /// The final simplex, for the next query of this pair.
+    pub warm_start: WarmStart,
+}
+
+/// The distance between `a` at `pose_a` and `b` at `pose_b`, with nearest points,
+/// certified bounds and the simplex for a warm start.
+///
+/// # Errors
+/// [`Error::NonFinitePose`] for a pose with NaN or infinity,
+/// [`Error::InvalidOption`] for options out of their domain, and
+/// [`Error::WarmStartOutOfRange`] for a warm start that names a piece or vertex
+/// the shapes do not have.
+pub fn distance(
+    a: &Shape,
+    pose_a: &Isometry3<f64>,
+    b: &Shape,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
+    options.validate()?;
+    if !pose_is_finite(pose_a) || !pose_is_finite(pose_b) {
+        return Err(Error::NonFinitePose);
+    }
+    if let Some(w) = warm {
+        let (pa, pb) = (w.pieces[0] as usize, w.pieces[1] as usize);
+        let (Some((_, ca)), Some((_, cb))) = (a.piece(pa), b.piece(pb)) else {
+            return Err(Error::WarmStartOutOfRange);
+        };
+        if w.pairs()
+            .iter()
+            .any(|&[i, j]| i as usize >= ca.len() || j as usize >= cb.len())
+        {
+            return Err(Error::WarmStartOutOfRange);
+        }
+    }
+    let warm = warm.filter(|w| options.warm_start && w.len > 0);
+    // a⁻¹·b: the translations are subtracted before rotating, so poses far from
+    // the world origin cancel exactly when the objects are near each other.
+    let rel = pose_a.inv_mul(pose_b);
+    let answer = match (a, b) {
+        (Shape::Convex(ca), Shape::Convex(cb)) => {
+            let pair = Pair::new(ca, cb, &rel);
+            let run = pair.solve(options, warm.map(|w| w.pairs()), f64::INFINITY);
+            pair.answer(
+                &run,
+                pose_a,
+                &Isometry3::identity(),
+                pose_b,
+                &Isometry3::identity(),
+                [0, 0],
+            )
+        }
+        _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
+    };
+    if !answer.distance.is_finite() || !answer.lower.is_finite() || !answer.upper.is_finite() {
+        // Finite inputs whose combination overflows f64 (coordinates near 1e308).
+        return Err(Error::NonFinitePose);
+    }
+    Ok(answer)
+}
+
+/// Two convex pieces in the frame of A's piece, origin at A's centroid: the
+/// quantities that do not change during one query.
+struct Pair<'s> {
+    a: &'s Convex,
+    b: &'s Convex,
+    /// Rotation of B's piece into A's piece frame, and its transpose.
+    r: Matrix3<f64>,
+    rt: Matrix3<f64>,
+    /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`.
+    t: Vector3<f64>,
+    /// `ε`-free part of (6.2): `D(K)²` from (6.4).
+    d2: f64,
+    /// Allowance for floating-point error in the bounds.
+    slack: f64,
+    radii: f64,
+}
+
+/// One convex pair's run of the Numerical Algorithm.
+struct Run {
+    simplex: Simplex,
+    sol: Solution,
+    /// `|v|`, zero when the cores touch or intersect.
+    norm: f64,
+    /// Best lower bound on the core distance seen, before slack.
+    lower: f64,
+    iterations: u32,
+    exit: Exit,
+    backup_used: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Exit {
+    Status(Status),
+    /// The lower bound passed the caller's cutoff: this pair cannot be the
+    /// nearest of a compound.
+    Pruned,
+}
+
+impl<'s> Pair<'s> {
+    fn new(a: &'s Convex, b: &'s Convex, rel: &Isometry3<f64>) -> Self {
+        let r = *rel.rotation.to_rotation_matrix().matrix();
+        let rb = r * b.centroid().coords;
+        let t = rb + rel.translation.vector - a.centroid().coords;
+        let t_norm = t.norm();
+        let d = a.size() + b.size() + t_norm;
+        // Every input to a dot product is at most `scale` in size; the sums of a
+        // few products each carry a relative error of a few ε. 64 ε covers the
+        // rotation, the centroid shift and the subalgorithm's weights with room.
+        let scale = d + a.centroid().coords.norm() + rb.norm() + rel.translation.vector.norm();
+        Pair {
+            a,
+            b,
+            r,
+            rt: r.transpose(),
+            t,
+            d2: d * d,
+            slack: 64.0 * f64::EPSILON * scale,
+            radii: a.radius() + b.radius(),
+        }
+    }
+
+    /// `y = z1 - z2` for vertex `ia` of A and `ib` of B. The centroid-midpoint
+    /// origin of (6.1) cancels in the difference; what matters is that both
+    /// terms are small vectors relative to their centroids.
+    #[inline]
+    fn vertex(&self, ia: usize, ib: usize) -> Vertex {
+        let y = self.a.local(ia) - (self.r * self.b.local(ib) + self.t);
+        Vertex {
+            y,
+            ia: ia as u32,
+            ib: ib as u32,
+        }
+    }
+
+    /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one scan of each vertex set.
+    #[inline]
+    fn support(&self, eta: &Vector3<f64>) -> Vertex {
+        let ia = self.a.support_index(eta);
+        let ib = self.b.support_index(&(self.rt * -eta));
+        self.vertex(ia, ib)
+    }
+
+    /// The Numerical Algorithm, steps (1) to (6).
+    fn solve(&self, options: &Options, warm: Option<&[[u32; 2]]>, cutoff: f64) -> Run {
+        // Step (1): V0 from the warm start, else the single point s_K(z̄2 - z̄1).
+        let mut simplex = match warm {
+            Some(pairs) => {
+                let mut pts = [Vertex::default(); 4];
+                for (p, &[i, j]) in pts.iter_mut().zip(pairs) {
+                    *p = self.vertex(i as usize, j as usize);
+                }
+                Simplex::new(&pts[..pairs.len()])
+            }
+            None => Simplex::new(&[self.support(&self.t)]),
+        };
+        let eps_d2 = options.tolerance * self.d2;
+        let mut iterations = 0u32;
+        let mut prev: Option<(Solution, f64)> = None;
+        let mut lower = 0.0f64;
+        let mut backup_used = false;
+        loop {
+            iterations += 1;
+            // Step (2).
+            let (mut sol, mut by_backup) = match simplex.solve() {
+                Some(s) => (s, false),
+                None => {
+                    backup_used = true;
+                    (simplex.backup(), true)
+                }
+            };
+            loop {
+                let full = sol.mask == 0b1111;
+                if full {
+                    // The origin is inside the tetrahedron: the cores intersect.
+                    sol.v = Vector3::zeros();
+                }
+                let v2 = sol.v.norm_squared();
+                let finish = |exit, sol: Solution, simplex: Simplex, lower: f64| {
+                    let norm = sol.v.norm();
+                    Run {
+                        simplex,
+                        sol,
+                        norm,
+                        lower,
+                        iterations,
+                        exit: Exit::Status(exit),
+                        backup_used,
+                    }
+                };
+                if v2 == 0.0 {
+                    return finish(Status::Converged, sol, simplex, 0.0);
+                }
+                // Step (3): the stopping rule, and the bounds of Theorem 4.1.
+                let s = self.support(&-sol.v);
+                let vs = sol.v.dot(&s.y);
+                let norm = v2.sqrt();
+                lower = lower.max(vs / norm);
+                if v2 - vs <= eps_d2 {
+                    return finish(Status::Converged, sol, simplex, lower);
+                }
+                let lower_cert = lower - self.slack - self.radii;
+                if lower_cert > cutoff {
+                    let mut run = finish(Status::Converged, sol, simplex, lower);
+                    run.exit = Exit::Pruned;
+                    return run;
+                }
+                if let Some(m) = options.margin {
+                    if lower_cert > m {
+                        return finish(Status::Farther, sol, simplex, lower);
+                    }
+                    if norm + self.slack - self.radii <= m {
+                        return finish(Status::Closer, sol, simplex, lower);
+                    }
+                }
+                if iterations >= options.max_iterations {
+                    return finish(Status::IterationCap, sol, simplex, lower);
+                }
+                // Step (4): descend while |v| decreases and V̂ is not full.
+                let descended = prev.is_none_or(|(_, p2)| v2 < p2);
+                if descended && sol.mask.count_ones() <= 3 {
+                    prev = Some((sol, v2));
+                    simplex.push(sol.mask, s);
+                    break;
+                }
+                // Step (5): round-off has the last word. The previous iterate,
+                // if nearer, is still valid: its vertices kept their slots.
+                if by_backup {
+                    let best = match prev {
+                        Some((p, p2)) if p2 < v2 => p,
+                        _ => sol,
+                    };
+                    return finish(Status::ToleranceNotMet, best, simplex, lower);
+                }
+                // Step (6): redo v_k with the Backup Procedure.
+                sol = simplex.backup();
+                by_backup = true;
+                backup_used = true;
+            }
+        }
+    }
+
+    /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
+    /// pieces' offsets in their shapes' body frames.
+    fn answer(
+        &self,
+        run: &Run,
+        pose_a: &Isometry3<f64>,
+        off_a: &Isometry3<f64>,
+        pose_b: &Isometry3<f64>,
+        off_b: &Isometry3<f64>,
+        pieces: [u32; 2],
+    ) -> Answer {
+        let mut wa = Vector3::zeros();
+        let mut wb = Vector3::zeros();
+        let mut pairs = [[0u32; 2]; 4];
+        let mut len = 0;
+        for i in 0..4 {
+            if run.sol.mask & (1 << i) != 0 {
+                let vx = &run.simplex.vertices[i];
+                let l = run.sol.lambda[i];
+                wa += self.a.local(vx.ia as usize) * l;
+                wb += self.b.local(vx.ib as usize) * l;
+                pairs[len] = [vx.ia, vx.ib];
+                len += 1;
+            }
+        }
+        let core_a = pose_a * (off_a * (self.a.centroid() + wa));
+        let core_b = pose_b * (off_b * (self.b.centroid() + wb));
+        let separated = run.norm > 0.0;
+        let normal = if separated {
+            // b - a = -v in A's piece frame.
+            pose_a.rotation * (off_a.rotation * (-run.sol.v / run.norm))
+        } else {
+            Vector3::zeros()
+        };
+        let (ra, rb) = (self.a.radius(), self.b.radius());
+        let penetration = if !separated {
+            let core = if run.sol.mask == 0b1111 {
+                run.simplex.inner_radius()
+            } else {
+                0.0
+            };
+            core + self.radii
+        } else {
+            (self.radii - run.norm).max(0.0)
+        };
+        let upper = (run.norm + self.slack - self.radii).max(0.0);
+        let lower = (run.lower - self.slack - self.radii).max(0.0);
+        let distance = (run.norm - self.radii).max(0.0).clamp(lower, upper);
+        Answer {
+            distance,
+            lower,
+            upper,
+            point_a: core_a + normal * ra,
+            point_b: core_b - normal * rb,
+            normal,
+            penetration,
+            iterations: run.iterations,
+            status: match run.exit {
+                Exit::Status(s) => s,
+                Exit::Pruned => Status::Converged,
+            },
+            backup_used: run.backup_used,
+            pieces,
+            warm_start: WarmStart {
+                pieces,
+                len: len as u8,
+                pairs,
+            },
+        }
+    }
+}
+
+/// (2.3), (2.8): the minimum over piece pairs. Pairs are visited warm pair
+/// first, then by a bounding-sphere lower bound; each runs with the best upper
+/// bound so far as its cutoff, so a pair that cannot win stops early.
+fn compound(
+    a: &Shape,
+    pose_a: &Isometry3<f64>,
+    b: &Shape,
+    pose_b: &Isometry3<f64>,
+    rel: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Answer {
+    let (na, nb) = (a.piece_count(), b.piece_count());
+    let mut order: Vec<(f64, u32, u32)> = Vec::with_capacity(na * nb);
+    for i in 0..na {
+        let (oa, ca) = a.piece(i).expect("index below piece_count");
+        let centre_a = oa * ca.centroid();
+        for j in 0..nb {
+            let (ob, cb) = b.piece(j).expect("index below piece_count");
+            let centre_b = rel * (ob * cb.centroid());
+            let gap = (centre_b - centre_a).norm()
+                - (ca.size() + ca.radius())
+                - (cb.size() + cb.radius());
+            order.push((gap, i as u32, j as u32));
+        }
+    }
+    order.sort_by(|x, y| x.0.total_cmp(&y.0));
+    if let Some(w) = warm
+        && let Some(pos) = order.iter().position(|&(_, i, j)| [i, j] == w.pieces)
+    {
+        let first = order.remove(pos);
+        order.insert(0, first);
+    }
+
+    let mut best: Option<Answer> = None;
+    let mut lower = f64::INFINITY;
+    let mut iterations = 0u32;
+    let mut backup_used = false;
+    let mut penetration = 0.0f64;
+    let mut trouble: Option<Status> = None;
+    for (gap, i, j) in order {
+        let cutoff = best.map_or(f64::INFINITY, |b| b.upper);
+        // The sphere bound is rough (no slack): only skip on a clear margin.
+        if gap > cutoff * (1.0 + 1e-9) + f64::MIN_POSITIVE {
+            continue;
+        }
+        let (oa, ca) = a.piece(i as usize).expect("index below piece_count");
+        let (ob, cb) = b.piece(j as usize).expect("index below piece_count");
+        let piece_rel = oa.inv_mul(&(rel * ob));
+        let pair = Pair::new(ca, cb, &piece_rel);
+        let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
+        let run = pair.solve(options, warm_pairs, cutoff);
+        let ans = pair.answer(&run, pose_a, &oa, pose_b, &ob, [i, j]);
+        iterations = iterations.saturating_add(ans.iterations);
+        backup_used |= ans.backup_used;
+        lower = lower.min(ans.lower);
+        if run.norm == 0.0 {
+            penetration = penetration.max(ans.penetration);
+        }
+        match run.exit {
+            Exit::Pruned => continue,
+            Exit::Status(Status::IterationCap | Status::ToleranceNotMet) => {
+                trouble = trouble.max_by_severity(ans.status);
+            }
+            Exit::Status(_) => {}
+        }
+        let better = best.is_none_or(|b| (ans.upper, ans.distance) < (b.upper, b.distance));
+        if better {
+            best = Some(ans);
+        }
+        if ans.status == Status::Closer {
+            best = Some(ans);
+            break;
+        }
+    }
+    let mut out = best.expect("the first pair is never skipped or pruned");
+    out.lower = lower.min(out.upper);
+    out.iterations = iterations;
+    out.backup_used = backup_used;
+    out.penetration = out.penetration.max(penetration);
+    // The margin is decided on the union's bounds, not on one pair's.
+    out.status = match options.margin {
+        _ if out.status == Status::Closer => Status::Closer,
+        Some(m) if out.lower > m => Status::Farther,
+        _ => match trouble {
+            Some(t) => t,
+            None if out.status == Status::Farther => Status::Converged,
+            None => out.status,
+        },
+    };
+    out
+}
+
+trait Severity {
+    fn max_by_severity(self, s: Status) -> Option<Status>;
+}
+
+impl Severity for Option<Status> {
+    fn max_by_severity(self, s: Status) -> Option<Status> {
+        match (self, s) {
+            (Some(Status::ToleranceNotMet), _) => self,
+            _ => Some(s),
+        }
+    }
+}

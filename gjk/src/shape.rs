@@ -1,0 +1,344 @@
+//! Shapes: convex vertex sets with a rounding radius, and unions of them.
+//!
+//! A shape is described in its own body frame and placed in the world by an
+//! [`Isometry3`] at query time. Everything that does not depend on the pose
+//! (centroid, size bound, a layout fit for the support scan) is computed once
+//! here, at construction, as Section 6 of the paper suggests.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use crate::Error;
+
+/// A convex object: the convex hull of a vertex set, grown by a radius `r >= 0`
+/// (the paper's r-spherical extension, Section 2).
+///
+/// A single point with a radius is a sphere, two points a capsule, a box with a
+/// radius a rounded box: model only what the scene needs. Vertices need not be
+/// hull vertices; duplicates, collinear and coplanar sets are valid.
+///
+/// ```
+/// use gjk::Convex;
+/// use nalgebra::{Point3, Vector3};
+///
+/// let ball = Convex::sphere(0.5)?;
+/// let pill = Convex::capsule(Point3::new(0.0, 0.0, -1.0), Point3::new(0.0, 0.0, 1.0), 0.2)?;
+/// let crate_ = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.05)?;
+/// let tetra = Convex::new(
+///     vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0), Point3::new(0.0, 0.0, 1.0)],
+///     0.0,
+/// )?;
+/// assert_eq!(tetra.vertices().len(), 4);
+/// # Ok::<(), gjk::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Convex {
+    vertices: Vec<Point3<f64>>,
+    radius: f64,
+    centroid: Point3<f64>,
+    /// `D(coZ - z̄)` of (6.4): the largest distance of a vertex from the centroid.
+    size: f64,
+    /// Vertices relative to the centroid, one array per coordinate, so that the
+    /// support scan reads memory linearly and vectorises. Kept relative to the
+    /// centroid so that a body frame far from its vertices loses no precision.
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    zs: Vec<f64>,
+}
+
+impl Convex {
+    /// The convex hull of `vertices` grown by `radius`.
+    ///
+    /// # Errors
+    /// [`Error::EmptyVertices`] for no vertices, [`Error::TooManyVertices`] past
+    /// `u32::MAX`, [`Error::NonFiniteVertex`] for NaN or infinity, and
+    /// [`Error::InvalidRadius`] for a negative or non-finite radius.
+    pub fn new(vertices: impl Into<Vec<Point3<f64>>>, radius: f64) -> Result<Self, Error> {
+        let vertices = vertices.into();
+        if vertices.is_empty() {
+            return Err(Error::EmptyVertices);
+        }
+        if u32::try_from(vertices.len()).is_err() {
+            return Err(Error::TooManyVertices(vertices.len()));
+        }
+        if let Some(index) = vertices
+            .iter()
+            .position(|v| !v.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::NonFiniteVertex(index));
+        }
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(Error::InvalidRadius(radius));
+        }
+        // Two-pass mean around the first vertex: summing raw coordinates of a set
+        // far from the origin would lose the digits that matter.
+        let base = vertices[0];
+        let n = vertices.len() as f64;
+        let mean_offset = vertices
+            .iter()
+            .fold(Vector3::zeros(), |acc, v| acc + (v - base))
+            / n;
+        let centroid = base + mean_offset;
+        if !centroid.coords.iter().all(|c| c.is_finite()) {
+            // Finite vertices whose spread overflows f64.
+            return Err(Error::NonFiniteVertex(0));
+        }
+        let len = vertices.len();
+        let (mut xs, mut ys, mut zs) = (
+            Vec::with_capacity(len),
+            Vec::with_capacity(len),
+            Vec::with_capacity(len),
+        );
+        let mut size2: f64 = 0.0;
+        for v in &vertices {
+            let d = v - centroid;
+            size2 = size2.max(d.norm_squared());
+            xs.push(d.x);
+            ys.push(d.y);
+            zs.push(d.z);
+        }
+        let size = size2.sqrt();
+        if !size.is_finite() {
+            return Err(Error::NonFiniteVertex(0));
+        }
+        Ok(Self {
+            vertices,
+            radius,
+            centroid,
+            size,
+            xs,
+            ys,
+            zs,
+        })
+    }
+
+    /// A sphere: one point at the body origin with a radius.
+    ///
+    /// # Errors
+    /// [`Error::InvalidRadius`] for a negative or non-finite radius.
+    pub fn sphere(radius: f64) -> Result<Self, Error> {
+        Self::new(vec![Point3::origin()], radius)
+    }
+
+    /// A capsule: the segment from `a` to `b` grown by `radius`.
+    ///
+    /// # Errors
+    /// As [`Convex::new`].
+    pub fn capsule(a: Point3<f64>, b: Point3<f64>, radius: f64) -> Result<Self, Error> {
+        Self::new(vec![a, b], radius)
+    }
+
+    /// A box centred on the body origin with the given half extents, its edges
+    /// rounded by `radius` (0 for a sharp box).
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteVertex`] for a non-finite or negative half extent, and
+    /// as [`Convex::new`] for the radius.
+    pub fn cuboid(half_extents: Vector3<f64>, radius: f64) -> Result<Self, Error> {
+        if !half_extents.iter().all(|h| h.is_finite() && *h >= 0.0) {
+            return Err(Error::NonFiniteVertex(0));
+        }
+        let h = half_extents;
+        let vertices: Vec<Point3<f64>> = (0..8)
+            .map(|i| {
+                Point3::new(
+                    if i & 1 == 0 { -h.x } else { h.x },
+                    if i & 2 == 0 { -h.y } else { h.y },
+                    if i & 4 == 0 { -h.z } else { h.z },
+                )
+            })
+            .collect();
+        Self::new(vertices, radius)
+    }
+
+    /// The vertices as given, in the body frame. Warm-start indices refer to
+    /// positions in this slice.
+    pub fn vertices(&self) -> &[Point3<f64>] {
+        &self.vertices
+    }
+
+    /// The rounding radius.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// The mean of the vertices, in the body frame.
+    pub fn centroid(&self) -> Point3<f64> {
+        self.centroid
+    }
+
+    /// The largest distance from the centroid to a vertex: `D(coZ - z̄)` of (6.4),
+    /// the radius not included.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// Always false: a convex shape has at least one vertex. Present because
+    /// `len` is.
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+
+    /// Index of the vertex that maximises `(v - centroid)·d`: the support point
+    /// (3.7). A linear scan, as the paper prescribes, over a layout the compiler
+    /// vectorises; ties go to the lowest index so the answer is deterministic.
+    #[inline]
+    pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
+        let (xs, ys, zs) = (&self.xs[..], &self.ys[..], &self.zs[..]);
+        let n = xs.len();
+        let (dx, dy, dz) = (d.x, d.y, d.z);
+        const LANES: usize = 4;
+        if n < 2 * LANES {
+            let mut best = 0;
+            let mut best_dot = f64::NEG_INFINITY;
+            for i in 0..n {
+                let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
+                if dot > best_dot {
+                    best_dot = dot;
+                    best = i;
+                }
+            }
+            return best;
+        }
+        // Independent lanes break the loop-carried dependency of a single running
+        // maximum; the lanes are merged at the end, lowest index first on ties.
+        let mut lane_dot = [f64::NEG_INFINITY; LANES];
+        let mut lane_idx = [0usize; LANES];
+        let chunks = n / LANES;
+        for c in 0..chunks {
+            let base = c * LANES;
+            let x = &xs[base..base + LANES];
+            let y = &ys[base..base + LANES];
+            let z = &zs[base..base + LANES];
+            for l in 0..LANES {
+                let dot = x[l] * dx + y[l] * dy + z[l] * dz;
+                if dot > lane_dot[l] {
+                    lane_dot[l] = dot;
+                    lane_idx[l] = base + l;
+                }
+            }
+        }
+        let mut best = lane_idx[0];
+        let mut best_dot = lane_dot[0];
+        for l in 1..LANES {
+            if lane_dot[l] > best_dot || (lane_dot[l] == best_dot && lane_idx[l] < best) {
+                best_dot = lane_dot[l];
+                best = lane_idx[l];
+            }
+        }
+        for i in chunks * LANES..n {
+            let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
+            if dot > best_dot {
+                best_dot = dot;
+                best = i;
+            }
+        }
+        best
+    }
+
+    /// Vertex `i` relative to the centroid, as stored for the scan.
+    #[inline]
+    pub(crate) fn local(&self, i: usize) -> Vector3<f64> {
+        Vector3::new(self.xs[i], self.ys[i], self.zs[i])
+    }
+}
+
+/// A union of convex pieces, each placed in the compound's body frame by its own
+/// offset. Its distance to another shape is the minimum over piece pairs, (2.3)
+/// and (2.8), and the answer names the pieces that realise it.
+///
+/// ```
+/// use gjk::{Compound, Convex};
+/// use nalgebra::{Isometry3, Point3, Vector3};
+///
+/// // A dumbbell: two balls joined by a bar.
+/// let ball = Convex::sphere(0.3)?;
+/// let bar = Convex::capsule(Point3::new(-1.0, 0.0, 0.0), Point3::new(1.0, 0.0, 0.0), 0.05)?;
+/// let dumbbell = Compound::new(vec![
+///     (Isometry3::translation(-1.0, 0.0, 0.0), ball.clone()),
+///     (Isometry3::identity(), bar),
+///     (Isometry3::translation(1.0, 0.0, 0.0), ball),
+/// ])?;
+/// assert_eq!(dumbbell.pieces().len(), 3);
+/// # Ok::<(), gjk::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Compound {
+    pieces: Vec<(Isometry3<f64>, Convex)>,
+}
+
+impl Compound {
+    /// A union of `pieces`, each with its offset in the compound's body frame.
+    ///
+    /// # Errors
+    /// [`Error::EmptyCompound`] for no pieces, [`Error::TooManyVertices`] past
+    /// `u32::MAX` pieces, and [`Error::NonFinitePose`] for an offset with NaN or
+    /// infinity.
+    pub fn new(pieces: Vec<(Isometry3<f64>, Convex)>) -> Result<Self, Error> {
+        if pieces.is_empty() {
+            return Err(Error::EmptyCompound);
+        }
+        if u32::try_from(pieces.len()).is_err() {
+            return Err(Error::TooManyVertices(pieces.len()));
+        }
+        if pieces.iter().any(|(offset, _)| !pose_is_finite(offset)) {
+            return Err(Error::NonFinitePose);
+        }
+        Ok(Self { pieces })
+    }
+
+    /// The pieces with their offsets, in the order given; the answer's piece
+    /// indices refer to positions in this slice.
+    pub fn pieces(&self) -> &[(Isometry3<f64>, Convex)] {
+        &self.pieces
+    }
+}
+
+/// Anything the query accepts: one convex piece or a union of them.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A single convex object.
+    Convex(Convex),
+    /// A union of convex objects.
+    Compound(Compound),
+}
+
+impl Shape {
+    /// Number of convex pieces: 1 for a convex shape.
+    pub fn piece_count(&self) -> usize {
+        match self {
+            Shape::Convex(_) => 1,
+            Shape::Compound(c) => c.pieces.len(),
+        }
+    }
+
+    /// Piece `i` with its offset in the shape's body frame.
+    pub(crate) fn piece(&self, i: usize) -> Option<(Isometry3<f64>, &Convex)> {
+        match self {
+            Shape::Convex(c) if i == 0 => Some((Isometry3::identity(), c)),
+            Shape::Convex(_) => None,
+            Shape::Compound(c) => c.pieces.get(i).map(|(o, p)| (*o, p)),
+        }
+    }
+}
+
+impl From<Convex> for Shape {
+    fn from(c: Convex) -> Self {
+        Shape::Convex(c)
+    }
+}
+
+impl From<Compound> for Shape {
+    fn from(c: Compound) -> Self {
+        Shape::Compound(c)
+    }
+}
+
+pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {
+    p.translation.vector.iter().all(|c| c.is_finite())
+        && p.rotation.coords.iter().all(|c| c.is_finite())
+}

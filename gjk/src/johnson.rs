@@ -23,6 +23,10 @@ const fn members(mask: usize) -> ([u8; 4], u8) {
     (out, n as u8)
 }
 
+/// Every non-empty subset, smallest first, so that a subset's cofactors are
+/// computed after those of the subsets they recurse on.
+const BY_SIZE: [u8; 15] = [1, 2, 4, 8, 3, 5, 6, 9, 10, 12, 7, 11, 13, 14, 15];
+
 const MEMBERS: [([u8; 4], u8); 16] = {
     let mut t = [([0u8; 4], 0u8); 16];
     let mut m = 0;
@@ -113,14 +117,10 @@ impl Simplex {
         let nbit = 1usize << n;
         // Subsets containing n, by increasing size, so each cofactor's
         // smaller subsets are ready. Subsets of `old` keep their values.
-        for size in 1..=4u8 {
-            for mask in 1..16usize {
-                if mask & nbit == 0 || mask & !(self.all as usize) != 0 {
-                    continue;
-                }
-                if MEMBERS[mask].1 != size {
-                    continue;
-                }
+        let all = self.all as usize;
+        for &mask in &BY_SIZE {
+            let mask = mask as usize;
+            if mask & nbit != 0 && mask & !all == 0 {
                 self.cofactors(mask);
             }
         }
@@ -231,18 +231,10 @@ impl Simplex {
                 // Then every other subset holding the newest point, smallest
                 // first; subsets without it were rejected last iteration and
                 // come last, for round-off's sake only.
-                for size in 1..=4u8 {
-                    for mask in 1..16usize {
-                        if mask == first
-                            || mask & !all != 0
-                            || mask & nbit == 0
-                            || MEMBERS[mask].1 != size
-                        {
-                            continue;
-                        }
-                        if self.passes(mask) {
-                            return Some(self.solution(mask));
-                        }
+                for &mask in &BY_SIZE {
+                    let mask = mask as usize;
+                    if mask != first && mask & !all == 0 && mask & nbit != 0 && self.passes(mask) {
+                        return Some(self.solution(mask));
                     }
                 }
                 (1..16usize)
@@ -252,17 +244,13 @@ impl Simplex {
             }
             None => {
                 // A fresh V0 (warm start): the whole set is the likeliest answer.
-                for size in (1..=4u8).rev() {
-                    for mask in 1..16usize {
-                        if mask & !all != 0 || MEMBERS[mask].1 != size {
-                            continue;
-                        }
-                        if self.passes(mask) {
-                            return Some(self.solution(mask));
-                        }
-                    }
-                }
-                None
+                BY_SIZE
+                    .iter()
+                    .rev()
+                    .map(|&m| m as usize)
+                    .filter(|&m| m & !all == 0)
+                    .find(|&m| self.passes(m))
+                    .map(|m| self.solution(m))
             }
         }
     }

@@ -187,14 +187,7 @@ pub fn distance(
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel);
             let run = pair.solve(options, warm.map(|w| w.pairs()), f64::INFINITY);
-            pair.answer(
-                &run,
-                pose_a,
-                &Isometry3::identity(),
-                pose_b,
-                &Isometry3::identity(),
-                [0, 0],
-            )
+            pair.answer(&run, pose_a, None, pose_b, None, [0, 0])
         }
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
@@ -224,7 +217,10 @@ struct Pair<'s> {
 
 /// One convex pair's run of the Numerical Algorithm.
 struct Run {
-    simplex: Simplex,
+    /// The simplex's vertices by slot; `sol.mask` says which count.
+    vertices: [Vertex; 4],
+    /// (5.9) when the final simplex is a tetrahedron holding the origin.
+    inner_radius: f64,
     sol: Solution,
     /// `|v|`, zero when the cores touch or intersect.
     norm: f64,
@@ -322,10 +318,15 @@ impl<'s> Pair<'s> {
                     sol.v = Vector3::zeros();
                 }
                 let v2 = sol.v.norm_squared();
-                let finish = |exit, sol: Solution, simplex: Simplex, lower: f64| {
+                let finish = |exit, sol: Solution, simplex: &Simplex, lower: f64| {
                     let norm = sol.v.norm();
                     Run {
-                        simplex,
+                        vertices: simplex.vertices,
+                        inner_radius: if sol.mask == 0b1111 {
+                            simplex.inner_radius()
+                        } else {
+                            0.0
+                        },
                         sol,
                         norm,
                         lower,
@@ -335,7 +336,7 @@ impl<'s> Pair<'s> {
                     }
                 };
                 if v2 == 0.0 {
-                    return finish(Status::Converged, sol, simplex, 0.0);
+                    return finish(Status::Converged, sol, &simplex, 0.0);
                 }
                 // Step (3): the stopping rule, and the bounds of Theorem 4.1.
                 let s = self.support(&-sol.v);
@@ -343,24 +344,24 @@ impl<'s> Pair<'s> {
                 let norm = v2.sqrt();
                 lower = lower.max(vs / norm);
                 if v2 - vs <= eps_d2 {
-                    return finish(Status::Converged, sol, simplex, lower);
+                    return finish(Status::Converged, sol, &simplex, lower);
                 }
                 let lower_cert = lower - self.slack - self.radii;
                 if lower_cert > cutoff {
-                    let mut run = finish(Status::Converged, sol, simplex, lower);
+                    let mut run = finish(Status::Converged, sol, &simplex, lower);
                     run.exit = Exit::Pruned;
                     return run;
                 }
                 if let Some(m) = options.margin {
                     if lower_cert > m {
-                        return finish(Status::Farther, sol, simplex, lower);
+                        return finish(Status::Farther, sol, &simplex, lower);
                     }
                     if norm + self.slack - self.radii <= m {
-                        return finish(Status::Closer, sol, simplex, lower);
+                        return finish(Status::Closer, sol, &simplex, lower);
                     }
                 }
                 if iterations >= options.max_iterations {
-                    return finish(Status::IterationCap, sol, simplex, lower);
+                    return finish(Status::IterationCap, sol, &simplex, lower);
                 }
                 // Step (4): descend while |v| decreases and V̂ is not full.
                 let descended = prev.is_none_or(|(_, p2)| v2 < p2);
@@ -376,7 +377,7 @@ impl<'s> Pair<'s> {
                         Some((p, p2)) if p2 < v2 => p,
                         _ => sol,
                     };
-                    return finish(Status::ToleranceNotMet, best, simplex, lower);
+                    return finish(Status::ToleranceNotMet, best, &simplex, lower);
                 }
                 // Step (6): redo v_k with the Backup Procedure.
                 sol = simplex.backup();
@@ -392,18 +393,23 @@ impl<'s> Pair<'s> {
         &self,
         run: &Run,
         pose_a: &Isometry3<f64>,
-        off_a: &Isometry3<f64>,
+        off_a: Option<&Isometry3<f64>>,
         pose_b: &Isometry3<f64>,
-        off_b: &Isometry3<f64>,
+        off_b: Option<&Isometry3<f64>>,
         pieces: [u32; 2],
     ) -> Answer {
+        // Pieces of a compound sit at an offset in their shape's body frame.
+        let place = |pose: &Isometry3<f64>, off: Option<&Isometry3<f64>>, p: Point3<f64>| match off {
+            Some(o) => pose * (o * p),
+            None => pose * p,
+        };
         let mut wa = Vector3::zeros();
         let mut wb = Vector3::zeros();
         let mut pairs = [[0u32; 2]; 4];
         let mut len = 0;
         for i in 0..4 {
             if run.sol.mask & (1 << i) != 0 {
-                let vx = &run.simplex.vertices[i];
+                let vx = &run.vertices[i];
                 let l = run.sol.lambda[i];
                 wa += self.a.local(vx.ia as usize) * l;
                 wb += self.b.local(vx.ib as usize) * l;
@@ -411,23 +417,19 @@ impl<'s> Pair<'s> {
                 len += 1;
             }
         }
-        let core_a = pose_a * (off_a * (self.a.centroid() + wa));
-        let core_b = pose_b * (off_b * (self.b.centroid() + wb));
+        let core_a = place(pose_a, off_a, self.a.centroid() + wa);
+        let core_b = place(pose_b, off_b, self.b.centroid() + wb);
         let separated = run.norm > 0.0;
         let normal = if separated {
             // b - a = -v in A's piece frame.
-            pose_a.rotation * (off_a.rotation * (-run.sol.v / run.norm))
+            let n = -run.sol.v / run.norm;
+            pose_a.rotation * off_a.map_or(n, |o| o.rotation * n)
         } else {
             Vector3::zeros()
         };
         let (ra, rb) = (self.a.radius(), self.b.radius());
         let penetration = if !separated {
-            let core = if run.sol.mask == 0b1111 {
-                run.simplex.inner_radius()
-            } else {
-                0.0
-            };
-            core + self.radii
+            run.inner_radius + self.radii
         } else {
             (self.radii - run.norm).max(0.0)
         };
@@ -510,7 +512,7 @@ fn compound(
         let pair = Pair::new(ca, cb, &piece_rel);
         let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
         let run = pair.solve(options, warm_pairs, cutoff);
-        let ans = pair.answer(&run, pose_a, &oa, pose_b, &ob, [i, j]);
+        let ans = pair.answer(&run, pose_a, Some(&oa), pose_b, Some(&ob), [i, j]);
         iterations = iterations.saturating_add(ans.iterations);
         backup_used |= ans.backup_used;
         lower = lower.min(ans.lower);

@@ -185,59 +185,18 @@ impl Convex {
 
     /// Index of the vertex that maximises `(v - centroid)·d`: the support point
     /// (3.7). A linear scan, as the paper prescribes, over a layout the compiler
-    /// vectorises; ties go to the lowest index so the answer is deterministic.
+    /// vectorises; ties go to the lowest index so the answer is deterministic
+    /// whichever code path runs.
     #[inline]
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
-        let (xs, ys, zs) = (&self.xs[..], &self.ys[..], &self.zs[..]);
-        let n = xs.len();
-        let (dx, dy, dz) = (d.x, d.y, d.z);
-        const LANES: usize = 4;
-        if n < 2 * LANES {
-            let mut best = 0;
-            let mut best_dot = f64::NEG_INFINITY;
-            for i in 0..n {
-                let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
-                if dot > best_dot {
-                    best_dot = dot;
-                    best = i;
-                }
-            }
-            return best;
-        }
-        // Independent lanes break the loop-carried dependency of a single running
-        // maximum; the lanes are merged at the end, lowest index first on ties.
-        let mut lane_dot = [f64::NEG_INFINITY; LANES];
-        let mut lane_idx = [0usize; LANES];
-        let chunks = n / LANES;
-        for c in 0..chunks {
-            let base = c * LANES;
-            let x = &xs[base..base + LANES];
-            let y = &ys[base..base + LANES];
-            let z = &zs[base..base + LANES];
-            for l in 0..LANES {
-                let dot = x[l] * dx + y[l] * dy + z[l] * dz;
-                if dot > lane_dot[l] {
-                    lane_dot[l] = dot;
-                    lane_idx[l] = base + l;
-                }
+        #[cfg(target_arch = "x86_64")]
+        {
+            if self.xs.len() >= 16 && std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, checked just above.
+                return unsafe { scan_avx2(&self.xs, &self.ys, &self.zs, d) };
             }
         }
-        let mut best = lane_idx[0];
-        let mut best_dot = lane_dot[0];
-        for l in 1..LANES {
-            if lane_dot[l] > best_dot || (lane_dot[l] == best_dot && lane_idx[l] < best) {
-                best_dot = lane_dot[l];
-                best = lane_idx[l];
-            }
-        }
-        for i in chunks * LANES..n {
-            let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
-            if dot > best_dot {
-                best_dot = dot;
-                best = i;
-            }
-        }
-        best
+        scan(&self.xs, &self.ys, &self.zs, d)
     }
 
     /// Vertex `i` relative to the centroid, as stored for the scan.
@@ -341,4 +300,68 @@ impl From<Compound> for Shape {
 pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {
     p.translation.vector.iter().all(|c| c.is_finite())
         && p.rotation.coords.iter().all(|c| c.is_finite())
+}
+
+/// The support scan on 4 independent lanes. Each lane keeps its running maximum
+/// and the index (as f64, exact below 2^53) through selects, not branches, so
+/// the loop vectorises; lanes are merged lowest index first on ties.
+#[inline(always)]
+fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+    const LANES: usize = 4;
+    let n = xs.len().min(ys.len()).min(zs.len());
+    let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+    let (dx, dy, dz) = (d.x, d.y, d.z);
+    if n < 2 * LANES {
+        // Spheres, capsules, boxes: lane set-up would cost more than the scan.
+        let mut top = f64::NEG_INFINITY;
+        let mut idx = 0;
+        for i in 0..n {
+            let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
+            if dot > top {
+                top = dot;
+                idx = i;
+            }
+        }
+        return idx;
+    }
+    let mut best = [f64::NEG_INFINITY; LANES];
+    let mut best_i = [0.0f64; LANES];
+    let mut base = [0.0f64, 1.0, 2.0, 3.0];
+    for ((x, y), z) in xs
+        .chunks_exact(LANES)
+        .zip(ys.chunks_exact(LANES))
+        .zip(zs.chunks_exact(LANES))
+    {
+        for l in 0..LANES {
+            let dot = x[l] * dx + y[l] * dy + z[l] * dz;
+            let gt = dot > best[l];
+            best[l] = if gt { dot } else { best[l] };
+            best_i[l] = if gt { base[l] } else { best_i[l] };
+            base[l] += LANES as f64;
+        }
+    }
+    let mut top = best[0];
+    let mut top_i = best_i[0];
+    for l in 1..LANES {
+        if best[l] > top || (best[l] == top && best_i[l] < top_i) {
+            top = best[l];
+            top_i = best_i[l];
+        }
+    }
+    let mut idx = top_i as usize;
+    for i in n - n % LANES..n {
+        let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
+        if dot > top {
+            top = dot;
+            idx = i;
+        }
+    }
+    idx
+}
+
+/// [`scan`] compiled for AVX2 and FMA, chosen at run time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+    scan(xs, ys, zs, d)
 }

@@ -75,20 +75,42 @@ pub(crate) struct Simplex {
 
 impl Simplex {
     /// `Y = V0`, one to four points, all cofactors computed from scratch.
+    #[cfg(test)]
     pub fn new(points: &[Vertex]) -> Self {
-        debug_assert!(!points.is_empty() && points.len() <= 4);
-        let mut s = Simplex {
+        let mut s = Simplex::empty();
+        s.reset(points);
+        s
+    }
+
+    /// A simplex with no points, to be [`reset`](Self::reset) before use. One
+    /// per query, reused across a compound's piece pairs.
+    pub fn empty() -> Self {
+        Simplex {
             vertices: [Vertex::default(); 4],
             all: 0,
             dot: [[0.0; 4]; 4],
             delta: [[0.0; 4]; 16],
             newest: None,
-        };
-        for (slot, p) in points.iter().enumerate() {
-            s.insert(slot as u8, *p);
         }
-        s.newest = if points.len() == 1 { Some(0) } else { None };
-        s
+    }
+
+    /// `Y = V0`, one to four points, all cofactors computed from scratch.
+    pub fn reset(&mut self, points: &[Vertex]) {
+        debug_assert!(!points.is_empty() && points.len() <= 4);
+        if let [p] = points {
+            // The single-point start of Section 6, the common case.
+            self.vertices[0] = *p;
+            self.dot[0][0] = p.y.norm_squared();
+            self.delta[1][0] = 1.0;
+            self.all = 1;
+            self.newest = Some(0);
+            return;
+        }
+        self.all = 0;
+        for (slot, p) in points.iter().enumerate() {
+            self.insert(slot as u8, *p);
+        }
+        self.newest = None;
     }
 
     /// `Y = V̂ ∪ {p}`: keep `keep`, put `p` in a free slot, and compute the dot

@@ -186,8 +186,14 @@ pub fn distance(
     let answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel);
-            let run = pair.solve(options, warm.map(|w| w.pairs()), f64::INFINITY);
-            pair.answer(&run, pose_a, None, pose_b, None, [0, 0])
+            let mut simplex = Simplex::empty();
+            let run = pair.solve(
+                &mut simplex,
+                options,
+                warm.map(|w| w.pairs()),
+                f64::INFINITY,
+            );
+            pair.answer(&run, &simplex, pose_a, None, pose_b, None, [0, 0])
         }
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
@@ -217,10 +223,6 @@ struct Pair<'s> {
 
 /// One convex pair's run of the Numerical Algorithm.
 struct Run {
-    /// The simplex's vertices by slot; `sol.mask` says which count.
-    vertices: [Vertex; 4],
-    /// (5.9) when the final simplex is a tetrahedron holding the origin.
-    inner_radius: f64,
     sol: Solution,
     /// `|v|`, zero when the cores touch or intersect.
     norm: f64,
@@ -284,18 +286,24 @@ impl<'s> Pair<'s> {
     }
 
     /// The Numerical Algorithm, steps (1) to (6).
-    fn solve(&self, options: &Options, warm: Option<&[[u32; 2]]>, cutoff: f64) -> Run {
+    fn solve(
+        &self,
+        simplex: &mut Simplex,
+        options: &Options,
+        warm: Option<&[[u32; 2]]>,
+        cutoff: f64,
+    ) -> Run {
         // Step (1): V0 from the warm start, else the single point s_K(z̄2 - z̄1).
-        let mut simplex = match warm {
+        match warm {
             Some(pairs) => {
                 let mut pts = [Vertex::default(); 4];
                 for (p, &[i, j]) in pts.iter_mut().zip(pairs) {
                     *p = self.vertex(i as usize, j as usize);
                 }
-                Simplex::new(&pts[..pairs.len()])
+                simplex.reset(&pts[..pairs.len()]);
             }
-            None => Simplex::new(&[self.support(&self.t)]),
-        };
+            None => simplex.reset(&[self.support(&self.t)]),
+        }
         let eps_d2 = options.tolerance * self.d2;
         let mut iterations = 0u32;
         let mut prev: Option<(Solution, f64)> = None;
@@ -318,15 +326,9 @@ impl<'s> Pair<'s> {
                     sol.v = Vector3::zeros();
                 }
                 let v2 = sol.v.norm_squared();
-                let finish = |exit, sol: Solution, simplex: &Simplex, lower: f64| {
+                let finish = |exit, sol: Solution, lower: f64| {
                     let norm = sol.v.norm();
                     Run {
-                        vertices: simplex.vertices,
-                        inner_radius: if sol.mask == 0b1111 {
-                            simplex.inner_radius()
-                        } else {
-                            0.0
-                        },
                         sol,
                         norm,
                         lower,
@@ -336,7 +338,7 @@ impl<'s> Pair<'s> {
                     }
                 };
                 if v2 == 0.0 {
-                    return finish(Status::Converged, sol, &simplex, 0.0);
+                    return finish(Status::Converged, sol, 0.0);
                 }
                 // Step (3): the stopping rule, and the bounds of Theorem 4.1.
                 let s = self.support(&-sol.v);
@@ -344,24 +346,24 @@ impl<'s> Pair<'s> {
                 let norm = v2.sqrt();
                 lower = lower.max(vs / norm);
                 if v2 - vs <= eps_d2 {
-                    return finish(Status::Converged, sol, &simplex, lower);
+                    return finish(Status::Converged, sol, lower);
                 }
                 let lower_cert = lower - self.slack - self.radii;
                 if lower_cert > cutoff {
-                    let mut run = finish(Status::Converged, sol, &simplex, lower);
+                    let mut run = finish(Status::Converged, sol, lower);
                     run.exit = Exit::Pruned;
                     return run;
                 }
                 if let Some(m) = options.margin {
                     if lower_cert > m {
-                        return finish(Status::Farther, sol, &simplex, lower);
+                        return finish(Status::Farther, sol, lower);
                     }
                     if norm + self.slack - self.radii <= m {
-                        return finish(Status::Closer, sol, &simplex, lower);
+                        return finish(Status::Closer, sol, lower);
                     }
                 }
                 if iterations >= options.max_iterations {
-                    return finish(Status::IterationCap, sol, &simplex, lower);
+                    return finish(Status::IterationCap, sol, lower);
                 }
                 // Step (4): descend while |v| decreases and V̂ is not full.
                 let descended = prev.is_none_or(|(_, p2)| v2 < p2);
@@ -377,7 +379,7 @@ impl<'s> Pair<'s> {
                         Some((p, p2)) if p2 < v2 => p,
                         _ => sol,
                     };
-                    return finish(Status::ToleranceNotMet, best, &simplex, lower);
+                    return finish(Status::ToleranceNotMet, best, lower);
                 }
                 // Step (6): redo v_k with the Backup Procedure.
                 sol = simplex.backup();
@@ -392,6 +394,7 @@ impl<'s> Pair<'s> {
     fn answer(
         &self,
         run: &Run,
+        simplex: &Simplex,
         pose_a: &Isometry3<f64>,
         off_a: Option<&Isometry3<f64>>,
         pose_b: &Isometry3<f64>,
@@ -399,7 +402,8 @@ impl<'s> Pair<'s> {
         pieces: [u32; 2],
     ) -> Answer {
         // Pieces of a compound sit at an offset in their shape's body frame.
-        let place = |pose: &Isometry3<f64>, off: Option<&Isometry3<f64>>, p: Point3<f64>| match off {
+        let place = |pose: &Isometry3<f64>, off: Option<&Isometry3<f64>>, p: Point3<f64>| match off
+        {
             Some(o) => pose * (o * p),
             None => pose * p,
         };
@@ -409,7 +413,7 @@ impl<'s> Pair<'s> {
         let mut len = 0;
         for i in 0..4 {
             if run.sol.mask & (1 << i) != 0 {
-                let vx = &run.vertices[i];
+                let vx = &simplex.vertices[i];
                 let l = run.sol.lambda[i];
                 wa += self.a.local(vx.ia as usize) * l;
                 wb += self.b.local(vx.ib as usize) * l;
@@ -429,7 +433,12 @@ impl<'s> Pair<'s> {
         };
         let (ra, rb) = (self.a.radius(), self.b.radius());
         let penetration = if !separated {
-            run.inner_radius + self.radii
+            let core = if run.sol.mask == 0b1111 {
+                simplex.inner_radius()
+            } else {
+                0.0
+            };
+            core + self.radii
         } else {
             (self.radii - run.norm).max(0.0)
         };
@@ -494,6 +503,7 @@ fn compound(
         order.insert(0, first);
     }
 
+    let mut simplex = Simplex::empty();
     let mut best: Option<Answer> = None;
     let mut lower = f64::INFINITY;
     let mut iterations = 0u32;
@@ -511,8 +521,8 @@ fn compound(
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel);
         let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
-        let run = pair.solve(options, warm_pairs, cutoff);
-        let ans = pair.answer(&run, pose_a, Some(&oa), pose_b, Some(&ob), [i, j]);
+        let run = pair.solve(&mut simplex, options, warm_pairs, cutoff);
+        let ans = pair.answer(&run, &simplex, pose_a, Some(&oa), pose_b, Some(&ob), [i, j]);
         iterations = iterations.saturating_add(ans.iterations);
         backup_used |= ans.backup_used;
         lower = lower.min(ans.lower);

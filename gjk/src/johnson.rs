@@ -107,8 +107,17 @@ impl Simplex {
             return;
         }
         self.all = 0;
-        for (slot, p) in points.iter().enumerate() {
-            self.insert(slot as u8, *p);
+        let mut slot = 0u8;
+        for p in points {
+            self.insert(slot, *p);
+            // A warm start may name points that have become (nearly) affinely
+            // dependent at the new pose. Their cofactors would be round-off,
+            // so such a point is left out: it costs an iteration, not accuracy.
+            if self.independent() {
+                slot += 1;
+            } else {
+                self.all &= !(1 << slot);
+            }
         }
         self.newest = None;
     }
@@ -171,6 +180,26 @@ impl Simplex {
         }
     }
 
+    /// Whether `Y` is affinely independent by a clear margin: `Δ(Y)` is the
+    /// Gram determinant of the edges from the first point (proof of Theorem
+    /// 5.1), so its ratio to the product of the squared edge lengths is a
+    /// product of squared sines, 1 for orthogonal edges and 0 for flat sets.
+    fn independent(&self) -> bool {
+        let all = self.all as usize;
+        let (mem, len) = MEMBERS[all];
+        if len < 2 {
+            return true;
+        }
+        let k = mem[0] as usize;
+        let mut scale = 1.0;
+        for &i in &mem[1..len as usize] {
+            let i = i as usize;
+            scale *= self.dot[i][i] - 2.0 * self.dot[i][k] + self.dot[k][k];
+        }
+        let total = self.total(all);
+        total > 1e-10 * scale && scale > 0.0
+    }
+
     /// `Δ(Y_s)` of (5.4).
     #[inline]
     fn total(&self, mask: usize) -> f64 {
@@ -196,6 +225,9 @@ impl Simplex {
         if !self.interior(mask) {
             return false;
         }
+        if mask == 0b1111 {
+            return self.holds_origin();
+        }
         let rest = self.all as usize & !mask;
         let (rmem, rlen) = MEMBERS[rest];
         rmem[..rlen as usize].iter().all(|&j| {
@@ -204,14 +236,54 @@ impl Simplex {
         })
     }
 
+    /// Whether the origin is certainly inside the tetrahedron `Y`. Round-off
+    /// can make every cofactor of a flat tetrahedron positive, so the full set
+    /// passing Theorem 5.2 is confirmed here by the signs of the four signed
+    /// volumes with the origin in place of one vertex, each compared with a
+    /// forward bound on its own rounding error. A tetrahedron that fails is
+    /// left to its faces, which then give a `v` within round-off of the origin.
+    fn holds_origin(&self) -> bool {
+        let [a, b, c, d] = [0, 1, 2, 3].map(|i| self.vertices[i].y);
+        // (p, q, r) -> p·(q×r) with its error bound.
+        let triple = |p: Vector3<f64>, q: Vector3<f64>, r: Vector3<f64>| {
+            let cr = q.cross(&r);
+            (
+                p.dot(&cr),
+                16.0 * f64::EPSILON * p.norm() * q.norm() * r.norm(),
+            )
+        };
+        let (ba, ca, da) = (b - a, c - a, d - a);
+        let vols = [
+            triple(b, c, d),
+            triple(-a, ca, da),
+            triple(ba, -a, da),
+            triple(ba, ca, -a),
+        ];
+        let (total, _) = triple(ba, ca, da);
+        vols.iter()
+            .all(|&(v, err)| v.abs() > err && (v > 0.0) == (total > 0.0))
+    }
+
     fn solution(&self, mask: usize) -> Solution {
         let total = self.total(mask);
         let (mem, len) = MEMBERS[mask];
         let mut v = Vector3::zeros();
         let mut lambda = [0.0; 4];
+        let inv = 1.0 / total;
+        if mask == 0b1111 {
+            // Certified by `holds_origin`: the origin is inside the tetrahedron.
+            for (i, l) in lambda.iter_mut().enumerate() {
+                *l = self.delta[mask][i] * inv;
+            }
+            return Solution {
+                mask: mask as u8,
+                v,
+                lambda,
+            };
+        }
         for &i in &mem[..len as usize] {
             let i = i as usize;
-            let l = self.delta[mask][i] / total;
+            let l = self.delta[mask][i] * inv;
             lambda[i] = l;
             v += self.vertices[i].y * l;
         }
@@ -288,6 +360,9 @@ impl Simplex {
             if mask & !all != 0 || !self.interior(mask) {
                 continue;
             }
+            if mask == 0b1111 && !self.holds_origin() {
+                continue;
+            }
             let total = self.total(mask);
             if total <= 0.0 {
                 continue;
@@ -317,19 +392,29 @@ impl Simplex {
 
     /// (5.9): for a tetrahedron holding the origin, the distance from the
     /// origin to the nearest face plane, a lower bound on penetration depth.
+    /// Computed from each face's normal rather than through (5.10): that
+    /// formula gives the squared distance, whose square root carries an error
+    /// of `√ε` relative, too much for a bound that must stay below the truth.
     pub fn inner_radius(&self) -> f64 {
         debug_assert_eq!(self.all, 0b1111);
         let mut best = f64::INFINITY;
-        for drop in 0..4 {
-            let face = 0b1111 & !(1usize << drop);
-            let total = self.total(face);
-            if total <= 0.0 {
+        for face in [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]] {
+            let [p, q, r] = face.map(|i| self.vertices[i].y);
+            let n = (q - p).cross(&(r - p));
+            let len = n.norm();
+            if len.is_nan() || len == 0.0 {
                 // A flat face: the tetrahedron is degenerate and proves nothing.
                 return 0.0;
             }
-            best = best.min(self.aff_dist2(face, total).sqrt());
+            best = best.min(n.dot(&p).abs() / len);
         }
         if best.is_finite() { best } else { 0.0 }
+    }
+
+    /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
+    pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
+        (0..4)
+            .any(|i| mask & (1 << i) != 0 && self.vertices[i].ia == ia && self.vertices[i].ib == ib)
     }
 }
 
@@ -375,7 +460,8 @@ mod tests {
 
     #[test]
     fn tetrahedron_with_origin_inside_and_its_inner_radius() {
-        let s = Simplex::new(&[
+        let mut s = Simplex::empty();
+        s.reset(&[
             vtx(1.0, 1.0, 1.0),
             vtx(1.0, -1.0, -1.0),
             vtx(-1.0, 1.0, -1.0),

@@ -28,6 +28,7 @@
 //! ```
 
 mod johnson;
+pub mod paper;
 mod query;
 mod shape;
 

@@ -183,6 +183,10 @@ pub fn distance(
     // a⁻¹·b: the translations are subtracted before rotating, so poses far from
     // the world origin cancel exactly when the objects are near each other.
     let rel = pose_a.inv_mul(pose_b);
+    if !pose_is_finite(&rel) {
+        // Finite poses whose difference overflows f64 (coordinates near 1e308).
+        return Err(Error::NonFinitePose);
+    }
     let answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel);
@@ -193,11 +197,34 @@ pub fn distance(
                 warm.map(|w| w.pairs()),
                 f64::INFINITY,
             );
-            pair.answer(&run, &simplex, pose_a, None, pose_b, None, [0, 0])
+            pair.answer(
+                &run,
+                &simplex,
+                Place {
+                    pose: pose_a,
+                    offset: None,
+                },
+                Place {
+                    pose: pose_b,
+                    offset: None,
+                },
+                [0, 0],
+            )
         }
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
-    if !answer.distance.is_finite() || !answer.lower.is_finite() || !answer.upper.is_finite() {
+    let finite = [
+        answer.distance,
+        answer.lower,
+        answer.upper,
+        answer.penetration,
+    ]
+    .iter()
+    .chain(answer.point_a.coords.iter())
+    .chain(answer.point_b.coords.iter())
+    .chain(answer.normal.iter())
+    .all(|c| c.is_finite());
+    if !finite {
         // Finite inputs whose combination overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }
@@ -214,15 +241,26 @@ struct Pair<'s> {
     rt: Matrix3<f64>,
     /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`.
     t: Vector3<f64>,
-    /// `ε`-free part of (6.2): `D(K)²` from (6.4).
-    d2: f64,
+    /// `D(K)` bounded by (6.4).
+    d: f64,
     /// Allowance for floating-point error in the bounds.
     slack: f64,
     radii: f64,
 }
 
+/// Where a piece sits: its shape's pose and, for a compound's piece, its offset
+/// in the shape's body frame.
+#[derive(Clone, Copy)]
+struct Place<'p> {
+    pose: &'p Isometry3<f64>,
+    offset: Option<&'p Isometry3<f64>>,
+}
+
 /// One convex pair's run of the Numerical Algorithm.
 struct Run {
+    /// Lower bound on the cores' penetration depth (5.9), 0 unless they touch
+    /// or intersect.
+    inner: f64,
     sol: Solution,
     /// `|v|`, zero when the cores touch or intersect.
     norm: f64,
@@ -258,7 +296,7 @@ impl<'s> Pair<'s> {
             r,
             rt: r.transpose(),
             t,
-            d2: d * d,
+            d,
             slack: 64.0 * f64::EPSILON * scale,
             radii: a.radius() + b.radius(),
         }
@@ -304,11 +342,14 @@ impl<'s> Pair<'s> {
             }
             None => simplex.reset(&[self.support(&self.t)]),
         }
-        let eps_d2 = options.tolerance * self.d2;
+        let eps_d = options.tolerance * self.d;
         let mut iterations = 0u32;
         let mut prev: Option<(Solution, f64)> = None;
         let mut lower = 0.0f64;
         let mut backup_used = false;
+        // Steps taken without a measurable descent (see step 4).
+        let mut flat_steps = 0u32;
+        let mut paper_met;
         loop {
             iterations += 1;
             // Step (2).
@@ -320,15 +361,16 @@ impl<'s> Pair<'s> {
                 }
             };
             loop {
-                let full = sol.mask == 0b1111;
-                if full {
-                    // The origin is inside the tetrahedron: the cores intersect.
-                    sol.v = Vector3::zeros();
-                }
                 let v2 = sol.v.norm_squared();
+                let norm = v2.sqrt();
                 let finish = |exit, sol: Solution, lower: f64| {
                     let norm = sol.v.norm();
                     Run {
+                        inner: if norm <= self.slack {
+                            self.penetration(simplex, &sol)
+                        } else {
+                            0.0
+                        },
                         sol,
                         norm,
                         lower,
@@ -337,15 +379,24 @@ impl<'s> Pair<'s> {
                         backup_used,
                     }
                 };
-                if v2 == 0.0 {
+                if norm <= self.slack {
+                    // v is the origin up to round-off: the cores touch or
+                    // intersect, and nothing finer can be certified.
                     return finish(Status::Converged, sol, 0.0);
                 }
                 // Step (3): the stopping rule, and the bounds of Theorem 4.1.
                 let s = self.support(&-sol.v);
                 let vs = sol.v.dot(&s.y);
-                let norm = v2.sqrt();
                 lower = lower.max(vs / norm);
-                if v2 - vs <= eps_d2 {
+                let g = v2 - vs;
+                // (6.2): g <= ε·D². Near contact that rule alone lets |v|
+                // exceed the distance by up to √ε·D (nearly parallel edges do
+                // this), so once it holds the run goes on while |v| still
+                // descends, and stops early only when the certified interval,
+                // of width g/|v|, is within ε·D. A support point already in V̂
+                // proves g = 0 but for round-off: nothing is left to add.
+                paper_met = g <= eps_d * self.d;
+                if g <= eps_d * norm || simplex.has_pair(sol.mask, s.ia, s.ib) {
                     return finish(Status::Converged, sol, lower);
                 }
                 let lower_cert = lower - self.slack - self.radii;
@@ -355,18 +406,35 @@ impl<'s> Pair<'s> {
                     return run;
                 }
                 if let Some(m) = options.margin {
-                    if lower_cert > m {
+                    if lower_cert.max(0.0) > m {
                         return finish(Status::Farther, sol, lower);
                     }
-                    if norm + self.slack - self.radii <= m {
+                    if (norm + self.slack - self.radii).max(0.0) <= m {
                         return finish(Status::Closer, sol, lower);
                     }
                 }
                 if iterations >= options.max_iterations {
-                    return finish(Status::IterationCap, sol, lower);
+                    let status = if paper_met {
+                        Status::Converged
+                    } else {
+                        Status::IterationCap
+                    };
+                    return finish(status, sol, lower);
                 }
-                // Step (4): descend while |v| decreases and V̂ is not full.
-                let descended = prev.is_none_or(|(_, p2)| v2 < p2);
+                // Step (4): descend while |v| decreases and V̂ is not full. A
+                // step that only grows V̂ by a dimension, with |v| unchanged at
+                // round-off level, is also progress (nearly parallel edges give
+                // such steps); a few are allowed before step (5) takes over.
+                let descended = match prev {
+                    None => true,
+                    Some((_, p2)) if v2 < p2 => true,
+                    Some((p, p2)) => {
+                        let grew = sol.mask.count_ones() > p.mask.count_ones();
+                        let ok = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON) && flat_steps < 3;
+                        flat_steps += ok as u32;
+                        ok
+                    }
+                };
                 if descended && sol.mask.count_ones() <= 3 {
                     prev = Some((sol, v2));
                     simplex.push(sol.mask, s);
@@ -379,7 +447,12 @@ impl<'s> Pair<'s> {
                         Some((p, p2)) if p2 < v2 => p,
                         _ => sol,
                     };
-                    return finish(Status::ToleranceNotMet, best, lower);
+                    let status = if paper_met {
+                        Status::Converged
+                    } else {
+                        Status::ToleranceNotMet
+                    };
+                    return finish(status, best, lower);
                 }
                 // Step (6): redo v_k with the Backup Procedure.
                 sol = simplex.backup();
@@ -389,19 +462,44 @@ impl<'s> Pair<'s> {
         }
     }
 
+    /// A lower bound on the cores' penetration depth once `v` is the origin.
+    /// (5.9) needs a tetrahedron around the origin; when the run stopped on a
+    /// smaller simplex (the origin on a face, or hit by the first point), one
+    /// is built from the supports in four tetrahedral directions. Either way
+    /// the bound is cut by the round-off allowance, since it must never exceed
+    /// the truth.
+    #[cold]
+    fn penetration(&self, simplex: &Simplex, sol: &Solution) -> f64 {
+        let inner = if sol.mask == 0b1111 {
+            simplex.inner_radius()
+        } else {
+            let dirs = [
+                Vector3::new(1.0, 1.0, 1.0),
+                Vector3::new(1.0, -1.0, -1.0),
+                Vector3::new(-1.0, 1.0, -1.0),
+                Vector3::new(-1.0, -1.0, 1.0),
+            ];
+            let mut tetra = Simplex::empty();
+            tetra.reset(&dirs.map(|d| self.support(&d)));
+            match tetra.solve() {
+                Some(s) if s.mask == 0b1111 => tetra.inner_radius(),
+                _ => 0.0,
+            }
+        };
+        (inner - self.slack).max(0.0)
+    }
+
     /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
     /// pieces' offsets in their shapes' body frames.
     fn answer(
         &self,
         run: &Run,
         simplex: &Simplex,
-        pose_a: &Isometry3<f64>,
-        off_a: Option<&Isometry3<f64>>,
-        pose_b: &Isometry3<f64>,
-        off_b: Option<&Isometry3<f64>>,
+        place_a: Place<'_>,
+        place_b: Place<'_>,
         pieces: [u32; 2],
     ) -> Answer {
-        // Pieces of a compound sit at an offset in their shape's body frame.
+        let (pose_a, off_a) = (place_a.pose, place_a.offset);
         let place = |pose: &Isometry3<f64>, off: Option<&Isometry3<f64>>, p: Point3<f64>| match off
         {
             Some(o) => pose * (o * p),
@@ -422,8 +520,8 @@ impl<'s> Pair<'s> {
             }
         }
         let core_a = place(pose_a, off_a, self.a.centroid() + wa);
-        let core_b = place(pose_b, off_b, self.b.centroid() + wb);
-        let separated = run.norm > 0.0;
+        let core_b = place(place_b.pose, place_b.offset, self.b.centroid() + wb);
+        let separated = run.norm > self.slack;
         let normal = if separated {
             // b - a = -v in A's piece frame.
             let n = -run.sol.v / run.norm;
@@ -433,12 +531,7 @@ impl<'s> Pair<'s> {
         };
         let (ra, rb) = (self.a.radius(), self.b.radius());
         let penetration = if !separated {
-            let core = if run.sol.mask == 0b1111 {
-                simplex.inner_radius()
-            } else {
-                0.0
-            };
-            core + self.radii
+            run.inner + self.radii
         } else {
             (self.radii - run.norm).max(0.0)
         };
@@ -510,7 +603,7 @@ fn compound(
     let mut backup_used = false;
     let mut penetration = 0.0f64;
     let mut trouble: Option<Status> = None;
-    for (gap, i, j) in order {
+    for (k, &(gap, i, j)) in order.iter().enumerate() {
         let cutoff = best.map_or(f64::INFINITY, |b| b.upper);
         // The sphere bound is rough (no slack): only skip on a clear margin.
         if gap > cutoff * (1.0 + 1e-9) + f64::MIN_POSITIVE {
@@ -522,7 +615,19 @@ fn compound(
         let pair = Pair::new(ca, cb, &piece_rel);
         let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
         let run = pair.solve(&mut simplex, options, warm_pairs, cutoff);
-        let ans = pair.answer(&run, &simplex, pose_a, Some(&oa), pose_b, Some(&ob), [i, j]);
+        let ans = pair.answer(
+            &run,
+            &simplex,
+            Place {
+                pose: pose_a,
+                offset: Some(&oa),
+            },
+            Place {
+                pose: pose_b,
+                offset: Some(&ob),
+            },
+            [i, j],
+        );
         iterations = iterations.saturating_add(ans.iterations);
         backup_used |= ans.backup_used;
         lower = lower.min(ans.lower);
@@ -542,6 +647,13 @@ fn compound(
         }
         if ans.status == Status::Closer {
             best = Some(ans);
+            // The pairs not visited still bound the union's distance from
+            // below by their sphere gaps (shaded for round-off).
+            let rest = order[k + 1..]
+                .iter()
+                .map(|o| o.0 - 1e-9 * o.0.abs())
+                .fold(f64::INFINITY, f64::min);
+            lower = lower.min(rest.max(0.0));
             break;
         }
     }

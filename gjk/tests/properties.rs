@@ -1,0 +1,364 @@
+//! Property tests: random small point sets (general, with duplicates,
+//! collinear, coplanar, single points), random radii and poses, compared with
+//! the brute force in `common`.
+
+mod common;
+
+use common::{
+    P, RefShape, Tolerance, V, hull_distance, shape_distance, verify, verify_penetration,
+};
+use gjk::{Compound, Convex, Options, Shape, Status, WarmStart, distance};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed};
+
+const CASES: u32 = 512;
+
+/// A fixed seed so that runs are reproducible; `PROPTEST_RNG_SEED` and
+/// `PROPTEST_CASES` in the environment override seed and case count.
+fn config() -> Config {
+    let mut c = Config {
+        failure_persistence: None,
+        ..Config::default()
+    };
+    if std::env::var_os("PROPTEST_CASES").is_none() {
+        c.cases = CASES;
+    }
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        c.rng_seed = RngSeed::Fixed(0x676a_6b64);
+    }
+    c
+}
+
+fn coord() -> impl Strategy<Value = f64> {
+    -1.0..1.0f64
+}
+
+fn vec3() -> impl Strategy<Value = V> {
+    (coord(), coord(), coord()).prop_map(|(x, y, z)| V::new(x, y, z))
+}
+
+fn general(max: usize) -> impl Strategy<Value = Vec<P>> {
+    prop::collection::vec(vec3().prop_map(P::from), 1..=max)
+}
+
+/// A few distinct points, each repeated.
+fn duplicates(max: usize) -> impl Strategy<Value = Vec<P>> {
+    (general(4), prop::collection::vec(0..4usize, 1..=max))
+        .prop_map(|(base, picks)| picks.iter().map(|&i| base[i % base.len()]).collect())
+}
+
+fn collinear(max: usize) -> impl Strategy<Value = Vec<P>> {
+    (vec3(), vec3(), prop::collection::vec(-1.0..1.0f64, 1..=max))
+        .prop_map(|(a, d, ts)| ts.iter().map(|t| P::from(a + d * *t)).collect())
+}
+
+fn coplanar(max: usize) -> impl Strategy<Value = Vec<P>> {
+    (
+        vec3(),
+        vec3(),
+        vec3(),
+        prop::collection::vec((-1.0..1.0f64, -1.0..1.0f64), 1..=max),
+    )
+        .prop_map(|(a, e1, e2, uv)| {
+            uv.iter()
+                .map(|(u, w)| P::from(a + e1 * *u + e2 * *w))
+                .collect()
+        })
+}
+
+/// Any of the kinds, scaled by a factor in [0.1, 3].
+fn point_set(max: usize) -> impl Strategy<Value = Vec<P>> {
+    (
+        prop_oneof![
+            3 => general(max),
+            1 => duplicates(max),
+            1 => collinear(max),
+            1 => coplanar(max),
+            1 => vec3().prop_map(|x| vec![P::from(x)]),
+        ],
+        0.1..3.0f64,
+    )
+        .prop_map(|(pts, s)| pts.iter().map(|x| P::from(x.coords * s)).collect())
+}
+
+fn radius() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(0.0), 0.0..1.0f64]
+}
+
+fn convex(max: usize) -> impl Strategy<Value = Convex> {
+    (point_set(max), radius()).prop_map(|(pts, r)| Convex::new(pts, r).unwrap())
+}
+
+fn pose(spread: f64) -> impl Strategy<Value = Isometry3<f64>> {
+    (vec3(), vec3()).prop_map(move |(t, w)| {
+        Isometry3::from_parts(
+            Translation3::from(t * spread),
+            UnitQuaternion::from_scaled_axis(w * std::f64::consts::PI),
+        )
+    })
+}
+
+fn compound(max_pieces: usize, max_points: usize) -> impl Strategy<Value = Shape> {
+    prop::collection::vec((pose(2.0), convex(max_points)), 1..=max_pieces)
+        .prop_map(|pieces| Compound::new(pieces).unwrap().into())
+}
+
+/// Tolerances for a scene: distance to 1e-9 of its size, bounds to round-off.
+fn tolerances(r: &RefShape) -> Tolerance {
+    Tolerance {
+        distance: 1e-9 * r.scale,
+        bounds: 1e-14 * r.scale,
+    }
+}
+
+/// Distance, bounds, status, pieces, points and normal against the brute
+/// force, and the penetration field too when `penetration` is set.
+fn check(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    penetration: bool,
+) -> Result<(), String> {
+    let r = shape_distance(a, pa, b, pb);
+    let t = tolerances(&r);
+    let ans = distance(a, pa, b, pb, &Options::default(), None).map_err(|e| format!("{e:?}"))?;
+    verify(a, pa, b, pb, &ans, &r, t)?;
+    if penetration {
+        verify_penetration(&ans, &r, t.distance)?;
+    }
+    Ok(())
+}
+
+/// `b` moved along the direction of the cores' nearest points until the gap
+/// between the cores is 0 (`k = None`) or 10^-k of the scene size; `None`
+/// when the cores are not clearly apart to begin with.
+fn nearly_touching(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    k: Option<i32>,
+) -> Option<(Isometry3<f64>, f64)> {
+    let r = shape_distance(a, pa, b, pb);
+    let core = hull_distance(&r.pieces_a[0].points, &r.pieces_b[0].points);
+    if !(core.separated && core.distance > 1e-3 * r.scale) {
+        return None;
+    }
+    let gap = k.map_or(0.0, |k| 10f64.powi(-k) * r.scale);
+    let n = (core.point_q - core.point_p) / core.distance;
+    Some((Translation3::from(-n * (core.distance - gap)) * pb, gap))
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn convex_pairs_match_brute_force(a in convex(8), pa in pose(3.0), b in convex(8), pb in pose(3.0)) {
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        if let Err(e) = check(&a, &pa, &b, &pb, true) {
+            prop_assert!(false, "{}", e);
+        }
+    }
+
+    /// Poses that bring the shapes close: many touching and overlapping cases.
+    #[test]
+    fn close_convex_pairs_match_brute_force(a in convex(8), pa in pose(0.5), b in convex(8), pb in pose(0.5)) {
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        if let Err(e) = check(&a, &pa, &b, &pb, true) {
+            prop_assert!(false, "{}", e);
+        }
+    }
+
+    #[test]
+    fn compounds_match_brute_force(a in compound(3, 5), pa in pose(3.0), b in prop_oneof![compound(3, 5), convex(6).prop_map(Shape::from)], pb in pose(3.0)) {
+        if let Err(e) = check(&a, &pa, &b, &pb, true) {
+            prop_assert!(false, "{}", e);
+        }
+    }
+
+    /// With a margin the early exit must agree with the truth; a converged
+    /// answer must be right.
+    #[test]
+    fn margin_decisions_agree_with_truth(
+        a in prop_oneof![3 => convex(8).prop_map(Shape::from), 1 => compound(3, 4)],
+        pa in pose(2.0),
+        b in convex(8),
+        pb in pose(2.0),
+        m in prop_oneof![Just(0.0), 0.0..3.0f64],
+    ) {
+        let b: Shape = b.into();
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let t = tolerances(&r);
+        let (tol, eps) = (t.distance, t.bounds);
+        let truth = r.distance;
+        let opt = Options { margin: Some(m), ..Options::default() };
+        let ans = distance(&a, &pa, &b, &pb, &opt, None).unwrap();
+        prop_assert!(ans.lower <= truth + eps && truth <= ans.upper + eps,
+            "bounds [{}, {}] miss {truth}: {ans:?}", ans.lower, ans.upper);
+        match ans.status {
+            Status::Farther => prop_assert!(truth > m - eps, "Farther than {m} but truth {truth}: {ans:?}"),
+            Status::Closer => prop_assert!(truth <= m + eps, "Closer than {m} but truth {truth}: {ans:?}"),
+            Status::Converged => prop_assert!((ans.distance - truth).abs() <= tol,
+                "converged to {} but truth {truth}: {ans:?}", ans.distance),
+            s => prop_assert!(false, "status {s:?}: {ans:?}"),
+        }
+    }
+
+    /// Stopped early by the iteration cap or a loose tolerance, the answer's
+    /// bounds still hold and the distance lies within them.
+    #[test]
+    fn bounds_hold_when_stopped_early(
+        a in prop_oneof![3 => convex(8).prop_map(Shape::from), 1 => compound(3, 4)],
+        pa in pose(2.0),
+        b in convex(8),
+        pb in pose(2.0),
+        max_iterations in 1..=6u32,
+        tolerance in prop_oneof![Just(0.0), Just(1e-10), Just(1e-6), Just(1e-2)],
+    ) {
+        let b: Shape = b.into();
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let eps = tolerances(&r).bounds;
+        let opt = Options { max_iterations, tolerance, ..Options::default() };
+        let ans = distance(&a, &pa, &b, &pb, &opt, None).unwrap();
+        let truth = r.distance;
+        prop_assert!(ans.lower <= truth + eps && truth <= ans.upper + eps,
+            "bounds [{}, {}] miss {truth}: {ans:?}", ans.lower, ans.upper);
+        prop_assert!(ans.lower <= ans.distance && ans.distance <= ans.upper, "{ans:?}");
+        prop_assert!(matches!(ans.status, Status::Converged | Status::IterationCap | Status::ToleranceNotMet), "{ans:?}");
+        if ans.status == Status::Converged && tolerance <= 1e-10 {
+            prop_assert!((ans.distance - truth).abs() <= tolerances(&r).distance, "truth {truth}: {ans:?}");
+        }
+    }
+
+    /// Any warm start (arbitrary in-range vertex pairs) gives the right answer.
+    #[test]
+    fn arbitrary_warm_starts_give_the_right_answer(
+        a in convex(8), pa in pose(2.0), b in convex(8), pb in pose(2.0),
+        picks in prop::collection::vec((0..64u32, 0..64u32), 0..=4),
+    ) {
+        let pairs: Vec<[u32; 2]> = picks
+            .iter()
+            .map(|&(i, j)| [i % a.len() as u32, j % b.len() as u32])
+            .collect();
+        let w = WarmStart::new([0, 0], &pairs).unwrap();
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let t = tolerances(&r);
+        let ans = distance(&a, &pa, &b, &pb, &Options::default(), Some(&w)).unwrap();
+        if let Err(e) = verify(&a, &pa, &b, &pb, &ans, &r, t) {
+            prop_assert!(false, "warm start {:?}: {}", pairs, e);
+        }
+    }
+
+    /// Shapes moved along the direction of their nearest points until the
+    /// gap between the cores is 0 or 10^-k of the scene size: touching and
+    /// nearly touching pairs, which random poses almost never produce.
+    #[test]
+    fn nearly_touching_pairs_match_brute_force(
+        a in convex(8), pa in pose(2.0), b in convex(8), pb in pose(2.0),
+        k in prop_oneof![Just(None), (3..=12i32).prop_map(Some)],
+    ) {
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        let moved = nearly_touching(&a, &pa, &b, &pb, k);
+        prop_assume!(moved.is_some());
+        let (pb, gap) = moved.unwrap();
+        if let Err(e) = check(&a, &pa, &b, &pb, false) {
+            prop_assert!(false, "gap {gap:e}: {}", e);
+        }
+    }
+
+    /// The penetration field of touching and nearly touching pairs: exact
+    /// (`rA + rB - d(cores)`) while the cores are apart, at most the true
+    /// depth (`rA + rB`) when they touch.
+    #[test]
+    fn nearly_touching_penetration(
+        a in convex(8), pa in pose(2.0), b in convex(8), pb in pose(2.0),
+        k in prop_oneof![Just(None), (3..=12i32).prop_map(Some)],
+    ) {
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        let moved = nearly_touching(&a, &pa, &b, &pb, k);
+        prop_assume!(moved.is_some());
+        let (pb, gap) = moved.unwrap();
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let tol = tolerances(&r).distance;
+        let ans = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        if let Err(e) = verify_penetration(&ans, &r, tol) {
+            prop_assert!(false, "gap {gap:e}: {}", e);
+        }
+    }
+
+    /// Swapping the arguments gives the same distance.
+    #[test]
+    fn symmetric_in_its_arguments(a in convex(8), pa in pose(2.0), b in convex(8), pb in pose(2.0)) {
+        let (a, b): (Shape, Shape) = (a.into(), b.into());
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let tol = tolerances(&r).distance;
+        let ab = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        let ba = distance(&b, &pb, &a, &pa, &Options::default(), None).unwrap();
+        prop_assert!((ab.distance - r.distance).abs() <= tol && (ba.distance - r.distance).abs() <= tol,
+            "ab {} ba {} truth {}", ab.distance, ba.distance, r.distance);
+    }
+}
+
+/// The checks in `verify` are live: perturbing a correct answer in any of the
+/// asserted fields is caught.
+#[test]
+fn verify_rejects_perturbed_answers() {
+    let a: Shape = Convex::cuboid(V::new(1., 1., 1.), 0.25).unwrap().into();
+    let b: Shape = Convex::new(
+        vec![P::new(0., 0., 0.), P::new(0., 1., 0.), P::new(1., 0., 0.)],
+        0.5,
+    )
+    .unwrap()
+    .into();
+    let pa = Isometry3::identity();
+    for pb in [
+        Isometry3::translation(4., 0.5, 0.2),
+        Isometry3::translation(2.2, 0.1, -0.3),
+    ] {
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let t = tolerances(&r);
+        let tol = t.distance;
+        let good = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        verify(&a, &pa, &b, &pb, &good, &r, t).unwrap();
+        verify_penetration(&good, &r, tol).unwrap();
+        let mut bad = Vec::new();
+        let mut x = good;
+        x.distance += 1e-6;
+        x.upper += 1e-6;
+        bad.push(("distance", x));
+        let mut x = good;
+        x.lower = r.distance + 1e-6;
+        x.distance = x.distance.max(x.lower);
+        x.upper = x.upper.max(x.lower);
+        bad.push(("lower", x));
+        let mut x = good;
+        x.upper = r.distance - 1e-6;
+        bad.push(("upper", x));
+        let mut x = good;
+        x.point_a.y += 1e-6;
+        bad.push(("point_a", x));
+        let mut x = good;
+        x.point_b.z -= 1e-6;
+        bad.push(("point_b", x));
+        let mut x = good;
+        x.normal = -x.normal;
+        bad.push(("normal", x));
+        let mut x = good;
+        x.penetration += 1e-6;
+        bad.push(("penetration", x));
+        let mut x = good;
+        x.status = Status::ToleranceNotMet;
+        bad.push(("status", x));
+        let mut x = good;
+        x.pieces = [1, 0];
+        bad.push(("pieces", x));
+        for (what, x) in bad {
+            let caught = verify(&a, &pa, &b, &pb, &x, &r, t).is_err()
+                || verify_penetration(&x, &r, tol).is_err();
+            assert!(caught, "perturbed {what} not caught, pb {pb:?}");
+        }
+    }
+}

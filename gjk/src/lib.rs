@@ -27,6 +27,7 @@
 //! # Ok::<(), gjk::Error>(())
 //! ```
 
+mod dd;
 mod johnson;
 pub mod paper;
 mod query;

@@ -189,7 +189,7 @@ pub fn distance(
     }
     let answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
-            let pair = Pair::new(ca, cb, &rel);
+            let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)));
             let mut simplex = Simplex::empty();
             let run = pair.solve(
                 &mut simplex,
@@ -280,16 +280,40 @@ enum Exit {
 }
 
 impl<'s> Pair<'s> {
-    fn new(a: &'s Convex, b: &'s Convex, rel: &Isometry3<f64>) -> Self {
+    /// The pair at relative pose `rel = A⁻¹·B`. `world`, when given, holds the
+    /// two poses themselves, for the exact centroid offset of a body frame far
+    /// from its vertices.
+    fn new(
+        a: &'s Convex,
+        b: &'s Convex,
+        rel: &Isometry3<f64>,
+        world: Option<(&Isometry3<f64>, &Isometry3<f64>)>,
+    ) -> Self {
         let r = *rel.rotation.to_rotation_matrix().matrix();
         let rb = r * b.centroid().coords;
-        let t = rb + rel.translation.vector - a.centroid().coords;
+        let (ca, cb) = (a.centroid(), b.centroid());
+        // Centroids far from their body origins (relative to the shapes'
+        // sizes) make rb and the translation cancel: then the offset is
+        // taken in world coordinates in double-double and rotated once.
+        let far = ca.coords.norm() + cb.coords.norm() > 16.0 * (a.size() + b.size());
+        let (t, exact) = match world {
+            Some((pa, pb)) if far => (
+                pa.rotation
+                    .inverse_transform_vector(&crate::dd::centroid_gap(pa, &ca, pb, &cb)),
+                true,
+            ),
+            _ => (rb + rel.translation.vector - ca.coords, false),
+        };
         let t_norm = t.norm();
         let d = a.size() + b.size() + t_norm;
         // Every input to a dot product is at most `scale` in size; the sums of a
         // few products each carry a relative error of a few ε. 64 ε covers the
         // rotation, the centroid shift and the subalgorithm's weights with room.
-        let scale = d + a.centroid().coords.norm() + rb.norm() + rel.translation.vector.norm();
+        let scale = if exact {
+            d
+        } else {
+            d + ca.coords.norm() + rb.norm() + rel.translation.vector.norm()
+        };
         Pair {
             a,
             b,
@@ -473,6 +497,8 @@ impl<'s> Pair<'s> {
         let inner = if sol.mask == 0b1111 {
             simplex.inner_radius()
         } else {
+            // The two tetrahedra inscribed in a cube between them use all its
+            // corners, so one holds any point near a corner of a box-like K.
             let dirs = [
                 Vector3::new(1.0, 1.0, 1.0),
                 Vector3::new(1.0, -1.0, -1.0),
@@ -480,11 +506,16 @@ impl<'s> Pair<'s> {
                 Vector3::new(-1.0, -1.0, 1.0),
             ];
             let mut tetra = Simplex::empty();
-            tetra.reset(&dirs.map(|d| self.support(&d)));
-            match tetra.solve() {
-                Some(s) if s.mask == 0b1111 => tetra.inner_radius(),
-                _ => 0.0,
+            let mut best = 0.0f64;
+            for sign in [1.0, -1.0] {
+                tetra.reset(&dirs.map(|d| self.support(&(d * sign))));
+                if let Some(s) = tetra.solve()
+                    && s.mask == 0b1111
+                {
+                    best = best.max(tetra.inner_radius());
+                }
             }
+            best
         };
         (inner - self.slack).max(0.0)
     }
@@ -612,7 +643,7 @@ fn compound(
         let (oa, ca) = a.piece(i as usize).expect("index below piece_count");
         let (ob, cb) = b.piece(j as usize).expect("index below piece_count");
         let piece_rel = oa.inv_mul(&(rel * ob));
-        let pair = Pair::new(ca, cb, &piece_rel);
+        let pair = Pair::new(ca, cb, &piece_rel, None);
         let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
         let run = pair.solve(&mut simplex, options, warm_pairs, cutoff);
         let ans = pair.answer(

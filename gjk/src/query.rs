@@ -420,7 +420,9 @@ impl<'s> Pair<'s> {
                 // of width g/|v|, is within ε·D. A support point already in V̂
                 // proves g = 0 but for round-off: nothing is left to add.
                 paper_met = g <= eps_d * self.d;
-                if g <= eps_d * norm || simplex.has_pair(sol.mask, s.ia, s.ib) {
+                // The error of |v| is at most min(|v|, g/|v|): stop once that
+                // is within ε·D.
+                if g <= eps_d * norm || norm <= eps_d || simplex.has_pair(sol.mask, s.ia, s.ib) {
                     return finish(Status::Converged, sol, lower);
                 }
                 let lower_cert = lower - self.slack - self.radii;
@@ -466,7 +468,9 @@ impl<'s> Pair<'s> {
                 }
                 // Step (5): round-off has the last word. The previous iterate,
                 // if nearer, is still valid: its vertices kept their slots.
-                if by_backup {
+                // When (6.2) holds the paper would have stopped at step (3):
+                // no Backup Procedure is needed to confirm that.
+                if by_backup || paper_met {
                     let best = match prev {
                         Some((p, p2)) if p2 < v2 => p,
                         _ => sol,
@@ -487,15 +491,19 @@ impl<'s> Pair<'s> {
     }
 
     /// A lower bound on the cores' penetration depth once `v` is the origin.
-    /// (5.9) needs a tetrahedron around the origin; when the run stopped on a
-    /// smaller simplex (the origin on a face, or hit by the first point), one
-    /// is built from the supports in four tetrahedral directions. Either way
-    /// the bound is cut by the round-off allowance, since it must never exceed
-    /// the truth.
+    /// (5.9) needs a tetrahedron around the origin. When the run stopped on a
+    /// smaller simplex with `v` exactly zero (the first support point was the
+    /// origin, as for identical shapes), one is built from the supports in
+    /// tetrahedral directions; when `v` is merely within round-off of zero the
+    /// origin lies on a face of the simplex, usually a touching contact, and
+    /// the bound is 0. Either way it is cut by the round-off allowance, since
+    /// it must never exceed the truth.
     #[cold]
     fn penetration(&self, simplex: &Simplex, sol: &Solution) -> f64 {
         let inner = if sol.mask == 0b1111 {
             simplex.inner_radius()
+        } else if sol.v != Vector3::zeros() {
+            0.0
         } else {
             // The two tetrahedra inscribed in a cube between them use all its
             // corners, so one holds any point near a corner of a box-like K.

@@ -1,1 +1,1052 @@
-//! Client of gjkd (work in progress).
+//! # gjkd-client
+//!
+//! Client of the gjkd distance server. A [`Client`] talks to a `gjkd serve`
+//! process on the same host through iceoryx2 shared memory: register convex
+//! objects once, then ask for distances between them at changing poses, one
+//! pair at a time or in batches. The server keeps each pair's last simplex
+//! per client, so a sequence of queries along a motion starts warm.
+//!
+//! Start a server first (`gjkd serve`, or `gjkd serve --service NAME` to run
+//! several side by side), then:
+//!
+//! ```no_run
+//! use gjkd_client::{Client, QueryOptions};
+//! use nalgebra::{Isometry3, Point3, Vector3};
+//!
+//! # fn main() -> Result<(), gjkd_client::ClientError> {
+//! let mut client = Client::connect("gjkd")?;
+//! let ball = client.register_sphere(0.5)?;
+//! let crate_ = client.register_cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)?;
+//!
+//! // Poses are stored by the server until changed...
+//! client.set_pose(ball, &Isometry3::translation(3.0, 0.0, 0.0))?;
+//! let answer = client.distance(crate_, ball, &QueryOptions::default())?;
+//! assert!((answer.distance - 1.5).abs() < 1e-9);
+//! println!("nearest points {} and {}", answer.point_a, answer.point_b);
+//!
+//! // ...or given per query, leaving the stored ones alone.
+//! let answer = client.distance_at(
+//!     crate_, &Isometry3::identity(),
+//!     ball, &Isometry3::translation(0.0, 4.0, 0.0),
+//!     &QueryOptions::default(),
+//! )?;
+//! assert!((answer.distance - 2.5).abs() < 1e-9);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! ## Batches
+//!
+//! [`Client::query_batch`] sends any mix of pose updates and pair queries as
+//! one request and writes the results, in order, into a buffer you own: no
+//! buffers are allocated per call. Each result carries its own error code.
+//!
+//! ```no_run
+//! use gjkd_client::{Client, ErrorCode, Item, ItemResult, QueryOptions};
+//! use nalgebra::{Isometry3, Vector3};
+//!
+//! # fn main() -> Result<(), gjkd_client::ClientError> {
+//! let mut client = Client::connect("gjkd")?;
+//! let robot = client.register_cuboid(Vector3::new(0.5, 0.5, 1.0), 0.05)?;
+//! let obstacles: Vec<_> = (0..8)
+//!     .map(|_| client.register_sphere(0.3))
+//!     .collect::<Result<_, _>>()?;
+//! for (i, &o) in obstacles.iter().enumerate() {
+//!     client.set_pose(o, &Isometry3::translation(2.0 + i as f64, 0.0, 0.0))?;
+//! }
+//!
+//! let mut items = Vec::new();
+//! let mut results = vec![ItemResult::default(); obstacles.len() + 1];
+//! for step in 0..100 {
+//!     items.clear();
+//!     let pose = Isometry3::translation(0.05 * step as f64, 0.0, 0.0);
+//!     items.push(Item::set_pose(robot, &pose));
+//!     for &o in &obstacles {
+//!         items.push(Item::distance(robot, o, &QueryOptions::default()));
+//!     }
+//!     client.query_batch(&items, &mut results)?;
+//!     for r in &results[1..] {
+//!         match r.answer() {
+//!             Ok(a) => println!("{:.3}", a.distance),
+//!             Err(ErrorCode::UnknownObject) => println!("removed meanwhile"),
+//!             Err(e) => println!("error: {e}"),
+//!         }
+//!     }
+//! }
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! ## Errors, timeouts and a server that goes away
+//!
+//! Every call returns within the client's timeout (default one second, see
+//! [`ClientBuilder::timeout`]). If the server has died or stopped, the call
+//! fails with [`ClientError::ServerGone`]; later calls reconnect by themselves
+//! once a server serves the name again. Object ids do not survive a server
+//! restart: after one, re-register (or [`Client::lookup`] scene objects by
+//! name again); old ids get [`ErrorCode::UnknownObject`], never some other
+//! object.
+//!
+//! A `Client` is not `Send` (iceoryx2 ports are bound to their thread): create
+//! one per thread. Each holds one iceoryx2 node and two client ports.
+
+#![warn(missing_docs)]
+
+use std::time::{Duration, Instant};
+
+use iceoryx2::node::Node;
+use iceoryx2::port::client::Client as IoxClient;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{event, request_response};
+use nalgebra::{Isometry3, Point3, Vector3};
+
+pub use gjkd_proto::{
+    AdminOp, Answer, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemResult, MAX_NAME_LEN,
+    MAX_PIECES, ObjectId, QueryOptions, ServerInfo, ServerStats, Status, WaitMode,
+};
+use gjkd_proto::{
+    AdminReply, AdminRequest, PieceDesc, Pose, ReplyHeader, Vertex, admin_service_name,
+    query_service_name, shape_kind, wake_service_name,
+};
+
+/// Timeout of every call unless set with [`ClientBuilder::timeout`].
+pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(1);
+
+/// What can go wrong with a call.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ClientError {
+    /// No server answers on this service: it was never started, it stopped,
+    /// or it died. The next call tries to reconnect.
+    #[error("no gjkd server is serving `{0}`")]
+    ServerGone(String),
+    /// The server is alive but did not answer within the timeout.
+    #[error("no answer within {0:?}")]
+    Timeout(Duration),
+    /// The server refused the request (or, for single-item calls, the item):
+    /// the code says why.
+    #[error("request refused: {0}")]
+    Rejected(ErrorCode),
+    /// The result buffer of [`Client::query_batch`] is shorter than the batch.
+    #[error("result buffer holds {got} results but the batch has {needed} items")]
+    ResultBufferTooSmall {
+        /// Items in the batch.
+        needed: usize,
+        /// Length of the buffer.
+        got: usize,
+    },
+    /// An argument cannot be sent (a name too long, a compound nested in a
+    /// compound, too many pieces).
+    #[error("invalid argument: {0}")]
+    InvalidArgument(&'static str),
+    /// The server answered something this client does not understand
+    /// (different protocol version or a broken server).
+    #[error("protocol error: {0}")]
+    Protocol(String),
+    /// iceoryx2 failed locally (shared memory, permissions, limits).
+    #[error("iceoryx2: {0}")]
+    Ipc(String),
+}
+
+fn ipc_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ClientError {
+    move |e| ClientError::Ipc(format!("{what}: {e:?}"))
+}
+
+/// A convex shape, or a union of convex pieces, to register.
+///
+/// Vertices are in the object's body frame. The radius grows the convex hull
+/// of the vertices by a ball ("rounding"); 0 gives the plain polytope.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Geometry<'a> {
+    /// A ball of `radius` about the body origin.
+    Sphere {
+        /// Radius, `>= 0`.
+        radius: f64,
+    },
+    /// The segment from `a` to `b` grown by `radius`.
+    Capsule {
+        /// One end.
+        a: Point3<f64>,
+        /// The other end.
+        b: Point3<f64>,
+        /// Radius, `>= 0`.
+        radius: f64,
+    },
+    /// A box centred on the body origin, its edges rounded by `radius`.
+    Cuboid {
+        /// Half extents, each `>= 0`.
+        half_extents: Vector3<f64>,
+        /// Rounding radius, `>= 0`.
+        radius: f64,
+    },
+    /// The convex hull of `vertices` grown by `radius`. Vertices need not be
+    /// hull vertices.
+    Polytope {
+        /// At least one vertex.
+        vertices: &'a [Point3<f64>],
+        /// Rounding radius, `>= 0`.
+        radius: f64,
+    },
+    /// A union of convex pieces (at most [`MAX_PIECES`], none of them itself
+    /// a compound). Answers name the pieces that realise the distance, by
+    /// position in this slice.
+    Compound(&'a [Piece<'a>]),
+}
+
+/// A convex piece of a [`Geometry::Compound`], placed in the compound's body
+/// frame by `offset`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Piece<'a> {
+    /// Pose of the piece in the compound's body frame.
+    pub offset: Isometry3<f64>,
+    /// The piece's shape; not a compound.
+    pub geometry: Geometry<'a>,
+}
+
+impl Geometry<'_> {
+    /// Vertices and radius of a convex geometry, appended to `out`; the order
+    /// is the one the `gjk` crate's constructors use, so that the server's
+    /// answers equal in-process ones bit for bit.
+    fn push_convex(&self, out: &mut Vec<Vertex>) -> Result<f64, ClientError> {
+        match *self {
+            Geometry::Sphere { radius } => {
+                out.push(Vertex::default());
+                Ok(radius)
+            }
+            Geometry::Capsule { a, b, radius } => {
+                out.push(a.into());
+                out.push(b.into());
+                Ok(radius)
+            }
+            Geometry::Cuboid {
+                half_extents: h,
+                radius,
+            } => {
+                for i in 0..8 {
+                    out.push(Vertex {
+                        x: if i & 1 == 0 { -h.x } else { h.x },
+                        y: if i & 2 == 0 { -h.y } else { h.y },
+                        z: if i & 4 == 0 { -h.z } else { h.z },
+                    });
+                }
+                Ok(radius)
+            }
+            Geometry::Polytope { vertices, radius } => {
+                out.extend(vertices.iter().map(|&p| Vertex::from(p)));
+                Ok(radius)
+            }
+            Geometry::Compound(_) => Err(ClientError::InvalidArgument(
+                "a compound cannot be a piece of a compound",
+            )),
+        }
+    }
+}
+
+/// Configures and opens a [`Client`].
+#[derive(Clone, Debug)]
+pub struct ClientBuilder {
+    service: String,
+    timeout: Duration,
+    connect_timeout: Option<Duration>,
+}
+
+impl ClientBuilder {
+    /// Timeout of every call (default [`DEFAULT_TIMEOUT`]), and of
+    /// [`ClientBuilder::connect`] unless [`ClientBuilder::connect_timeout`]
+    /// is set.
+    pub fn timeout(mut self, timeout: Duration) -> Self {
+        self.timeout = timeout;
+        self
+    }
+
+    /// How long [`ClientBuilder::connect`] waits for a server to come up
+    /// (default: the call timeout). Useful when the server is started just
+    /// before the client.
+    pub fn connect_timeout(mut self, timeout: Duration) -> Self {
+        self.connect_timeout = Some(timeout);
+        self
+    }
+
+    /// Connects, waiting up to the connect timeout for a server to come up.
+    ///
+    /// # Errors
+    /// [`ClientError::ServerGone`] if no server serves the name within the
+    /// timeout, [`ClientError::Ipc`] if iceoryx2 cannot set up this process.
+    pub fn connect(self) -> Result<Client, ClientError> {
+        let node = NodeBuilder::new()
+            .name(&NodeName::new("gjkd-client").map_err(ipc_err("node name"))?)
+            .create::<ipc::Service>()
+            .map_err(ipc_err("node"))?;
+        let mut client = Client {
+            service: self.service,
+            timeout: self.timeout,
+            node,
+            conn: None,
+            vertex_scratch: Vec::new(),
+        };
+        let deadline = Instant::now() + self.connect_timeout.unwrap_or(client.timeout);
+        let mut first = true;
+        loop {
+            match client.reconnect(deadline, !first) {
+                Ok(()) => return Ok(client),
+                Err(ClientError::ServerGone(_)) if Instant::now() < deadline => {
+                    first = false;
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+}
+
+type QueryPort = IoxClient<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
+type AdminPort = IoxClient<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+
+/// Open ports to one server incarnation.
+struct Connection {
+    // Ports are declared before their services so they are dropped first.
+    query: QueryPort,
+    admin: AdminPort,
+    wake: Notifier<ipc::Service>,
+    query_service:
+        request_response::PortFactory<ipc::Service, [Item], (), [ItemResult], ReplyHeader>,
+    admin_service:
+        request_response::PortFactory<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>,
+    _wake_service: event::PortFactory<ipc::Service>,
+    info: ServerInfo,
+    /// The admin server port that answered hello, once it has. A server that
+    /// is killed and restarted before this client notices is a different
+    /// port; this client's old ports may never hear from the new one, so
+    /// that counts as the server being gone (and the next call reconnects).
+    server: Option<u128>,
+    notify_queries: bool,
+}
+
+impl Connection {
+    /// A failed send means the server is gone if it is; otherwise it is
+    /// iceoryx2's error.
+    fn send_failed<E: std::fmt::Debug>(
+        &self,
+        node: &Node<ipc::Service>,
+        what: &'static str,
+        e: E,
+    ) -> Waited {
+        if self.server_alive(node) {
+            Waited::Failed(ipc_err(what)(e))
+        } else {
+            Waited::Gone
+        }
+    }
+
+    /// Whether the server this connection said hello to is still there,
+    /// after removing what dead processes left behind (which takes up to a
+    /// few milliseconds: keep it off the fast path).
+    fn server_alive(&self, node: &Node<ipc::Service>) -> bool {
+        node.try_cleanup_dead_nodes();
+        if self.query_service.dynamic_config().number_of_servers() == 0 {
+            return false;
+        }
+        let Some(id) = self.server else {
+            return self.admin_service.dynamic_config().number_of_servers() > 0;
+        };
+        let mut found = false;
+        self.admin_service.dynamic_config().list_servers(|d| {
+            found = d.server_id.value() == id;
+            if found {
+                CallbackProgression::Stop
+            } else {
+                CallbackProgression::Continue
+            }
+        });
+        found
+    }
+}
+
+/// A connection to a gjkd server. See the [crate documentation](crate).
+pub struct Client {
+    // The connection holds ports of the node's services: drop it first.
+    conn: Option<Connection>,
+    node: Node<ipc::Service>,
+    service: String,
+    timeout: Duration,
+    vertex_scratch: Vec<Vertex>,
+}
+
+impl std::fmt::Debug for Client {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Client")
+            .field("service", &self.service)
+            .field("timeout", &self.timeout)
+            .field("connected", &self.conn.is_some())
+            .finish()
+    }
+}
+
+/// After this long without an answer, the client starts checking that the
+/// server is still alive (a killed server's requests are never answered and
+/// iceoryx2 does not report its death by itself).
+const LIVENESS_AFTER: Duration = Duration::from_millis(20);
+/// How often it checks after that: a check cleans up dead nodes, which takes
+/// up to a couple of milliseconds.
+const LIVENESS_EVERY: Duration = Duration::from_millis(100);
+/// Busy-poll this long for an answer before yielding the CPU: a spinning
+/// server answers a query in a few microseconds.
+const SPIN_FOR: Duration = Duration::from_micros(100);
+/// Hello is repeated this often while connecting.
+const HELLO_RETRY: Duration = Duration::from_millis(250);
+/// Yield (rather than sleep) this long before sleeping between polls.
+const YIELD_FOR: Duration = Duration::from_millis(2);
+
+impl Client {
+    /// A builder for a client of the deployment named `service` (the server's
+    /// `--service`, default [`DEFAULT_SERVICE`]).
+    pub fn builder(service: &str) -> ClientBuilder {
+        ClientBuilder {
+            service: service.to_owned(),
+            timeout: DEFAULT_TIMEOUT,
+            connect_timeout: None,
+        }
+    }
+
+    /// Connects to the server of `service` with the default timeout, waiting
+    /// up to that long for it to come up.
+    ///
+    /// # Errors
+    /// As [`ClientBuilder::connect`].
+    pub fn connect(service: &str) -> Result<Self, ClientError> {
+        Self::builder(service).connect()
+    }
+
+    /// The service name.
+    pub fn service(&self) -> &str {
+        &self.service
+    }
+
+    /// The timeout of every call.
+    pub fn timeout(&self) -> Duration {
+        self.timeout
+    }
+
+    /// What the server said about itself when this client (re)connected:
+    /// limits, wait strategy, pid. `None` while disconnected.
+    pub fn server_info(&self) -> Option<ServerInfo> {
+        self.conn.as_ref().map(|c| c.info)
+    }
+
+    /// Whether the client currently holds a connection (it may still find
+    /// out at the next call that the server is gone).
+    pub fn is_connected(&self) -> bool {
+        self.conn.is_some()
+    }
+
+    fn gone(&self) -> ClientError {
+        ClientError::ServerGone(self.service.clone())
+    }
+
+    /// Opens the services and says hello. Drops any previous connection.
+    /// `cleanup` first removes what dead processes left behind: a killed
+    /// server's services linger until someone does, and a restarted server
+    /// is then found at once. (Creating the node did it already, so the first
+    /// attempt skips it: it scans every node on the host.)
+    fn reconnect(&mut self, deadline: Instant, cleanup: bool) -> Result<(), ClientError> {
+        self.conn = None;
+        if cleanup {
+            self.node.try_cleanup_dead_nodes();
+        }
+        let name = |s: String| ServiceName::new(&s).map_err(ipc_err("service name"));
+        let query_service = self
+            .node
+            .service_builder(&name(query_service_name(&self.service))?)
+            .request_response::<[Item], [ItemResult]>()
+            .response_user_header::<ReplyHeader>()
+            .open()
+            .map_err(|_| self.gone())?;
+        let admin_service = self
+            .node
+            .service_builder(&name(admin_service_name(&self.service))?)
+            .request_response::<[Vertex], AdminReply>()
+            .request_user_header::<AdminRequest>()
+            .open()
+            .map_err(|_| self.gone())?;
+        let wake_service = self
+            .node
+            .service_builder(&name(wake_service_name(&self.service))?)
+            .event()
+            .open()
+            .map_err(|_| self.gone())?;
+        if query_service.dynamic_config().number_of_servers() == 0
+            || admin_service.dynamic_config().number_of_servers() == 0
+        {
+            return Err(self.gone());
+        }
+        let query = query_service
+            .client_builder()
+            .initial_max_slice_len(64)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(ipc_err("query client port"))?;
+        let admin = admin_service
+            .client_builder()
+            .initial_max_slice_len(64)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(ipc_err("admin client port"))?;
+        let wake = wake_service
+            .notifier_builder()
+            .create()
+            .map_err(ipc_err("wake notifier"))?;
+        self.conn = Some(Connection {
+            query,
+            admin,
+            wake,
+            query_service,
+            admin_service,
+            _wake_service: wake_service,
+            info: ServerInfo::default(),
+            server: None,
+            notify_queries: true,
+        });
+        // A request sent while a server is still setting up its ports may
+        // never be answered; hello is harmless to repeat.
+        let hello = AdminRequest::new(AdminOp::Hello);
+        let (reply, server) = loop {
+            let attempt = (Instant::now() + HELLO_RETRY).min(deadline);
+            match self.admin_call(&hello, &[], attempt) {
+                Ok(r) => break r,
+                Err(ClientError::Timeout(_)) if Instant::now() < deadline => {}
+                Err(e) => {
+                    self.conn = None;
+                    return Err(e);
+                }
+            }
+        };
+        if reply.info.protocol != gjkd_proto::PROTOCOL_VERSION {
+            self.conn = None;
+            return Err(ClientError::Protocol(format!(
+                "server speaks protocol {}, this client {}",
+                reply.info.protocol,
+                gjkd_proto::PROTOCOL_VERSION
+            )));
+        }
+        if let Some(conn) = &mut self.conn {
+            conn.info = reply.info;
+            conn.server = Some(server);
+            // A spinning server needs no wake-up: skip the notify syscall.
+            conn.notify_queries =
+                WaitMode::from_raw(reply.info.wait).is_none_or(|m| m.needs_wake());
+        }
+        Ok(())
+    }
+
+    fn ensure_connected(&mut self, deadline: Instant) -> Result<(), ClientError> {
+        if self.conn.is_none() {
+            self.reconnect(deadline, true)?;
+        }
+        Ok(())
+    }
+
+    /// Waits for `poll` to produce an answer until `deadline`, checking now
+    /// and then that a server is still there.
+    fn await_reply<R>(
+        node: &Node<ipc::Service>,
+        conn: &Connection,
+        deadline: Instant,
+        timeout: Duration,
+        mut poll: impl FnMut() -> Result<Option<R>, ClientError>,
+    ) -> Result<R, Waited> {
+        let start = Instant::now();
+        let mut next_check = start + LIVENESS_AFTER;
+        loop {
+            match poll() {
+                Ok(Some(r)) => return Ok(r),
+                Ok(None) => {}
+                Err(e) => return Err(Waited::Failed(e)),
+            }
+            let now = Instant::now();
+            let waited = now - start;
+            if now >= next_check || now >= deadline {
+                if !conn.server_alive(node) {
+                    return Err(Waited::Gone);
+                }
+                // The answer may have come while we were cleaning up.
+                if let Ok(Some(r)) = poll() {
+                    return Ok(r);
+                }
+                if Instant::now() >= deadline {
+                    return Err(Waited::Failed(ClientError::Timeout(timeout)));
+                }
+                next_check = Instant::now() + LIVENESS_EVERY;
+            }
+            if waited < SPIN_FOR {
+                std::hint::spin_loop();
+            } else if waited < YIELD_FOR {
+                std::thread::yield_now();
+            } else {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+    }
+
+    /// Turns the outcome of a call into the caller's result, dropping the
+    /// connection when the server is gone so the next call reconnects.
+    fn settle<R>(&mut self, outcome: Result<R, Waited>) -> Result<R, ClientError> {
+        match outcome {
+            Ok(r) => Ok(r),
+            Err(Waited::Gone) => {
+                self.conn = None;
+                Err(self.gone())
+            }
+            Err(Waited::Failed(e)) => Err(e),
+        }
+    }
+
+    /// One admin round trip; the reply and the id of the server port that
+    /// sent it.
+    fn admin_call(
+        &mut self,
+        request: &AdminRequest,
+        vertices: &[Vertex],
+        deadline: Instant,
+    ) -> Result<(AdminReply, u128), ClientError> {
+        let conn = self.conn.as_ref().ok_or_else(|| self.gone())?;
+        let outcome = (|| {
+            let mut loan = conn
+                .admin
+                .loan_slice_uninit(vertices.len())
+                .map_err(|e| Waited::Failed(ipc_err("admin loan")(e)))?;
+            *loan.user_header_mut() = *request;
+            let pending = loan
+                .write_from_slice(vertices)
+                .send()
+                .map_err(|e| conn.send_failed(&self.node, "admin send", e))?;
+            // Admin requests are rare: always wake the server, whatever its
+            // mode (it is not known before the first hello).
+            let _ = conn.wake.notify();
+            Self::await_reply(&self.node, conn, deadline, self.timeout, || {
+                pending
+                    .receive()
+                    .map(|r| r.map(|r| (*r.payload(), r.header().server_id().value())))
+                    .map_err(ipc_err("admin receive"))
+            })
+        })();
+        let (reply, server) = self.settle(outcome)?;
+        if reply.op != request.op {
+            return Err(ClientError::Protocol(format!(
+                "reply to operation {} answers operation {}",
+                request.op, reply.op
+            )));
+        }
+        Ok((reply, server))
+    }
+
+    fn admin(
+        &mut self,
+        request: &AdminRequest,
+        vertices: &[Vertex],
+    ) -> Result<AdminReply, ClientError> {
+        let deadline = Instant::now() + self.timeout;
+        self.ensure_connected(deadline)?;
+        let (reply, _) = self.admin_call(request, vertices, deadline)?;
+        match reply.error_code() {
+            ErrorCode::Ok => Ok(reply),
+            code => Err(ClientError::Rejected(code)),
+        }
+    }
+
+    /// Registers an object at the identity pose, without a name.
+    ///
+    /// # Errors
+    /// [`ClientError::Rejected`] with the reason for invalid geometry
+    /// ([`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`],
+    /// [`ErrorCode::NonFiniteVertex`], [`ErrorCode::TooManyVertices`], ...),
+    /// and the connection errors of every call.
+    pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, ClientError> {
+        self.register_with(geometry, None, &Isometry3::identity())
+    }
+
+    /// Registers an object with a unique `name` (so that other clients can
+    /// [`lookup`](Client::lookup) it) and an initial pose.
+    ///
+    /// # Errors
+    /// As [`Client::register`], plus [`ErrorCode::NameTaken`] and
+    /// [`ClientError::InvalidArgument`] for a name over [`MAX_NAME_LEN`]
+    /// bytes.
+    pub fn register_named(
+        &mut self,
+        name: &str,
+        geometry: &Geometry<'_>,
+        pose: &Isometry3<f64>,
+    ) -> Result<ObjectId, ClientError> {
+        self.register_with(geometry, Some(name), pose)
+    }
+
+    fn register_with(
+        &mut self,
+        geometry: &Geometry<'_>,
+        name: Option<&str>,
+        pose: &Isometry3<f64>,
+    ) -> Result<ObjectId, ClientError> {
+        let mut request = AdminRequest::new(AdminOp::Register);
+        request.pose = Pose::from_isometry(pose);
+        if let Some(name) = name
+            && !request.set_name(name)
+        {
+            return Err(ClientError::InvalidArgument(
+                "name longer than MAX_NAME_LEN",
+            ));
+        }
+        let mut vertices = std::mem::take(&mut self.vertex_scratch);
+        vertices.clear();
+        let built = Self::encode(geometry, &mut request, &mut vertices);
+        let result = built.and_then(|()| self.admin(&request, &vertices));
+        self.vertex_scratch = vertices;
+        result.map(|r| ObjectId::from_raw(r.id))
+    }
+
+    fn encode(
+        geometry: &Geometry<'_>,
+        request: &mut AdminRequest,
+        vertices: &mut Vec<Vertex>,
+    ) -> Result<(), ClientError> {
+        match geometry {
+            Geometry::Compound(pieces) => {
+                if pieces.len() > MAX_PIECES {
+                    return Err(ClientError::InvalidArgument("more than MAX_PIECES pieces"));
+                }
+                request.shape = shape_kind::COMPOUND;
+                request.piece_count = pieces.len() as u32;
+                for (desc, piece) in request.pieces.iter_mut().zip(pieces.iter()) {
+                    let before = vertices.len();
+                    let radius = piece.geometry.push_convex(vertices)?;
+                    *desc = PieceDesc {
+                        offset: Pose::from_isometry(&piece.offset),
+                        radius,
+                        vertex_count: u32::try_from(vertices.len() - before).map_err(|_| {
+                            ClientError::InvalidArgument("too many vertices in a piece")
+                        })?,
+                        reserved: 0,
+                    };
+                }
+            }
+            convex => {
+                request.shape = shape_kind::CONVEX;
+                request.piece_count = 1;
+                let radius = convex.push_convex(vertices)?;
+                request.pieces[0] = PieceDesc {
+                    offset: Pose::IDENTITY,
+                    radius,
+                    vertex_count: u32::try_from(vertices.len())
+                        .map_err(|_| ClientError::InvalidArgument("too many vertices"))?,
+                    reserved: 0,
+                };
+            }
+        }
+        Ok(())
+    }
+
+    /// Registers a ball of `radius` about the body origin.
+    ///
+    /// # Errors
+    /// As [`Client::register`].
+    pub fn register_sphere(&mut self, radius: f64) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Sphere { radius })
+    }
+
+    /// Registers the segment `a`–`b` grown by `radius`.
+    ///
+    /// # Errors
+    /// As [`Client::register`].
+    pub fn register_capsule(
+        &mut self,
+        a: Point3<f64>,
+        b: Point3<f64>,
+        radius: f64,
+    ) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Capsule { a, b, radius })
+    }
+
+    /// Registers a box with these half extents, centred on the body origin,
+    /// its edges rounded by `radius` (0 for a sharp box).
+    ///
+    /// # Errors
+    /// As [`Client::register`].
+    pub fn register_cuboid(
+        &mut self,
+        half_extents: Vector3<f64>,
+        radius: f64,
+    ) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Cuboid {
+            half_extents,
+            radius,
+        })
+    }
+
+    /// Registers the convex hull of `vertices` grown by `radius`.
+    ///
+    /// # Errors
+    /// As [`Client::register`].
+    pub fn register_polytope(
+        &mut self,
+        vertices: &[Point3<f64>],
+        radius: f64,
+    ) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Polytope { vertices, radius })
+    }
+
+    /// Registers a union of convex pieces.
+    ///
+    /// ```no_run
+    /// use gjkd_client::{Client, Geometry, Piece};
+    /// use nalgebra::{Isometry3, Point3};
+    ///
+    /// # fn main() -> Result<(), gjkd_client::ClientError> {
+    /// let mut client = Client::connect("gjkd")?;
+    /// let ball = Geometry::Sphere { radius: 0.3 };
+    /// let bar = Geometry::Capsule {
+    ///     a: Point3::new(-1.0, 0.0, 0.0),
+    ///     b: Point3::new(1.0, 0.0, 0.0),
+    ///     radius: 0.05,
+    /// };
+    /// let dumbbell = client.register_compound(&[
+    ///     Piece { offset: Isometry3::translation(-1.0, 0.0, 0.0), geometry: ball },
+    ///     Piece { offset: Isometry3::identity(), geometry: bar },
+    ///     Piece { offset: Isometry3::translation(1.0, 0.0, 0.0), geometry: ball },
+    /// ])?;
+    /// # Ok(())
+    /// # }
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Client::register`], plus [`ErrorCode::EmptyCompound`] and
+    /// [`ClientError::InvalidArgument`] for a nested compound or more than
+    /// [`MAX_PIECES`] pieces.
+    pub fn register_compound(&mut self, pieces: &[Piece<'_>]) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Compound(pieces))
+    }
+
+    /// Removes an object this client registered. Its id is never reused.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
+    /// client's object, [`ErrorCode::ReadOnly`] for a scene object.
+    pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
+        let mut request = AdminRequest::new(AdminOp::Remove);
+        request.id = id.raw();
+        self.admin(&request, &[]).map(|_| ())
+    }
+
+    /// The id of the object named `name` (scene objects, or objects
+    /// registered with [`Client::register_named`]).
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownName`], [`ClientError::InvalidArgument`] for a name
+    /// over [`MAX_NAME_LEN`] bytes.
+    pub fn lookup(&mut self, name: &str) -> Result<ObjectId, ClientError> {
+        let mut request = AdminRequest::new(AdminOp::Lookup);
+        if !request.set_name(name) {
+            return Err(ClientError::InvalidArgument(
+                "name longer than MAX_NAME_LEN",
+            ));
+        }
+        self.admin(&request, &[]).map(|r| ObjectId::from_raw(r.id))
+    }
+
+    /// The server's counters: objects, requests, warm-start cache use.
+    ///
+    /// # Errors
+    /// The connection errors of every call.
+    pub fn stats(&mut self) -> Result<ServerStats, ClientError> {
+        self.admin(&AdminRequest::new(AdminOp::Stats), &[])
+            .map(|r| r.stats)
+    }
+
+    /// Stores a new pose for `id`, used by every later query (of any client)
+    /// that does not give its own.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NonFinitePose`],
+    /// [`ErrorCode::BadQuaternion`], and the connection errors.
+    pub fn set_pose(&mut self, id: ObjectId, pose: &Isometry3<f64>) -> Result<(), ClientError> {
+        self.single(Item::set_pose(id, pose)).map(|_| ())
+    }
+
+    /// Distance between `a` and `b` at their stored poses.
+    ///
+    /// # Errors
+    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownObject`] or
+    /// [`ErrorCode::InvalidOptions`], and the connection errors.
+    pub fn distance(
+        &mut self,
+        a: ObjectId,
+        b: ObjectId,
+        options: &QueryOptions,
+    ) -> Result<Answer, ClientError> {
+        self.single(Item::distance(a, b, options))
+    }
+
+    /// Distance between `a` at `pose_a` and `b` at `pose_b`; the stored poses
+    /// are neither used nor changed.
+    ///
+    /// # Errors
+    /// As [`Client::distance`], plus [`ErrorCode::NonFinitePose`] and
+    /// [`ErrorCode::BadQuaternion`].
+    pub fn distance_at(
+        &mut self,
+        a: ObjectId,
+        pose_a: &Isometry3<f64>,
+        b: ObjectId,
+        pose_b: &Isometry3<f64>,
+        options: &QueryOptions,
+    ) -> Result<Answer, ClientError> {
+        self.single(Item::distance_at(a, pose_a, b, pose_b, options))
+    }
+
+    fn single(&mut self, item: Item) -> Result<Answer, ClientError> {
+        let mut out = [ItemResult::error(ErrorCode::Internal)];
+        self.query_batch(&[item], &mut out)?;
+        out[0].answer().map_err(ClientError::Rejected)
+    }
+
+    /// Sends `items` as one request and writes the answer to `items[i]` into
+    /// `results[i]`. Items are applied in order, so a pose update affects the
+    /// queries after it. Each result has its own error code (see
+    /// [`ItemResult::answer`]); the call itself fails only if the whole
+    /// request does. Allocates nothing of its own (iceoryx2 0.10 makes one
+    /// small allocation per request for its loan bookkeeping).
+    ///
+    /// # Errors
+    /// [`ClientError::ResultBufferTooSmall`];
+    /// [`ClientError::Rejected`] with [`ErrorCode::EmptyBatch`] or
+    /// [`ErrorCode::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
+    /// items); and the connection errors.
+    pub fn query_batch(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+    ) -> Result<(), ClientError> {
+        if results.len() < items.len() {
+            return Err(ClientError::ResultBufferTooSmall {
+                needed: items.len(),
+                got: results.len(),
+            });
+        }
+        let deadline = Instant::now() + self.timeout;
+        self.ensure_connected(deadline)?;
+        let conn = self.conn.as_ref().ok_or_else(|| self.gone())?;
+        let outcome = (|| {
+            if conn.query_service.dynamic_config().number_of_servers() == 0 {
+                return Err(Waited::Gone);
+            }
+            let pending = conn
+                .query
+                .loan_slice_uninit(items.len())
+                .map_err(|e| Waited::Failed(ipc_err("query loan")(e)))?
+                .write_from_slice(items)
+                .send()
+                .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
+            if conn.notify_queries {
+                let _ = conn.wake.notify();
+            }
+            Self::await_reply(&self.node, conn, deadline, self.timeout, || {
+                let Some(response) = pending.receive().map_err(ipc_err("query receive"))? else {
+                    return Ok(None);
+                };
+                let header = *response.user_header();
+                let code = ErrorCode::from_raw(header.error).ok_or_else(|| {
+                    ClientError::Protocol(format!("unknown error code {}", header.error))
+                })?;
+                if code != ErrorCode::Ok {
+                    return Err(ClientError::Rejected(code));
+                }
+                let payload = response.payload();
+                if payload.len() != items.len() {
+                    return Err(ClientError::Protocol(format!(
+                        "{} results for {} items",
+                        payload.len(),
+                        items.len()
+                    )));
+                }
+                results[..payload.len()].copy_from_slice(payload);
+                Ok(Some(()))
+            })
+        })();
+        self.settle(outcome)
+    }
+}
+
+/// How waiting for an answer ended, short of an answer.
+enum Waited {
+    /// No server is left on the service.
+    Gone,
+    /// Anything else, reported as is.
+    Failed(ClientError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cuboid_vertices_follow_gjk_order() {
+        let mut v = Vec::new();
+        let g = Geometry::Cuboid {
+            half_extents: Vector3::new(1.0, 2.0, 3.0),
+            radius: 0.0,
+        };
+        assert_eq!(g.push_convex(&mut v), Ok(0.0));
+        assert_eq!(v.len(), 8);
+        assert_eq!(
+            v[0],
+            Vertex {
+                x: -1.0,
+                y: -2.0,
+                z: -3.0
+            }
+        );
+        assert_eq!(
+            v[5],
+            Vertex {
+                x: 1.0,
+                y: -2.0,
+                z: 3.0
+            }
+        );
+    }
+
+    #[test]
+    fn compounds_encode_their_piece_table() {
+        let pts = [Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0)];
+        let pieces = [
+            Piece {
+                offset: Isometry3::translation(1.0, 0.0, 0.0),
+                geometry: Geometry::Sphere { radius: 0.5 },
+            },
+            Piece {
+                offset: Isometry3::identity(),
+                geometry: Geometry::Polytope {
+                    vertices: &pts,
+                    radius: 0.1,
+                },
+            },
+        ];
+        let mut req = AdminRequest::new(AdminOp::Register);
+        let mut v = Vec::new();
+        Client::encode(&Geometry::Compound(&pieces), &mut req, &mut v).expect("valid");
+        assert_eq!(req.shape, shape_kind::COMPOUND);
+        assert_eq!(req.piece_count, 2);
+        assert_eq!(req.pieces[0].vertex_count, 1);
+        assert_eq!(req.pieces[1].vertex_count, 2);
+        assert_eq!(req.pieces[1].radius, 0.1);
+        assert_eq!(req.pieces[0].offset.translation, [1.0, 0.0, 0.0]);
+        assert_eq!(v.len(), 3);
+
+        let nested = [Piece {
+            offset: Isometry3::identity(),
+            geometry: Geometry::Compound(&pieces),
+        }];
+        assert!(matches!(
+            Client::encode(&Geometry::Compound(&nested), &mut req, &mut v),
+            Err(ClientError::InvalidArgument(_))
+        ));
+    }
+}

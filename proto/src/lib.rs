@@ -1,1 +1,999 @@
-//! Wire types of gjkd (work in progress).
+//! # gjkd-proto
+//!
+//! The wire types of gjkd. Every message is a `#[repr(C)]` struct that lives in
+//! iceoryx2 shared memory as it is: no serialisation on the hot path. Each type
+//! carries an explicit iceoryx2 `type_name` (the default would include the Rust
+//! module path, so the same struct seen from another crate would not match),
+//! and every service name carries the protocol version.
+//!
+//! Three services make up one gjkd deployment named `service` (default
+//! [`DEFAULT_SERVICE`]):
+//!
+//! | service name | pattern | request | response |
+//! |---|---|---|---|
+//! | [`query_service_name`] `{service}/v1/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
+//! | [`admin_service_name`] `{service}/v1/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
+//! | [`wake_service_name`] `{service}/v1/wake` | event | | |
+//!
+//! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
+//! are plain `u32` on the wire, never Rust enums: any bit pattern a client
+//! writes must be a valid value of the type, so that the server can read
+//! arbitrary bytes without undefined behaviour. The typed views
+//! ([`ErrorCode`], [`Status`], [`ItemKind`], ...) are decoded from them.
+//!
+//! Most programs should use the `gjkd-client` crate rather than these types
+//! directly; the batch API of the client takes [`Item`] and fills
+//! [`ItemResult`], so their builders and accessors are documented here.
+//!
+//! ```
+//! use gjkd_proto::{Item, ObjectId, QueryOptions};
+//! use nalgebra::Isometry3;
+//!
+//! let a = ObjectId::from_raw(0x1_0000_0001);
+//! let b = ObjectId::from_raw(0x1_0000_0002);
+//! let items = [
+//!     Item::set_pose(a, &Isometry3::translation(1.0, 0.0, 0.0)),
+//!     Item::distance(a, b, &QueryOptions::default()),
+//! ];
+//! assert_eq!(items[1].object_a(), a);
+//! ```
+
+#![warn(missing_docs)]
+
+use std::fmt;
+
+use iceoryx2::prelude::ZeroCopySend;
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+/// Protocol version, part of every service name: a client and a server of
+/// different versions never see each other's services, instead of misreading
+/// each other's bytes.
+pub const PROTOCOL_VERSION: u32 = 1;
+
+/// Service name used when none is given.
+pub const DEFAULT_SERVICE: &str = "gjkd";
+
+/// Default relative tolerance of a query: 100 × machine epsilon, as in the
+/// paper and the `gjk` crate.
+pub const DEFAULT_TOLERANCE: f64 = 100.0 * f64::EPSILON;
+
+/// Default iteration cap of a query, as in the `gjk` crate.
+pub const DEFAULT_MAX_ITERATIONS: u32 = 128;
+
+/// Most pieces a compound may have: the piece table travels in the fixed-size
+/// [`AdminRequest`] header.
+pub const MAX_PIECES: usize = 64;
+
+/// Longest object name in bytes (UTF-8).
+pub const MAX_NAME_LEN: usize = 64;
+
+/// Name of the query service of deployment `service`: `{service}/v1/query`.
+pub fn query_service_name(service: &str) -> String {
+    format!("{service}/v{PROTOCOL_VERSION}/query")
+}
+
+/// Name of the admin service (registration, removal, look-up, statistics).
+pub fn admin_service_name(service: &str) -> String {
+    format!("{service}/v{PROTOCOL_VERSION}/admin")
+}
+
+/// Name of the event service a client notifies after sending, so that a
+/// server in `block` or `adaptive` mode wakes up.
+pub fn wake_service_name(service: &str) -> String {
+    format!("{service}/v{PROTOCOL_VERSION}/wake")
+}
+
+/// Identifier of a registered object. Ids are never reused by a server, and
+/// carry a per-server-start epoch in their upper 32 bits, so an id from a
+/// previous server run is reported as unknown instead of naming some other
+/// object.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ObjectId(u64);
+
+impl ObjectId {
+    /// The id with the given wire value.
+    pub const fn from_raw(raw: u64) -> Self {
+        ObjectId(raw)
+    }
+
+    /// The wire value.
+    pub const fn raw(self) -> u64 {
+        self.0
+    }
+}
+
+impl fmt::Display for ObjectId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:#x}", self.0)
+    }
+}
+
+/// What went wrong with one item or one request. `Ok` is 0 so that a zeroed
+/// result reads as success only when the server wrote it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum ErrorCode {
+    /// No error.
+    Ok = 0,
+    /// An object id names no registered object (never registered, removed, or
+    /// registered with a server that has since restarted).
+    UnknownObject = 1,
+    /// A pose or piece offset has a NaN or infinite component.
+    NonFinitePose = 2,
+    /// A rotation quaternion is off unit length by more than 1e-6.
+    BadQuaternion = 3,
+    /// A query option is out of its domain (negative or NaN tolerance, zero
+    /// iteration cap, NaN margin).
+    InvalidOptions = 4,
+    /// A shape has no vertices.
+    EmptyVertices = 5,
+    /// A shape has more vertices than the server accepts.
+    TooManyVertices = 6,
+    /// A radius is negative, NaN or infinite.
+    InvalidRadius = 7,
+    /// A batch has more items than the server accepts.
+    BatchTooLarge = 8,
+    /// A batch has no items.
+    EmptyBatch = 9,
+    /// A field has a value no client should send (unknown item kind or
+    /// operation, inconsistent counts, bad UTF-8 in a name).
+    Malformed = 10,
+    /// The object belongs to another client.
+    NotOwner = 11,
+    /// The object was loaded from the server's scene file and cannot be
+    /// changed or removed.
+    ReadOnly = 12,
+    /// A compound has more pieces than [`MAX_PIECES`].
+    TooManyPieces = 13,
+    /// A compound has no pieces.
+    EmptyCompound = 14,
+    /// A vertex has a NaN or infinite coordinate.
+    NonFiniteVertex = 15,
+    /// No object has this name.
+    UnknownName = 16,
+    /// Another object already has this name.
+    NameTaken = 17,
+    /// The server holds as many objects as it accepts.
+    TooManyObjects = 18,
+    /// The server failed in a way that is its own fault; it keeps serving.
+    Internal = 19,
+}
+
+impl ErrorCode {
+    /// Every code, in wire order.
+    pub const ALL: [ErrorCode; 20] = [
+        ErrorCode::Ok,
+        ErrorCode::UnknownObject,
+        ErrorCode::NonFinitePose,
+        ErrorCode::BadQuaternion,
+        ErrorCode::InvalidOptions,
+        ErrorCode::EmptyVertices,
+        ErrorCode::TooManyVertices,
+        ErrorCode::InvalidRadius,
+        ErrorCode::BatchTooLarge,
+        ErrorCode::EmptyBatch,
+        ErrorCode::Malformed,
+        ErrorCode::NotOwner,
+        ErrorCode::ReadOnly,
+        ErrorCode::TooManyPieces,
+        ErrorCode::EmptyCompound,
+        ErrorCode::NonFiniteVertex,
+        ErrorCode::UnknownName,
+        ErrorCode::NameTaken,
+        ErrorCode::TooManyObjects,
+        ErrorCode::Internal,
+    ];
+
+    /// The code with wire value `raw`, or `None` for a value this version does
+    /// not know.
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        Self::ALL.get(raw as usize).copied()
+    }
+
+    /// The wire value.
+    pub const fn raw(self) -> u32 {
+        self as u32
+    }
+
+    /// A short description.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ErrorCode::Ok => "ok",
+            ErrorCode::UnknownObject => "unknown object id",
+            ErrorCode::NonFinitePose => "pose is not finite",
+            ErrorCode::BadQuaternion => "rotation quaternion is not of unit length",
+            ErrorCode::InvalidOptions => "invalid query options",
+            ErrorCode::EmptyVertices => "empty vertex set",
+            ErrorCode::TooManyVertices => "too many vertices",
+            ErrorCode::InvalidRadius => "radius is not a finite number >= 0",
+            ErrorCode::BatchTooLarge => "batch too large",
+            ErrorCode::EmptyBatch => "empty batch",
+            ErrorCode::Malformed => "malformed request",
+            ErrorCode::NotOwner => "object belongs to another client",
+            ErrorCode::ReadOnly => "object is read-only",
+            ErrorCode::TooManyPieces => "too many compound pieces",
+            ErrorCode::EmptyCompound => "compound with no pieces",
+            ErrorCode::NonFiniteVertex => "vertex is not finite",
+            ErrorCode::UnknownName => "no object has this name",
+            ErrorCode::NameTaken => "name already taken",
+            ErrorCode::TooManyObjects => "server object limit reached",
+            ErrorCode::Internal => "internal server error",
+        }
+    }
+}
+
+impl fmt::Display for ErrorCode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.describe())
+    }
+}
+
+impl std::error::Error for ErrorCode {}
+
+/// How a query ended; the wire values of [`ItemResult::status`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum Status {
+    /// The stopping rule held: the distance is exact to the tolerance.
+    Converged = 1,
+    /// Early exit: the distance is proved greater than the margin.
+    Farther = 2,
+    /// Early exit: the distance is proved at most the margin.
+    Closer = 3,
+    /// The iteration cap was reached first; the bounds still hold.
+    IterationCap = 4,
+    /// Round-off stopped progress before the tolerance was met; the bounds
+    /// still hold.
+    ToleranceNotMet = 5,
+}
+
+impl Status {
+    /// The status with wire value `raw`, if any (0 is "no answer", for items
+    /// that failed or were pose updates).
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            1 => Some(Status::Converged),
+            2 => Some(Status::Farther),
+            3 => Some(Status::Closer),
+            4 => Some(Status::IterationCap),
+            5 => Some(Status::ToleranceNotMet),
+            _ => None,
+        }
+    }
+
+    /// The wire value.
+    pub const fn raw(self) -> u32 {
+        self as u32
+    }
+}
+
+/// What an [`Item`] asks for; the wire values of [`Item::kind`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum ItemKind {
+    /// Store a new pose for an object (used by every later query that does not
+    /// give its own pose).
+    SetPose = 1,
+    /// Distance between two objects.
+    Distance = 2,
+}
+
+impl ItemKind {
+    /// The kind with wire value `raw`, if any.
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            1 => Some(ItemKind::SetPose),
+            2 => Some(ItemKind::Distance),
+            _ => None,
+        }
+    }
+}
+
+/// Bits of [`Item::flags`].
+pub mod item_flags {
+    /// The item's own `pose_a` replaces the stored pose of object A for this
+    /// query only.
+    pub const POSE_A: u32 = 1;
+    /// The item's own `pose_b` replaces the stored pose of object B for this
+    /// query only.
+    pub const POSE_B: u32 = 1 << 1;
+    /// `margin` is set: stop early once the distance is proved above or below
+    /// it.
+    pub const MARGIN: u32 = 1 << 2;
+    /// Start from the server's cached simplex of this pair (for this client).
+    pub const WARM_START: u32 = 1 << 3;
+    /// Every bit this version knows; others are rejected as malformed.
+    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START;
+}
+
+/// Bits of [`ItemResult::flags`].
+pub mod result_flags {
+    /// The query started from a cached simplex.
+    pub const WARM_STARTED: u32 = 1;
+    /// gjk's Backup Procedure ran (a sign of a numerically hard case).
+    pub const BACKUP_USED: u32 = 1 << 1;
+}
+
+/// A rigid pose on the wire: translation and rotation quaternion `[i, j, k, w]`
+/// (nalgebra's coordinate order), in f64.
+#[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.Pose")]
+pub struct Pose {
+    /// Translation.
+    pub translation: [f64; 3],
+    /// Unit quaternion `[i, j, k, w]`.
+    pub rotation: [f64; 4],
+}
+
+impl Pose {
+    /// The identity pose.
+    pub const IDENTITY: Pose = Pose {
+        translation: [0.0; 3],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+    };
+
+    /// The wire form of `iso`, bit for bit.
+    pub fn from_isometry(iso: &Isometry3<f64>) -> Self {
+        let t = iso.translation.vector;
+        let q = iso.rotation.coords;
+        Pose {
+            translation: [t.x, t.y, t.z],
+            rotation: [q.x, q.y, q.z, q.w],
+        }
+    }
+
+    /// The isometry with exactly these components. The quaternion is taken as
+    /// it is, without normalising: check it first (the server does).
+    pub fn to_isometry_unchecked(&self) -> Isometry3<f64> {
+        let [x, y, z] = self.translation;
+        let [i, j, k, w] = self.rotation;
+        Isometry3::from_parts(
+            Translation3::new(x, y, z),
+            UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
+        )
+    }
+}
+
+impl Default for Pose {
+    fn default() -> Self {
+        Pose::IDENTITY
+    }
+}
+
+impl From<&Isometry3<f64>> for Pose {
+    fn from(iso: &Isometry3<f64>) -> Self {
+        Pose::from_isometry(iso)
+    }
+}
+
+/// Per-query options, the client-side view of [`Item`]'s option fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QueryOptions {
+    /// Relative tolerance `ε` of the stopping rule, `>= 0` (default
+    /// [`DEFAULT_TOLERANCE`]). Larger is faster and looser; the answer's bounds
+    /// say by how much.
+    pub tolerance: f64,
+    /// Iteration cap, at least 1 (default [`DEFAULT_MAX_ITERATIONS`]).
+    pub max_iterations: u32,
+    /// Early exit: stop as soon as the distance is proved greater than this
+    /// margin ([`Status::Farther`]) or at most it ([`Status::Closer`]).
+    pub margin: Option<f64>,
+    /// Start from the simplex the server kept for this pair after this
+    /// client's previous query of it (default on). Changes only the time,
+    /// never the answer beyond the tolerance.
+    pub warm_start: bool,
+}
+
+impl Default for QueryOptions {
+    fn default() -> Self {
+        QueryOptions {
+            tolerance: DEFAULT_TOLERANCE,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            margin: None,
+            warm_start: true,
+        }
+    }
+}
+
+impl QueryOptions {
+    /// Defaults with warm start off: every query starts cold.
+    pub fn cold() -> Self {
+        QueryOptions {
+            warm_start: false,
+            ..Self::default()
+        }
+    }
+}
+
+/// One item of a query request: a pose update or a pair query. A request is a
+/// slice of items, answered by a slice of [`ItemResult`]s of the same length,
+/// in the same order; items are applied in order, so a pose update affects
+/// the queries after it in the same batch.
+///
+/// Build items with [`Item::set_pose`] and [`Item::distance`].
+#[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.Item")]
+pub struct Item {
+    /// [`ItemKind`] wire value.
+    pub kind: u32,
+    /// [`item_flags`] bits.
+    pub flags: u32,
+    /// Object A (the object whose pose is set, for [`ItemKind::SetPose`]).
+    pub a: u64,
+    /// Object B (unused for [`ItemKind::SetPose`]).
+    pub b: u64,
+    /// Pose of A: the new stored pose for [`ItemKind::SetPose`], this query's
+    /// pose of A with [`item_flags::POSE_A`].
+    pub pose_a: Pose,
+    /// This query's pose of B with [`item_flags::POSE_B`].
+    pub pose_b: Pose,
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Early-exit margin, with [`item_flags::MARGIN`].
+    pub margin: f64,
+    /// Iteration cap.
+    pub max_iterations: u32,
+    /// Zero.
+    pub reserved: u32,
+}
+
+impl Item {
+    /// Store `pose` as the pose of object `id`.
+    pub fn set_pose(id: ObjectId, pose: &Isometry3<f64>) -> Self {
+        Item {
+            kind: ItemKind::SetPose as u32,
+            flags: 0,
+            a: id.raw(),
+            b: 0,
+            pose_a: Pose::from_isometry(pose),
+            pose_b: Pose::IDENTITY,
+            tolerance: DEFAULT_TOLERANCE,
+            margin: 0.0,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            reserved: 0,
+        }
+    }
+
+    /// Distance between `a` and `b` at their stored poses.
+    pub fn distance(a: ObjectId, b: ObjectId, options: &QueryOptions) -> Self {
+        let mut flags = 0;
+        if options.warm_start {
+            flags |= item_flags::WARM_START;
+        }
+        if options.margin.is_some() {
+            flags |= item_flags::MARGIN;
+        }
+        Item {
+            kind: ItemKind::Distance as u32,
+            flags,
+            a: a.raw(),
+            b: b.raw(),
+            pose_a: Pose::IDENTITY,
+            pose_b: Pose::IDENTITY,
+            tolerance: options.tolerance,
+            margin: options.margin.unwrap_or(0.0),
+            max_iterations: options.max_iterations,
+            reserved: 0,
+        }
+    }
+
+    /// Distance between `a` at `pose_a` and `b` at `pose_b`, leaving the
+    /// stored poses alone.
+    pub fn distance_at(
+        a: ObjectId,
+        pose_a: &Isometry3<f64>,
+        b: ObjectId,
+        pose_b: &Isometry3<f64>,
+        options: &QueryOptions,
+    ) -> Self {
+        Self::distance(a, b, options)
+            .with_pose_a(pose_a)
+            .with_pose_b(pose_b)
+    }
+
+    /// This query with its own pose for A.
+    pub fn with_pose_a(mut self, pose: &Isometry3<f64>) -> Self {
+        self.flags |= item_flags::POSE_A;
+        self.pose_a = Pose::from_isometry(pose);
+        self
+    }
+
+    /// This query with its own pose for B.
+    pub fn with_pose_b(mut self, pose: &Isometry3<f64>) -> Self {
+        self.flags |= item_flags::POSE_B;
+        self.pose_b = Pose::from_isometry(pose);
+        self
+    }
+
+    /// The kind, if it is one this version knows.
+    pub fn item_kind(&self) -> Option<ItemKind> {
+        ItemKind::from_raw(self.kind)
+    }
+
+    /// Object A.
+    pub fn object_a(&self) -> ObjectId {
+        ObjectId(self.a)
+    }
+
+    /// Object B.
+    pub fn object_b(&self) -> ObjectId {
+        ObjectId(self.b)
+    }
+
+    /// The options encoded in this item.
+    pub fn options(&self) -> QueryOptions {
+        QueryOptions {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            margin: (self.flags & item_flags::MARGIN != 0).then_some(self.margin),
+            warm_start: self.flags & item_flags::WARM_START != 0,
+        }
+    }
+}
+
+/// The answer to one [`Item`]. For a pose update only `error` is meaningful.
+///
+/// Read it with [`ItemResult::answer`].
+#[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.ItemResult")]
+pub struct ItemResult {
+    /// Distance between the (rounded) shapes, `>= 0`.
+    pub distance: f64,
+    /// Certified lower bound on the distance.
+    pub lower: f64,
+    /// Certified upper bound on the distance.
+    pub upper: f64,
+    /// Lower bound on the penetration depth; 0 when separated.
+    pub penetration: f64,
+    /// Nearest point on A, world coordinates.
+    pub point_a: [f64; 3],
+    /// Nearest point on B, world coordinates.
+    pub point_b: [f64; 3],
+    /// Unit vector from A's nearest point towards B's; zero when the cores
+    /// touch or intersect.
+    pub normal: [f64; 3],
+    /// [`ErrorCode`] wire value.
+    pub error: u32,
+    /// [`Status`] wire value, 0 when there is no answer.
+    pub status: u32,
+    /// Subalgorithm iterations (summed over piece pairs for compounds).
+    pub iterations: u32,
+    /// [`result_flags`] bits.
+    pub flags: u32,
+    /// Pieces of A and B that realise the distance (0 for convex objects).
+    pub pieces: [u32; 2],
+}
+
+impl ItemResult {
+    /// A result that carries only an error code.
+    pub const fn error(code: ErrorCode) -> Self {
+        ItemResult {
+            distance: 0.0,
+            lower: 0.0,
+            upper: 0.0,
+            penetration: 0.0,
+            point_a: [0.0; 3],
+            point_b: [0.0; 3],
+            normal: [0.0; 3],
+            error: code as u32,
+            status: 0,
+            iterations: 0,
+            flags: 0,
+            pieces: [0; 2],
+        }
+    }
+
+    /// The error code; unknown wire values read as [`ErrorCode::Malformed`].
+    pub fn error_code(&self) -> ErrorCode {
+        ErrorCode::from_raw(self.error).unwrap_or(ErrorCode::Malformed)
+    }
+
+    /// The answer of a distance query, or the item's error. A successful pose
+    /// update reads as an answer with status `None`.
+    pub fn answer(&self) -> Result<Answer, ErrorCode> {
+        match self.error_code() {
+            ErrorCode::Ok => Ok(Answer {
+                distance: self.distance,
+                lower: self.lower,
+                upper: self.upper,
+                penetration: self.penetration,
+                point_a: Point3::from(self.point_a),
+                point_b: Point3::from(self.point_b),
+                normal: Vector3::from(self.normal),
+                status: Status::from_raw(self.status),
+                iterations: self.iterations,
+                pieces: self.pieces,
+                warm_started: self.flags & result_flags::WARM_STARTED != 0,
+                backup_used: self.flags & result_flags::BACKUP_USED != 0,
+            }),
+            code => Err(code),
+        }
+    }
+}
+
+impl Default for ItemResult {
+    fn default() -> Self {
+        ItemResult::error(ErrorCode::Ok)
+    }
+}
+
+/// A decoded distance answer. Distances are after radii; points are in world
+/// coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Answer {
+    /// Distance between the (rounded) shapes, `>= 0`.
+    pub distance: f64,
+    /// Certified lower bound on the distance.
+    pub lower: f64,
+    /// Certified upper bound on the distance.
+    pub upper: f64,
+    /// Lower bound on the penetration depth; 0 when separated.
+    pub penetration: f64,
+    /// Nearest point on A. When the shapes overlap, the deepest point of A
+    /// along `normal`.
+    pub point_a: Point3<f64>,
+    /// Nearest point on B.
+    pub point_b: Point3<f64>,
+    /// Unit vector from A's nearest point towards B's; zero when the cores
+    /// touch or intersect.
+    pub normal: Vector3<f64>,
+    /// How the query ended; `None` for a pose update.
+    pub status: Option<Status>,
+    /// Subalgorithm iterations (summed over piece pairs for compounds).
+    pub iterations: u32,
+    /// Pieces of A and B that realise the distance (0 for convex objects).
+    pub pieces: [u32; 2],
+    /// The query started from the server's cached simplex.
+    pub warm_started: bool,
+    /// gjk's Backup Procedure ran.
+    pub backup_used: bool,
+}
+
+/// Response header of the query service: whole-request errors. When `error`
+/// is not [`ErrorCode::Ok`] the result slice is empty.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.ReplyHeader")]
+pub struct ReplyHeader {
+    /// [`ErrorCode`] wire value: [`ErrorCode::EmptyBatch`],
+    /// [`ErrorCode::BatchTooLarge`], or [`ErrorCode::Ok`].
+    pub error: u32,
+    /// Number of results that follow.
+    pub count: u32,
+}
+
+/// A vertex on the wire.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.Vertex")]
+pub struct Vertex {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+impl From<Point3<f64>> for Vertex {
+    fn from(p: Point3<f64>) -> Self {
+        Vertex {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        }
+    }
+}
+
+impl From<Vertex> for Point3<f64> {
+    fn from(v: Vertex) -> Self {
+        Point3::new(v.x, v.y, v.z)
+    }
+}
+
+/// Operations of the admin service; the wire values of [`AdminRequest::op`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum AdminOp {
+    /// Server information and limits ([`AdminReply::info`]).
+    Hello = 1,
+    /// Register a convex object (one piece) or a compound (several), with
+    /// the vertices in the request's slice payload.
+    Register = 2,
+    /// Remove object [`AdminRequest::id`].
+    Remove = 3,
+    /// Look an object up by [`AdminRequest::name`].
+    Lookup = 4,
+    /// Server statistics ([`AdminReply::stats`]).
+    Stats = 5,
+}
+
+impl AdminOp {
+    /// The operation with wire value `raw`, if any.
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            1 => Some(AdminOp::Hello),
+            2 => Some(AdminOp::Register),
+            3 => Some(AdminOp::Remove),
+            4 => Some(AdminOp::Lookup),
+            5 => Some(AdminOp::Stats),
+            _ => None,
+        }
+    }
+}
+
+/// Values of [`AdminRequest::shape`].
+pub mod shape_kind {
+    /// One convex piece: `pieces[0]` describes it (its offset is ignored).
+    pub const CONVEX: u32 = 1;
+    /// A union of `piece_count` convex pieces, each with its offset.
+    pub const COMPOUND: u32 = 2;
+}
+
+/// One convex piece of a registration: its offset in the object's body frame,
+/// radius, and how many of the slice's vertices are its own (pieces take
+/// consecutive runs of the slice, in order).
+#[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.PieceDesc")]
+pub struct PieceDesc {
+    /// Offset of the piece in the object's body frame.
+    pub offset: Pose,
+    /// Rounding radius, `>= 0`.
+    pub radius: f64,
+    /// Number of vertices of this piece.
+    pub vertex_count: u32,
+    /// Zero.
+    pub reserved: u32,
+}
+
+/// Request header of the admin service. The slice payload holds the
+/// vertices of a registration (empty for other operations).
+#[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.AdminRequest")]
+pub struct AdminRequest {
+    /// [`AdminOp`] wire value.
+    pub op: u32,
+    /// [`shape_kind`] value, for [`AdminOp::Register`].
+    pub shape: u32,
+    /// Object, for [`AdminOp::Remove`].
+    pub id: u64,
+    /// Number of valid entries of `pieces`.
+    pub piece_count: u32,
+    /// Bytes of `name` in use.
+    pub name_len: u32,
+    /// UTF-8 name: optional for [`AdminOp::Register`], required for
+    /// [`AdminOp::Lookup`].
+    pub name: [u8; MAX_NAME_LEN],
+    /// Initial pose of a registered object.
+    pub pose: Pose,
+    /// Piece table of a registration.
+    pub pieces: [PieceDesc; MAX_PIECES],
+}
+
+impl Default for AdminRequest {
+    /// An empty request with operation 0, which no server accepts: iceoryx2
+    /// needs a default header, and a forgotten `op` must not mean anything.
+    fn default() -> Self {
+        AdminRequest {
+            op: 0,
+            ..AdminRequest::new(AdminOp::Hello)
+        }
+    }
+}
+
+impl AdminRequest {
+    /// A request for `op` with everything else empty.
+    pub fn new(op: AdminOp) -> Self {
+        AdminRequest {
+            op: op as u32,
+            shape: 0,
+            id: 0,
+            piece_count: 0,
+            name_len: 0,
+            name: [0; MAX_NAME_LEN],
+            pose: Pose::IDENTITY,
+            pieces: [PieceDesc::default(); MAX_PIECES],
+        }
+    }
+
+    /// Sets the name; `false` (and no change) if it is longer than
+    /// [`MAX_NAME_LEN`] bytes.
+    pub fn set_name(&mut self, name: &str) -> bool {
+        let bytes = name.as_bytes();
+        if bytes.len() > MAX_NAME_LEN {
+            return false;
+        }
+        self.name = [0; MAX_NAME_LEN];
+        self.name[..bytes.len()].copy_from_slice(bytes);
+        self.name_len = bytes.len() as u32;
+        true
+    }
+
+    /// The name, or `None` if `name_len` is out of range or the bytes are not
+    /// UTF-8.
+    pub fn name(&self) -> Option<&str> {
+        let len = usize::try_from(self.name_len).ok()?;
+        std::str::from_utf8(self.name.get(..len)?).ok()
+    }
+}
+
+/// Wait strategy of a server; the wire values of [`ServerInfo::wait`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum WaitMode {
+    /// Busy-polls: lowest latency, one core always busy.
+    Spin = 1,
+    /// Sleeps on an event until a client notifies: no busy CPU.
+    Block = 2,
+    /// Spins for a short while after each request, then sleeps.
+    Adaptive = 3,
+}
+
+impl WaitMode {
+    /// The mode with wire value `raw`, if any.
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            1 => Some(WaitMode::Spin),
+            2 => Some(WaitMode::Block),
+            3 => Some(WaitMode::Adaptive),
+            _ => None,
+        }
+    }
+
+    /// Whether clients must notify the wake event after sending.
+    pub fn needs_wake(self) -> bool {
+        self != WaitMode::Spin
+    }
+}
+
+/// What a server tells a client at [`AdminOp::Hello`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.ServerInfo")]
+pub struct ServerInfo {
+    /// [`PROTOCOL_VERSION`] of the server.
+    pub protocol: u32,
+    /// [`WaitMode`] wire value.
+    pub wait: u32,
+    /// Most items in one query request.
+    pub max_batch: u32,
+    /// Most vertices in one registration.
+    pub max_vertices: u32,
+    /// Most pieces in one compound.
+    pub max_pieces: u32,
+    /// Most clients per service.
+    pub max_clients: u32,
+    /// Most objects the server holds.
+    pub max_objects: u64,
+    /// Process id of the server.
+    pub pid: u64,
+}
+
+/// Server statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.ServerStats")]
+pub struct ServerStats {
+    /// Objects held.
+    pub objects: u64,
+    /// Query requests answered.
+    pub requests: u64,
+    /// Items answered (pose updates and queries).
+    pub items: u64,
+    /// Items that failed.
+    pub item_errors: u64,
+    /// Warm-start cache entries in use.
+    pub cache_entries: u64,
+    /// Warm-start cache capacity.
+    pub cache_capacity: u64,
+    /// Queries that found a cached simplex.
+    pub cache_hits: u64,
+    /// Warm-start queries that found none.
+    pub cache_misses: u64,
+    /// Entries evicted to stay within the capacity.
+    pub cache_evictions: u64,
+}
+
+/// The admin service's answer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("gjkd.v1.AdminReply")]
+pub struct AdminReply {
+    /// [`ErrorCode`] wire value.
+    pub error: u32,
+    /// [`AdminOp`] wire value of the request.
+    pub op: u32,
+    /// The object registered, removed or found.
+    pub id: u64,
+    /// Filled for [`AdminOp::Hello`].
+    pub info: ServerInfo,
+    /// Filled for [`AdminOp::Stats`].
+    pub stats: ServerStats,
+}
+
+impl AdminReply {
+    /// A reply carrying only an error code.
+    pub fn error(op: u32, code: ErrorCode) -> Self {
+        AdminReply {
+            error: code as u32,
+            op,
+            ..Default::default()
+        }
+    }
+
+    /// The error code; unknown wire values read as [`ErrorCode::Malformed`].
+    pub fn error_code(&self) -> ErrorCode {
+        ErrorCode::from_raw(self.error).unwrap_or(ErrorCode::Malformed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_carry_the_version() {
+        assert_eq!(query_service_name("gjkd"), "gjkd/v1/query");
+        assert_eq!(admin_service_name("x"), "x/v1/admin");
+        assert_eq!(wake_service_name("x"), "x/v1/wake");
+    }
+
+    #[test]
+    fn error_codes_round_trip() {
+        for (i, c) in ErrorCode::ALL.iter().enumerate() {
+            assert_eq!(c.raw() as usize, i);
+            assert_eq!(ErrorCode::from_raw(c.raw()), Some(*c));
+        }
+        assert_eq!(ErrorCode::from_raw(ErrorCode::ALL.len() as u32), None);
+    }
+
+    #[test]
+    fn pose_round_trips_bit_for_bit() {
+        let iso = Isometry3::new(
+            Vector3::new(1.25, -3.5, 1e-300),
+            Vector3::new(0.3, -1.2, 2.0),
+        );
+        let back = Pose::from_isometry(&iso).to_isometry_unchecked();
+        assert_eq!(back, iso);
+    }
+
+    #[test]
+    fn item_encodes_options() {
+        let o = QueryOptions {
+            tolerance: 1e-9,
+            max_iterations: 7,
+            margin: Some(0.5),
+            warm_start: false,
+        };
+        let it = Item::distance(ObjectId::from_raw(3), ObjectId::from_raw(4), &o);
+        assert_eq!(it.options(), o);
+        assert_eq!(it.item_kind(), Some(ItemKind::Distance));
+        assert_eq!(it.flags & item_flags::WARM_START, 0);
+    }
+
+    #[test]
+    fn names_are_bounded_and_checked() {
+        let mut r = AdminRequest::new(AdminOp::Lookup);
+        assert!(r.set_name("ball"));
+        assert_eq!(r.name(), Some("ball"));
+        assert!(!r.set_name(&"x".repeat(MAX_NAME_LEN + 1)));
+        r.name_len = 1000;
+        assert_eq!(r.name(), None);
+        r.name_len = 2;
+        r.name[0] = 0xff;
+        assert_eq!(r.name(), None);
+    }
+
+    #[test]
+    fn wire_sizes_are_stable() {
+        assert_eq!(std::mem::size_of::<Pose>(), 56);
+        assert_eq!(std::mem::size_of::<Item>(), 160);
+        assert_eq!(std::mem::size_of::<ItemResult>(), 128);
+        assert_eq!(std::mem::size_of::<Vertex>(), 24);
+    }
+}

@@ -1,1 +1,170 @@
-fn main() {}
+//! `gjkd`: the distance server (`gjkd serve`) and its demo (`gjkd demo`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use gjkd::scene::Scene;
+use gjkd::server::{ServeOptions, run};
+use gjkd::state::{Limits, State};
+use gjkd_proto::{DEFAULT_SERVICE, MAX_PIECES, WaitMode};
+use tracing::{error, info};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "gjkd",
+    version,
+    about = "Distance server for co-located processes"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Serve distance queries until SIGINT or SIGTERM.
+    Serve(ServeArgs),
+    /// Start a server, sweep the Section 8 scene through it and print the
+    /// distances and the warm-start speed-up.
+    Demo(DemoArgs),
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum Wait {
+    /// Busy-poll: lowest latency, burns a core.
+    Spin,
+    /// Sleep until a client notifies: no busy CPU.
+    Block,
+    /// Spin briefly after each request, then sleep.
+    Adaptive,
+}
+
+impl From<Wait> for WaitMode {
+    fn from(w: Wait) -> Self {
+        match w {
+            Wait::Spin => WaitMode::Spin,
+            Wait::Block => WaitMode::Block,
+            Wait::Adaptive => WaitMode::Adaptive,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+struct ServeArgs {
+    /// Deployment name: the services are NAME/v1/query, NAME/v1/admin and
+    /// NAME/v1/wake.
+    #[arg(long, default_value = DEFAULT_SERVICE)]
+    service: String,
+    /// Scene file (TOML) of read-only named objects to load at start.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Wait strategy.
+    #[arg(long, value_enum, default_value_t = Wait::Adaptive)]
+    wait: Wait,
+    /// Most clients at once (one per `gjkd-client` `Client`; the limit holds
+    /// for each of the query and admin services).
+    #[arg(long, default_value_t = Limits::default().max_clients)]
+    max_clients: usize,
+    /// Most processes (iceoryx2 nodes) per service.
+    #[arg(long, default_value_t = Limits::default().max_nodes)]
+    max_nodes: usize,
+    /// Most items per query request.
+    #[arg(long, default_value_t = Limits::default().max_batch)]
+    max_batch: usize,
+    /// Most vertices per registered object.
+    #[arg(long, default_value_t = Limits::default().max_vertices)]
+    max_vertices: usize,
+    /// Most objects held at once.
+    #[arg(long, default_value_t = Limits::default().max_objects)]
+    max_objects: usize,
+    /// Most warm-start cache entries (one per client and ordered pair).
+    #[arg(long, default_value_t = Limits::default().cache_capacity)]
+    cache_capacity: usize,
+}
+
+#[derive(Args, Debug)]
+struct DemoArgs {
+    /// Sweep steps to time, besides the paper's 10, 100 and 1000.
+    #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000])]
+    steps: Vec<usize>,
+    /// Repetitions of each timed sweep (the median is reported).
+    #[arg(long, default_value_t = 7)]
+    repeats: usize,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .init();
+    // iceoryx2 logs to the console by itself; keep it to real problems.
+    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Serve(args) => serve(args),
+        Command::Demo(args) => match gjkd::demo::run(&args.steps, args.repeats.max(1)) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("gjkd demo: {e}");
+                ExitCode::FAILURE
+            }
+        },
+    }
+}
+
+fn serve(args: ServeArgs) -> ExitCode {
+    let limits = Limits {
+        max_clients: args.max_clients.max(1),
+        max_nodes: args.max_nodes.max(2),
+        max_batch: args.max_batch.max(1),
+        max_vertices: args.max_vertices.max(1),
+        max_pieces: MAX_PIECES,
+        max_objects: args.max_objects,
+        cache_capacity: args.cache_capacity,
+    };
+    let mut state = State::new(limits, args.wait.into(), epoch());
+    if let Some(path) = &args.scene {
+        match Scene::load(path).and_then(|s| s.install(&mut state)) {
+            Ok(ids) => info!(scene = %path.display(), objects = ids.len(), "scene loaded"),
+            Err(e) => {
+                error!("{e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    let shutdown = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        if let Err(e) = signal_hook::flag::register(signal, Arc::clone(&shutdown)) {
+            error!("cannot install the handler of signal {signal}: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let options = ServeOptions {
+        service: args.service,
+        wait: args.wait.into(),
+    };
+    match run(&options, state, &shutdown, || {}) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            error!("{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Upper half of every object id of this run: differs between runs so that a
+/// client's ids from before a restart are unknown, not aliases.
+fn epoch() -> u32 {
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_nanos() as u64)
+        .unwrap_or(0);
+    let mixed = (nanos ^ (u64::from(std::process::id()) << 20)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    ((mixed >> 32) as u32).max(1)
+}

@@ -1,0 +1,437 @@
+//! `gjkd demo`: the paper's Section 8 experiment, run through a real server.
+//!
+//! It starts `gjkd serve` as a child process on a private service name,
+//! registers the Section 8 scene (a compound object moving and turning
+//! through five fixed obstacles, from `gjk::paper::section8`) through the
+//! client library, sweeps the path at T = 10, 100 and 1000 steps, and prints
+//! the distance to each obstacle along the path and the time of cold-started
+//! sweeps against sweeps warm-started from the server's per-pair cache, beside
+//! the paper's Table 1.
+//!
+//! Each sweep is sent as few batches as the server's batch limit allows, every
+//! item carrying the moving object's pose of its step: the items of a batch
+//! are applied in order, so each step's query of an obstacle starts from the
+//! simplex the previous step left for that pair, exactly as in the paper.
+
+use std::io::Write;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use gjk::paper::{self, Motion, OBSTACLES};
+use gjk::{Options, Shape};
+use gjkd_client::{Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions};
+use nalgebra::Isometry3;
+
+/// The paper's Table 1: time without warm start over time with it, for
+/// T = 10, 100, 1000.
+pub const PAPER_RATIOS: [(usize, f64); 3] = [(10, 1.7), (100, 2.9), (1000, 3.1)];
+
+/// What can stop the demo.
+#[derive(Debug, thiserror::Error)]
+pub enum DemoError {
+    /// The server process could not be started.
+    #[error("cannot start the server: {0}")]
+    Spawn(std::io::Error),
+    /// A client call failed.
+    #[error("client: {0}")]
+    Client(#[from] ClientError),
+    /// An answer failed or disagreed with the in-process computation.
+    #[error("{0}")]
+    Check(String),
+}
+
+/// A `gjkd serve` child process, stopped with SIGTERM when dropped.
+pub struct ServerProcess {
+    child: Child,
+    /// The service name it serves.
+    pub service: String,
+}
+
+impl ServerProcess {
+    /// Starts `gjkd serve --service SERVICE` plus `extra` arguments, using
+    /// the current executable (which must be `gjkd`).
+    ///
+    /// # Errors
+    /// When the process cannot be spawned.
+    pub fn spawn(service: &str, extra: &[&str]) -> std::io::Result<Self> {
+        let exe = std::env::current_exe()?;
+        let child = Command::new(exe)
+            .arg("serve")
+            .arg("--service")
+            .arg(service)
+            .args(extra)
+            .env(
+                "RUST_LOG",
+                std::env::var("GJKD_DEMO_LOG").unwrap_or_else(|_| "warn".into()),
+            )
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .spawn()?;
+        Ok(ServerProcess {
+            child,
+            service: service.to_owned(),
+        })
+    }
+
+    /// Sends SIGTERM and waits up to five seconds for a clean exit, then
+    /// kills. Returns whether it exited cleanly.
+    pub fn stop(&mut self) -> bool {
+        if let Ok(Some(status)) = self.child.try_wait() {
+            return status.success();
+        }
+        if let Ok(pid) = libc::pid_t::try_from(self.child.id()) {
+            // SAFETY: kill(2) with a pid we spawned and have not reaped yet.
+            unsafe {
+                libc::kill(pid, libc::SIGTERM);
+            }
+        }
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while Instant::now() < deadline {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                return status.success();
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        false
+    }
+}
+
+impl Drop for ServerProcess {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// The scene as registered with the server.
+struct Registered {
+    moving: ObjectId,
+    obstacles: [ObjectId; OBSTACLES],
+}
+
+fn register(client: &mut Client, motion: &Motion) -> Result<Registered, DemoError> {
+    let Shape::Compound(moving) = motion.moving() else {
+        return Err(DemoError::Check(
+            "the moving object is not a compound".into(),
+        ));
+    };
+    let pieces: Vec<Piece<'_>> = moving
+        .pieces()
+        .iter()
+        .map(|(offset, convex)| Piece {
+            offset: *offset,
+            geometry: Geometry::Polytope {
+                vertices: convex.vertices(),
+                radius: convex.radius(),
+            },
+        })
+        .collect();
+    let moving = client.register_named("KA", &Geometry::Compound(&pieces), &motion.pose(0.0))?;
+    let mut obstacles = [ObjectId::from_raw(0); OBSTACLES];
+    for (i, (shape, pose)) in motion.obstacles().iter().enumerate() {
+        let Shape::Convex(c) = shape else {
+            return Err(DemoError::Check(format!(
+                "obstacle {} is not convex",
+                i + 1
+            )));
+        };
+        let geometry = Geometry::Polytope {
+            vertices: c.vertices(),
+            radius: c.radius(),
+        };
+        obstacles[i] = client.register_named(&format!("K{}", i + 1), &geometry, pose)?;
+    }
+    Ok(Registered { moving, obstacles })
+}
+
+/// One sweep through the server: distances per step, total iterations.
+struct ServedSweep {
+    distances: Vec<[f64; OBSTACLES]>,
+    iterations: u64,
+    elapsed: Duration,
+}
+
+/// Reusable buffers, so that timing measures the server and not `Vec` growth.
+struct Buffers {
+    items: Vec<Item>,
+    results: Vec<ItemResult>,
+}
+
+fn sweep(
+    client: &mut Client,
+    motion: &Motion,
+    scene: &Registered,
+    steps: usize,
+    options: &QueryOptions,
+    max_batch: usize,
+    buffers: &mut Buffers,
+) -> Result<ServedSweep, DemoError> {
+    let steps = steps.max(1);
+    let per_batch = (max_batch / OBSTACLES).max(1);
+    // Poses are computed before the clock starts: the paper times the
+    // distance computations, not the path.
+    let poses: Vec<Isometry3<f64>> = (0..=steps)
+        .map(|t| motion.pose(t as f64 / steps as f64))
+        .collect();
+    let mut distances = Vec::with_capacity(steps + 1);
+    let mut iterations = 0u64;
+    let mut elapsed = Duration::ZERO;
+    for chunk in poses.chunks(per_batch) {
+        buffers.items.clear();
+        for pose in chunk {
+            for &o in &scene.obstacles {
+                buffers
+                    .items
+                    .push(Item::distance(scene.moving, o, options).with_pose_a(pose));
+            }
+        }
+        let n = buffers.items.len();
+        buffers.results.resize(n, ItemResult::default());
+        let start = Instant::now();
+        client.query_batch(&buffers.items, &mut buffers.results[..n])?;
+        elapsed += start.elapsed();
+        for step in buffers.results[..n].chunks(OBSTACLES) {
+            let mut d = [0.0; OBSTACLES];
+            for (slot, r) in d.iter_mut().zip(step) {
+                let a = r
+                    .answer()
+                    .map_err(|e| DemoError::Check(format!("query failed: {e}")))?;
+                *slot = a.distance;
+                iterations += u64::from(a.iterations);
+            }
+            distances.push(d);
+        }
+    }
+    Ok(ServedSweep {
+        distances,
+        iterations,
+        elapsed,
+    })
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+/// Runs the demo, printing to stdout.
+///
+/// # Errors
+/// [`DemoError`] when the server cannot be started or reached, or an answer
+/// disagrees with the in-process computation.
+pub fn run(steps: &[usize], repeats: usize) -> Result<(), DemoError> {
+    let service = format!("gjkd-demo-{}", std::process::id());
+    let mut server =
+        ServerProcess::spawn(&service, &["--wait", "spin"]).map_err(DemoError::Spawn)?;
+    let outcome = run_with_server(&service, steps, repeats);
+    let clean = server.stop();
+    let () = outcome?;
+    if !clean {
+        eprintln!("gjkd demo: the server did not exit cleanly");
+    }
+    Ok(())
+}
+
+fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(), DemoError> {
+    let mut out = std::io::stdout().lock();
+    let motion = paper::section8();
+    let mut client = Client::builder(service)
+        .timeout(Duration::from_secs(10))
+        .connect()?;
+    let max_batch = client.server_info().map_or(1024, |i| i.max_batch as usize);
+    let scene = register(&mut client, &motion)?;
+    let mut buffers = Buffers {
+        items: Vec::new(),
+        results: Vec::new(),
+    };
+
+    let _ = writeln!(
+        out,
+        "gjkd demo: Section 8 of Gilbert, Johnson & Keerthi (1986) through a gjkd server\n\
+         (service `{service}`, server pid {}, busy-polling). A compound object of two convex\n\
+         pieces (20 vertices) moves and turns along its path through five fixed obstacles.\n",
+        client.server_info().map_or(0, |i| i.pid)
+    );
+
+    // The distances along the path, checked against the library in-process.
+    let t_plot = 100;
+    let served = sweep(
+        &mut client,
+        &motion,
+        &scene,
+        t_plot,
+        &QueryOptions::cold(),
+        max_batch,
+        &mut buffers,
+    )?;
+    let local = motion
+        .sweep(
+            t_plot,
+            &Options {
+                warm_start: false,
+                ..Options::default()
+            },
+            false,
+        )
+        .map_err(|e| DemoError::Check(format!("in-process sweep: {e}")))?;
+    let identical = served
+        .distances
+        .iter()
+        .flatten()
+        .zip(local.distances.iter().flatten())
+        .all(|(a, b)| a.to_bits() == b.to_bits());
+    if !identical {
+        return Err(DemoError::Check(
+            "the server's distances differ from the in-process ones".into(),
+        ));
+    }
+    print_plot(&mut out, &served.distances);
+    let _ = writeln!(
+        out,
+        "All {} distances equal the in-process gjk answers bit for bit.\n",
+        served.distances.len() * OBSTACLES
+    );
+
+    let _ = writeln!(
+        out,
+        "Time of a sweep of T steps (5(T+1) queries, median of {repeats}), cold start against the\n\
+         server's per-pair warm start, beside the paper's Table 1 (a VAX 11/785 in 1986):\n"
+    );
+    let _ = writeln!(
+        out,
+        "{:>6} {:>8} {:>12} {:>12} {:>10} {:>10} {:>7} {:>10} {:>7}",
+        "T", "queries", "cold", "warm", "cold/query", "warm/query", "ratio", "in-process", "paper"
+    );
+    for &t in steps {
+        let mut cold = Vec::with_capacity(repeats);
+        let mut warm = Vec::with_capacity(repeats);
+        let (mut it_cold, mut it_warm) = (0, 0);
+        let (mut local_cold, mut local_warm) = (Vec::new(), Vec::new());
+        let opts = Options::default();
+        // Alternate so that drift in the machine's speed hits both alike.
+        for _ in 0..repeats {
+            let start = Instant::now();
+            motion
+                .sweep(t, &opts, false)
+                .map_err(|e| DemoError::Check(format!("in-process sweep: {e}")))?;
+            local_cold.push(start.elapsed());
+            let start = Instant::now();
+            motion
+                .sweep(t, &opts, true)
+                .map_err(|e| DemoError::Check(format!("in-process sweep: {e}")))?;
+            local_warm.push(start.elapsed());
+            let c = sweep(
+                &mut client,
+                &motion,
+                &scene,
+                t,
+                &QueryOptions::cold(),
+                max_batch,
+                &mut buffers,
+            )?;
+            let w = sweep(
+                &mut client,
+                &motion,
+                &scene,
+                t,
+                &QueryOptions::default(),
+                max_batch,
+                &mut buffers,
+            )?;
+            it_cold = c.iterations;
+            it_warm = w.iterations;
+            cold.push(c.elapsed);
+            warm.push(w.elapsed);
+        }
+        let (c, w) = (median(cold), median(warm));
+        let local_ratio =
+            median(local_cold).as_secs_f64() / median(local_warm).as_secs_f64().max(1e-12);
+        let queries = (t + 1) * OBSTACLES;
+        let per = |d: Duration| format!("{:.2} µs", d.as_secs_f64() * 1e6 / queries as f64);
+        let paper = PAPER_RATIOS
+            .iter()
+            .find(|(pt, _)| *pt == t)
+            .map_or("-".to_string(), |(_, r)| format!("{r:.1}×"));
+        let _ = writeln!(
+            out,
+            "{:>6} {:>8} {:>12} {:>12} {:>10} {:>10} {:>6.1}× {:>9.1}× {:>7}",
+            t,
+            queries,
+            format!("{:.3} ms", c.as_secs_f64() * 1e3),
+            format!("{:.3} ms", w.as_secs_f64() * 1e3),
+            per(c),
+            per(w),
+            c.as_secs_f64() / w.as_secs_f64().max(1e-12),
+            local_ratio,
+            paper
+        );
+        let _ = writeln!(
+            out,
+            "{:>6} {:>8} {:>12} {:>12}   (subalgorithm iterations)",
+            "", "", it_cold, it_warm
+        );
+    }
+    let stats = client.stats()?;
+    let _ = writeln!(
+        out,
+        "\nServer: {} requests, {} items; warm-start cache {} of {} entries, {} hits, {} misses, {} evictions.",
+        stats.requests,
+        stats.items,
+        stats.cache_entries,
+        stats.cache_capacity,
+        stats.cache_hits,
+        stats.cache_misses,
+        stats.cache_evictions
+    );
+    let _ = writeln!(
+        out,
+        "Times are as seen by the client, batches of up to {} queries per round trip;\n\
+         `in-process` is the same ratio for the gjk library called directly, for reference.",
+        (max_batch / OBSTACLES).max(1) * OBSTACLES
+    );
+    Ok(())
+}
+
+/// Distances along the path: one sparkline per obstacle (`█` high, `▁` near,
+/// `×` touching or overlapping) and a table at every tenth of the path.
+fn print_plot(out: &mut impl Write, d: &[[f64; OBSTACLES]]) {
+    const BARS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+    let max = d.iter().flatten().fold(0.0f64, |m, &x| m.max(x)).max(1e-12);
+    let steps = d.len().saturating_sub(1).max(1);
+    let _ = writeln!(
+        out,
+        "Distance to each obstacle along the path, s = 0 → 1 ({} steps; full bar = {max:.2}):",
+        steps
+    );
+    for i in 0..OBSTACLES {
+        let line: String = d
+            .iter()
+            .step_by(2)
+            .map(|row| {
+                let x = row[i];
+                if x <= 0.0 {
+                    '×'
+                } else {
+                    BARS[((x / max) * (BARS.len() - 1) as f64).round() as usize]
+                }
+            })
+            .collect();
+        let _ = writeln!(out, "  d{} {line}", i + 1);
+    }
+    let _ = writeln!(out);
+    let _ = write!(out, "{:>6}", "s");
+    for i in 0..OBSTACLES {
+        let _ = write!(out, " {:>8}", format!("d{}", i + 1));
+    }
+    let _ = writeln!(out);
+    for k in 0..=10 {
+        let t = k * steps / 10;
+        let _ = write!(out, "{:>6.2}", t as f64 / steps as f64);
+        for x in d[t.min(d.len() - 1)] {
+            let _ = write!(out, " {x:>8.4}");
+        }
+        let _ = writeln!(out);
+    }
+    let _ = writeln!(out);
+}

@@ -1,0 +1,37 @@
+//! # gjkd
+//!
+//! The gjkd distance server as a library: the object store and its request
+//! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
+//! ([`scene`]), the iceoryx2 serving loop ([`server`]) and the built-in demo
+//! ([`demo`]). The `gjkd` binary is a thin command line over these.
+//!
+//! The handlers are pure functions of the [`State`](state::State) and the
+//! request's bytes, so they can be tested and fuzzed without any IPC:
+//!
+//! ```
+//! use gjkd::state::{Limits, State};
+//! use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Item, ItemResult, ObjectId, QueryOptions,
+//!     Vertex, WaitMode, shape_kind};
+//!
+//! let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+//! let mut reg = AdminRequest::new(AdminOp::Register);
+//! reg.shape = shape_kind::CONVEX;
+//! reg.piece_count = 1;
+//! reg.pieces[0].vertex_count = 1;
+//! reg.pieces[0].radius = 0.5;
+//! let ball = state.handle_admin(1, &reg, &[Vertex::default()]).id;
+//! let other = state.handle_admin(1, &reg, &[Vertex { x: 3.0, y: 0.0, z: 0.0 }]).id;
+//!
+//! let items = [Item::distance(ObjectId::from_raw(ball), ObjectId::from_raw(other), &QueryOptions::default())];
+//! let mut results = [ItemResult::default()];
+//! state.handle(42, &items, &mut results);
+//! assert_eq!(results[0].answer().unwrap().distance, 2.0);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod cache;
+pub mod demo;
+pub mod scene;
+pub mod server;
+pub mod state;

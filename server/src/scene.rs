@@ -1,0 +1,400 @@
+//! Scene files: named objects in TOML, loaded by `gjkd serve --scene FILE`
+//! and looked up by clients by name.
+//!
+//! ```toml
+//! [[object]]
+//! name = "ball"
+//! type = "sphere"
+//! radius = 0.5
+//! pose = { translation = [0.0, 0.0, 1.0] }
+//!
+//! [[object]]
+//! name = "pill"
+//! type = "capsule"
+//! a = [0.0, 0.0, -1.0]
+//! b = [0.0, 0.0, 1.0]
+//! radius = 0.2
+//!
+//! [[object]]
+//! name = "crate"
+//! type = "box"
+//! half_extents = [1.0, 2.0, 0.5]
+//! radius = 0.05            # rounding, optional (default 0)
+//! pose = { translation = [4.0, 0.0, 0.0], axis_angle = [0.0, 0.0, 0.7] }
+//!
+//! [[object]]
+//! name = "wedge"
+//! type = "polytope"
+//! vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+//!
+//! [[object]]
+//! name = "dumbbell"
+//! type = "compound"
+//! [[object.pieces]]
+//! type = "sphere"
+//! radius = 0.3
+//! offset = { translation = [-1.0, 0.0, 0.0] }
+//! [[object.pieces]]
+//! type = "sphere"
+//! radius = 0.3
+//! offset = { translation = [1.0, 0.0, 0.0] }
+//! ```
+//!
+//! A pose has an optional `translation` and at most one of `quaternion`
+//! (`[i, j, k, w]`, normalised on load) and `axis_angle` (the rotation axis
+//! scaled by the angle in radians).
+
+use std::path::Path;
+
+use gjk::{Compound, Convex, Shape};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use serde::Deserialize;
+
+use crate::state::{NewObject, Owner, State};
+
+/// What can be wrong with a scene file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("cannot read scene file {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The TOML does not parse or does not match the schema.
+    #[error("invalid scene: {0}")]
+    Parse(#[from] toml::de::Error),
+    /// An object is not a valid shape.
+    #[error("object `{name}`: {reason}")]
+    Object {
+        /// The object's name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A scene: a list of named objects.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The objects, in file order.
+    #[serde(default, rename = "object")]
+    pub objects: Vec<ObjectSpec>,
+}
+
+/// One named object.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub struct ObjectSpec {
+    /// Unique name.
+    pub name: String,
+    /// Initial pose.
+    #[serde(default)]
+    pub pose: PoseSpec,
+    /// The geometry.
+    #[serde(flatten)]
+    pub shape: ShapeSpec,
+}
+
+/// A shape, tagged by `type`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum ShapeSpec {
+    /// A ball.
+    Sphere {
+        /// Radius.
+        radius: f64,
+    },
+    /// A segment grown by a radius.
+    Capsule {
+        /// One end.
+        a: [f64; 3],
+        /// The other end.
+        b: [f64; 3],
+        /// Radius.
+        radius: f64,
+    },
+    /// A box centred on the body origin, optionally with rounded edges.
+    Box {
+        /// Half extents.
+        half_extents: [f64; 3],
+        /// Rounding radius.
+        #[serde(default)]
+        radius: f64,
+    },
+    /// The convex hull of vertices, optionally grown by a radius.
+    Polytope {
+        /// Vertices.
+        vertices: Vec<[f64; 3]>,
+        /// Rounding radius.
+        #[serde(default)]
+        radius: f64,
+    },
+    /// A union of convex pieces.
+    Compound {
+        /// The pieces.
+        pieces: Vec<PieceSpec>,
+    },
+}
+
+/// A convex piece of a compound.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub struct PieceSpec {
+    /// Offset in the compound's body frame.
+    #[serde(default)]
+    pub offset: PoseSpec,
+    /// The piece's geometry (not itself a compound).
+    #[serde(flatten)]
+    pub shape: ShapeSpec,
+}
+
+/// A pose in a scene file.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// Translation (default zero).
+    #[serde(default)]
+    pub translation: [f64; 3],
+    /// Rotation quaternion `[i, j, k, w]`.
+    pub quaternion: Option<[f64; 4]>,
+    /// Rotation axis scaled by the angle, radians.
+    pub axis_angle: Option<[f64; 3]>,
+}
+
+impl PoseSpec {
+    /// The isometry.
+    ///
+    /// # Errors
+    /// A message for both rotations given, a non-finite component or a zero
+    /// quaternion.
+    pub fn to_isometry(&self) -> Result<Isometry3<f64>, String> {
+        let [x, y, z] = self.translation;
+        let rotation = match (self.quaternion, self.axis_angle) {
+            (Some(_), Some(_)) => return Err("give quaternion or axis_angle, not both".into()),
+            (Some([i, j, k, w]), None) => {
+                let q = Quaternion::new(w, i, j, k);
+                if !q.coords.iter().all(|c| c.is_finite()) || q.norm() < 1e-12 {
+                    return Err("quaternion must be finite and non-zero".into());
+                }
+                UnitQuaternion::from_quaternion(q)
+            }
+            (None, Some(v)) => UnitQuaternion::new(Vector3::from(v)),
+            (None, None) => UnitQuaternion::identity(),
+        };
+        let iso = Isometry3::from_parts(Translation3::new(x, y, z), rotation);
+        let finite = iso.translation.vector.iter().all(|c| c.is_finite())
+            && iso.rotation.coords.iter().all(|c| c.is_finite());
+        if !finite {
+            return Err("pose is not finite".into());
+        }
+        Ok(iso)
+    }
+}
+
+impl ShapeSpec {
+    fn convex(&self) -> Result<Convex, String> {
+        let p = |v: [f64; 3]| Point3::from(v);
+        let made = match self {
+            ShapeSpec::Sphere { radius } => Convex::sphere(*radius),
+            ShapeSpec::Capsule { a, b, radius } => Convex::capsule(p(*a), p(*b), *radius),
+            ShapeSpec::Box {
+                half_extents,
+                radius,
+            } => Convex::cuboid(Vector3::from(*half_extents), *radius),
+            ShapeSpec::Polytope { vertices, radius } => {
+                Convex::new(vertices.iter().map(|&v| p(v)).collect::<Vec<_>>(), *radius)
+            }
+            ShapeSpec::Compound { .. } => return Err("a compound cannot be a piece".into()),
+        };
+        made.map_err(|e| e.to_string())
+    }
+
+    /// The gjk shape.
+    ///
+    /// # Errors
+    /// A message saying what is wrong.
+    pub fn build(&self) -> Result<Shape, String> {
+        match self {
+            ShapeSpec::Compound { pieces } => {
+                let mut built = Vec::with_capacity(pieces.len());
+                for (i, piece) in pieces.iter().enumerate() {
+                    let offset = piece
+                        .offset
+                        .to_isometry()
+                        .map_err(|e| format!("piece {i}: {e}"))?;
+                    let convex = piece
+                        .shape
+                        .convex()
+                        .map_err(|e| format!("piece {i}: {e}"))?;
+                    built.push((offset, convex));
+                }
+                Ok(Compound::new(built).map_err(|e| e.to_string())?.into())
+            }
+            _ => Ok(self.convex()?.into()),
+        }
+    }
+}
+
+impl Scene {
+    /// Parses a scene from TOML text.
+    ///
+    /// # Errors
+    /// [`SceneError::Parse`].
+    pub fn from_toml(text: &str) -> Result<Self, SceneError> {
+        Ok(toml::from_str(text)?)
+    }
+
+    /// Reads and parses a scene file.
+    ///
+    /// # Errors
+    /// [`SceneError::Io`], [`SceneError::Parse`].
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_toml(&text)
+    }
+
+    /// Adds every object to `state` as a read-only scene object, in file
+    /// order, returning their ids.
+    ///
+    /// # Errors
+    /// [`SceneError::Object`] for an invalid shape or pose, a duplicate name or
+    /// too many objects; objects before it stay added.
+    pub fn install(&self, state: &mut State) -> Result<Vec<u64>, SceneError> {
+        let mut ids = Vec::with_capacity(self.objects.len());
+        for spec in &self.objects {
+            let fail = |reason: String| SceneError::Object {
+                name: spec.name.clone(),
+                reason,
+            };
+            if spec.name.is_empty() || spec.name.len() > gjkd_proto::MAX_NAME_LEN {
+                return Err(fail(format!(
+                    "names must be 1 to {} bytes long",
+                    gjkd_proto::MAX_NAME_LEN
+                )));
+            }
+            let shape = spec.shape.build().map_err(fail)?;
+            let pose = spec.pose.to_isometry().map_err(fail)?;
+            let new = NewObject {
+                shape,
+                pose,
+                name: Some(spec.name.clone()),
+            };
+            let id = state
+                .insert(new, Owner::Scene)
+                .map_err(|e| fail(e.to_string()))?;
+            ids.push(id);
+        }
+        Ok(ids)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::Limits;
+    use gjkd_proto::WaitMode;
+
+    const EXAMPLE: &str = r#"
+[[object]]
+name = "ball"
+type = "sphere"
+radius = 0.5
+pose = { translation = [0, 0, 1] }
+
+[[object]]
+name = "pill"
+type = "capsule"
+a = [0.0, 0.0, -1.0]
+b = [0.0, 0.0, 1.0]
+radius = 0.2
+
+[[object]]
+name = "crate"
+type = "box"
+half_extents = [1.0, 2.0, 0.5]
+radius = 0.05
+pose = { translation = [4.0, 0.0, 0.0], axis_angle = [0.0, 0.0, 0.7] }
+
+[[object]]
+name = "wedge"
+type = "polytope"
+vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+
+[[object]]
+name = "dumbbell"
+type = "compound"
+[[object.pieces]]
+type = "sphere"
+radius = 0.3
+offset = { translation = [-1.0, 0.0, 0.0] }
+[[object.pieces]]
+type = "box"
+half_extents = [0.2, 0.2, 0.2]
+offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
+"#;
+
+    #[test]
+    fn the_documented_example_loads() {
+        let scene = Scene::from_toml(EXAMPLE).expect("parses");
+        assert_eq!(scene.objects.len(), 5);
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        assert_eq!(state.lookup("crate"), Some(ids[2]));
+        let ball = state.object(ids[0]).expect("there");
+        assert_eq!(ball.pose.translation.vector.z, 1.0);
+        match &state.object(ids[4]).expect("there").shape {
+            Shape::Compound(c) => {
+                assert_eq!(c.pieces().len(), 2);
+                assert!((c.pieces()[1].0.rotation.norm() - 1.0).abs() < 1e-15);
+            }
+            other => panic!("not a compound: {other:?}"),
+        }
+        let crate_pose = state.object(ids[2]).expect("there").pose;
+        assert!((crate_pose.rotation.angle() - 0.7).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_module_doc_example_loads() {
+        let doc: String = include_str!("scene.rs")
+            .lines()
+            .skip_while(|l| !l.starts_with("//! ```toml"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("//! ```"))
+            .map(|l| format!("{}\n", l.trim_start_matches("//!").trim_start()))
+            .collect();
+        let scene = Scene::from_toml(&doc).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        assert_eq!(scene.install(&mut state).expect("valid").len(), 5);
+    }
+
+    #[test]
+    fn bad_scenes_are_reported() {
+        let dup = "[[object]]\nname='a'\ntype='sphere'\nradius=1\n[[object]]\nname='a'\ntype='sphere'\nradius=1\n";
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let err = Scene::from_toml(dup)
+            .expect("parses")
+            .install(&mut state)
+            .expect_err("duplicate");
+        assert!(err.to_string().contains("name"), "{err}");
+        assert!(Scene::from_toml("[[object]]\nname='a'\ntype='cone'\n").is_err());
+        let neg = "[[object]]\nname='n'\ntype='sphere'\nradius=-1\n";
+        assert!(
+            Scene::from_toml(neg)
+                .expect("parses")
+                .install(&mut state)
+                .is_err()
+        );
+        let both = "[[object]]\nname='q'\ntype='sphere'\nradius=1\npose={quaternion=[0,0,0,1], axis_angle=[0,0,1]}\n";
+        assert!(
+            Scene::from_toml(both)
+                .expect("parses")
+                .install(&mut state)
+                .is_err()
+        );
+    }
+}

@@ -1,0 +1,409 @@
+//! The iceoryx2 side of the server: services, ports, the wait loop.
+//!
+//! One thread answers everything. iceoryx2's `ipc::Service` ports are not
+//! `Send`, and one thread that owns the whole [`State`] needs no locks: a query
+//! is a few microseconds, far below what a lock hand-off would cost.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use gjkd_proto::{
+    AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, Vertex, WaitMode,
+    admin_service_name, query_service_name, wake_service_name,
+};
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::server::Server as IoxServer;
+use iceoryx2::prelude::*;
+use tracing::{debug, error, info, warn};
+
+use crate::state::State;
+
+type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
+type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+
+/// Why the server could not start or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum ServerError {
+    /// The service name is not a valid iceoryx2 service name.
+    #[error("invalid service name `{0}`")]
+    InvalidName(String),
+    /// iceoryx2 refused to create or open something.
+    #[error("iceoryx2: {0}")]
+    Ipc(String),
+    /// Another server already serves this service.
+    #[error("another gjkd server already serves `{0}`")]
+    AlreadyRunning(String),
+}
+
+fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError {
+    move |e| ServerError::Ipc(format!("{what}: {e:?}"))
+}
+
+/// How long `adaptive` keeps spinning after the last request before it
+/// sleeps. Long enough to cover a client's think time between queries of one
+/// control cycle, short enough that an idle server costs no CPU.
+pub const ADAPTIVE_SPIN: Duration = Duration::from_micros(50);
+
+/// Longest sleep in `block` mode: the loop wakes this often to look at the
+/// shutdown flag (signal handlers cannot wake an iceoryx2 wait) and do
+/// housekeeping.
+const BLOCK_SLICE: Duration = Duration::from_millis(50);
+
+/// Dead clients are looked for at most this often, and only when the server
+/// has been idle for [`IDLE_BEFORE_HOUSEKEEPING`]: cleaning up takes
+/// milliseconds that must not land in the middle of a burst of queries.
+const HOUSEKEEPING_PERIOD: Duration = Duration::from_secs(2);
+const IDLE_BEFORE_HOUSEKEEPING: Duration = Duration::from_millis(20);
+
+/// In spin mode, the admin service is polled once per this many idle loop
+/// turns: each poll scans every connected client, and registrations are rare.
+const ADMIN_POLL_EVERY: u32 = 64;
+
+/// Most requests a client may have in flight on one service.
+const ACTIVE_REQUESTS_PER_CLIENT: usize = 2;
+
+/// Response chunks the query server preallocates for `clients` clients.
+pub fn response_chunks(clients: usize) -> usize {
+    clients
+        .saturating_mul(ACTIVE_REQUESTS_PER_CLIENT)
+        .saturating_mul(2)
+        .saturating_add(16)
+}
+
+/// Everything needed to start a server.
+#[derive(Clone, Debug)]
+pub struct ServeOptions {
+    /// Deployment name; the services are `{service}/v1/...`.
+    pub service: String,
+    /// Wait strategy.
+    pub wait: WaitMode,
+}
+
+/// Runs a server until `shutdown` becomes true, then removes its services and
+/// returns. `state` comes filled (scene objects) and its limits size the
+/// services.
+///
+/// # Errors
+/// [`ServerError`] when the services or ports cannot be set up; once running,
+/// errors of single requests are logged and the loop goes on.
+pub fn run(
+    options: &ServeOptions,
+    mut state: State,
+    shutdown: &AtomicBool,
+    ready: impl FnOnce(),
+) -> Result<(), ServerError> {
+    let limits = *state.limits();
+    let name = |s: String| {
+        ServiceName::new(&s).map_err(|_| ServerError::InvalidName(options.service.clone()))
+    };
+    let query_name = name(query_service_name(&options.service))?;
+    let admin_name = name(admin_service_name(&options.service))?;
+    let wake_name = name(wake_service_name(&options.service))?;
+
+    let node = NodeBuilder::new()
+        .name(&NodeName::new("gjkd").map_err(ipc("node name"))?)
+        // Signals are handled by the caller's flag: iceoryx2 only looks at
+        // them inside its own waits, and a spinning server never waits.
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(ipc("node"))?;
+    // A server killed with -9 leaves its port registered; clearing dead nodes
+    // first lets a restarted server take its place.
+    let cleaned = node.try_cleanup_dead_nodes();
+    if cleaned.cleanups > 0 {
+        info!(
+            count = cleaned.cleanups,
+            "cleaned up resources of dead processes"
+        );
+    }
+
+    let clients = limits.max_clients;
+    let query_service = node
+        .service_builder(&query_name)
+        .request_response::<[Item], [ItemResult]>()
+        .response_user_header::<ReplyHeader>()
+        .max_clients(clients)
+        .max_servers(1)
+        .max_nodes(limits.max_nodes)
+        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(2)
+        .max_borrowed_responses_per_pending_response(1)
+        .enable_fire_and_forget_requests(false)
+        .open_or_create()
+        .map_err(ipc("query service"))?;
+    let admin_service = node
+        .service_builder(&admin_name)
+        .request_response::<[Vertex], AdminReply>()
+        .request_user_header::<AdminRequest>()
+        .max_clients(clients)
+        .max_servers(1)
+        .max_nodes(limits.max_nodes)
+        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(2)
+        .max_borrowed_responses_per_pending_response(1)
+        .enable_fire_and_forget_requests(false)
+        .open_or_create()
+        .map_err(ipc("admin service"))?;
+    let wake_service = node
+        .service_builder(&wake_name)
+        .event()
+        .max_notifiers(clients)
+        .max_listeners(2)
+        .max_nodes(limits.max_nodes)
+        .open_or_create()
+        .map_err(ipc("wake service"))?;
+
+    let listener = wake_service
+        .listener_builder()
+        .create()
+        .map_err(ipc("wake listener"))?;
+    let waitset = WaitSetBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(ipc("waitset"))?;
+    let _guard = waitset
+        .attach_notification(&listener)
+        .map_err(ipc("waitset attach"))?;
+
+    let admin: AdminServer = admin_service
+        .server_builder()
+        .create()
+        .map_err(|e| match e {
+            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
+                ServerError::AlreadyRunning(options.service.clone())
+            }
+            e => ServerError::Ipc(format!("admin server: {e:?}")),
+        })?;
+    // The query server port comes last: clients take it as the sign that
+    // the server is ready, and a request sent to a service before its server
+    // port exists is never answered.
+    let query: QueryServer = query_service
+        .server_builder()
+        // A static segment: a growing one makes iceoryx2 size every client's
+        // connection for all the segments it might grow into, which makes
+        // connecting slow (hundreds of ms for 128 clients in a debug build).
+        .initial_max_slice_len(limits.max_batch)
+        .allocation_strategy(AllocationStrategy::Static)
+        // iceoryx2 reserves for streams of responses per request; gjkd sends
+        // exactly one, so each client needs one chunk per active request, and
+        // as many again for replies to requests it gave up on.
+        .override_response_preallocation(move |_| response_chunks(clients))
+        .create()
+        .map_err(|e| match e {
+            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
+                ServerError::AlreadyRunning(options.service.clone())
+            }
+            e => ServerError::Ipc(format!("query server: {e:?}")),
+        })?;
+
+    info!(
+        service = %options.service,
+        wait = ?options.wait,
+        max_clients = limits.max_clients,
+        max_nodes = limits.max_nodes,
+        max_batch = limits.max_batch,
+        max_vertices = limits.max_vertices,
+        cache_capacity = limits.cache_capacity,
+        objects = state.len(),
+        "gjkd serving"
+    );
+    ready();
+
+    let mut last_request = Instant::now();
+    let mut last_housekeeping = Instant::now();
+    let mut turns: u32 = 0;
+    let mut known_clients = 0usize;
+    while !shutdown.load(Ordering::Relaxed) {
+        turns = turns.wrapping_add(1);
+        let mut served = serve_queries(&query, &mut state);
+        // Counted over all turns, busy or not, so that a stream of queries
+        // cannot starve registrations.
+        if options.wait != WaitMode::Spin || turns.is_multiple_of(ADMIN_POLL_EVERY) {
+            served += serve_admin(&admin, &mut state);
+        }
+        let now = Instant::now();
+        if served > 0 {
+            last_request = now;
+            continue;
+        }
+        if now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
+            && now.duration_since(last_housekeeping) > HOUSEKEEPING_PERIOD
+        {
+            last_housekeeping = now;
+            let cleaned = node.try_cleanup_dead_nodes();
+            if cleaned.cleanups > 0 {
+                info!(
+                    count = cleaned.cleanups,
+                    "cleaned up resources of dead clients"
+                );
+            }
+            let clients = query_service.dynamic_config().number_of_clients();
+            if clients < known_clients {
+                forget_departed_clients(&query_service, &mut state);
+            }
+            known_clients = clients;
+        }
+        let sleep = match options.wait {
+            WaitMode::Spin => false,
+            WaitMode::Block => true,
+            WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
+        };
+        if sleep {
+            block(&waitset, &listener, &query, &admin);
+        } else {
+            std::hint::spin_loop();
+        }
+    }
+    info!(service = %options.service, "shutting down");
+    // Ports, services and the node are dropped here, in reverse order of
+    // creation, which removes the services' shared memory.
+    Ok(())
+}
+
+/// Drops the warm starts of query clients that are no longer connected.
+fn forget_departed_clients(
+    query_service: &iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        [Item],
+        (),
+        [ItemResult],
+        ReplyHeader,
+    >,
+    state: &mut State,
+) {
+    let mut alive = std::collections::HashSet::new();
+    query_service.dynamic_config().list_clients(|c| {
+        alive.insert(c.client_id.value());
+        CallbackProgression::Continue
+    });
+    let before = state.stats().cache_entries;
+    state.retain_clients(|c| alive.contains(&c));
+    let dropped = before - state.stats().cache_entries;
+    if dropped > 0 {
+        debug!(dropped, "forgot warm starts of departed clients");
+    }
+}
+
+/// Sleeps until a client notifies or [`BLOCK_SLICE`] passes. The listener is
+/// drained and the servers looked at once more before sleeping, so that a
+/// request that arrived after the last poll but whose notification was
+/// consumed cannot be missed.
+fn block(
+    waitset: &WaitSet<ipc::Service>,
+    listener: &Listener<ipc::Service>,
+    query: &QueryServer,
+    admin: &AdminServer,
+) {
+    let _ = listener.try_wait(|_| {});
+    let pending = query.has_requests().unwrap_or(false) || admin.has_requests().unwrap_or(false);
+    if pending {
+        return;
+    }
+    let on_event = |_id: WaitSetAttachmentId<ipc::Service>| {
+        let _ = listener.try_wait(|_| {});
+        CallbackProgression::Stop
+    };
+    if let Err(e) = waitset.wait_and_process_once_with_timeout(on_event, BLOCK_SLICE) {
+        warn!(error = ?e, "waitset wait failed");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+/// Answers every query request waiting; returns how many.
+fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
+    let mut served = 0;
+    loop {
+        let request = match query.receive() {
+            Ok(Some(r)) => r,
+            Ok(None) => return served,
+            Err(e) => {
+                warn!(error = ?e, "query receive failed");
+                return served;
+            }
+        };
+        served += 1;
+        let items = request.payload();
+        let client = request.origin().value();
+        let header = match state.check_batch(items.len()) {
+            Ok(()) => ReplyHeader {
+                error: ErrorCode::Ok as u32,
+                count: items.len() as u32,
+            },
+            Err(code) => {
+                debug!(len = items.len(), ?code, "batch rejected");
+                let reply = request.loan_slice_uninit(0).map(|r| {
+                    let mut r = r.write_from_fn(|_| ItemResult::default());
+                    *r.user_header_mut() = ReplyHeader {
+                        error: code as u32,
+                        count: 0,
+                    };
+                    r
+                });
+                match reply {
+                    Ok(r) => {
+                        if let Err(e) = r.send() {
+                            debug!(error = ?e, "reply not delivered");
+                        }
+                    }
+                    Err(e) => warn!(error = ?e, "cannot loan reply"),
+                }
+                continue;
+            }
+        };
+        let reply = match request.loan_slice_uninit(items.len()) {
+            Ok(r) => r,
+            Err(e) => {
+                warn!(error = ?e, len = items.len(), "cannot loan reply");
+                continue;
+            }
+        };
+        let mut reply = reply.write_from_fn(|_| ItemResult::default());
+        *reply.user_header_mut() = header;
+        let results = reply.payload_mut();
+        let outcome = catch_unwind(AssertUnwindSafe(|| state.handle(client, items, results)));
+        if outcome.is_err() {
+            // A bug of ours, not the client's: answer, log, keep serving.
+            error!(len = items.len(), "query handler panicked");
+            for r in reply.payload_mut() {
+                *r = ItemResult::error(ErrorCode::Internal);
+            }
+        }
+        if let Err(e) = reply.send() {
+            debug!(error = ?e, "reply not delivered (client gone?)");
+        }
+    }
+}
+
+/// Answers every admin request waiting; returns how many.
+fn serve_admin(admin: &AdminServer, state: &mut State) -> usize {
+    let mut served = 0;
+    loop {
+        let request = match admin.receive() {
+            Ok(Some(r)) => r,
+            Ok(None) => return served,
+            Err(e) => {
+                warn!(error = ?e, "admin receive failed");
+                return served;
+            }
+        };
+        served += 1;
+        let header = request.user_header();
+        let client = request.origin().value();
+        let vertices = request.payload();
+        let reply = catch_unwind(AssertUnwindSafe(|| {
+            state.handle_admin(client, header, vertices)
+        }))
+        .unwrap_or_else(|_| {
+            error!(op = header.op, "admin handler panicked");
+            AdminReply::error(header.op, ErrorCode::Internal)
+        });
+        match reply.error_code() {
+            ErrorCode::Ok => debug!(op = header.op, id = reply.id, "admin ok"),
+            code => info!(op = header.op, ?code, "admin request refused"),
+        }
+        if let Err(e) = request.send_copy(reply) {
+            debug!(error = ?e, "admin reply not delivered (client gone?)");
+        }
+    }
+}

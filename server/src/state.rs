@@ -1,0 +1,805 @@
+//! The server's state and its request handlers: pure functions of the state
+//! and the bytes a client sent, with no iceoryx2 in sight, so that they can be
+//! tested and fuzzed in-process.
+//!
+//! Nothing here trusts the request: every field is checked, every failure is
+//! an [`ErrorCode`] in the result, and nothing panics on any input.
+
+use std::collections::HashMap;
+
+use gjk::{Compound, Convex, Shape};
+use gjkd_proto::{
+    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemKind, ItemResult, MAX_PIECES, Pose,
+    ServerInfo, ServerStats, Vertex, WaitMode, item_flags, result_flags, shape_kind,
+};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
+
+use crate::cache::{FxBuild, PairKey, WarmCache};
+
+/// Limits the server enforces, also used to size the iceoryx2 services.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Most clients at once: iceoryx2 client ports per service, and each
+    /// `gjkd-client` `Client` has one on the query and one on the admin
+    /// service.
+    pub max_clients: usize,
+    /// Most iceoryx2 nodes (processes or `Client`s) attached to a service.
+    pub max_nodes: usize,
+    /// Most items in one query request.
+    pub max_batch: usize,
+    /// Most vertices in one registration (all pieces together).
+    pub max_vertices: usize,
+    /// Most pieces in a compound, at most [`MAX_PIECES`].
+    pub max_pieces: usize,
+    /// Most objects held at once.
+    pub max_objects: usize,
+    /// Most warm-start cache entries.
+    pub cache_capacity: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_clients: 128,
+            max_nodes: 256,
+            max_batch: 1024,
+            max_vertices: 100_000,
+            max_pieces: MAX_PIECES,
+            max_objects: 1 << 20,
+            cache_capacity: 1 << 16,
+        }
+    }
+}
+
+/// Who may change an object.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Owner {
+    /// Loaded from the scene file at start: read-only.
+    Scene,
+    /// Registered by the admin client port with this id.
+    Client(u128),
+}
+
+/// A registered object.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// The geometry.
+    pub shape: Shape,
+    /// The stored pose, used by queries that do not give their own.
+    pub pose: Isometry3<f64>,
+    /// Who registered it.
+    pub owner: Owner,
+    /// Name for look-ups, if any.
+    pub name: Option<String>,
+}
+
+/// Everything the server holds.
+#[derive(Debug)]
+pub struct State {
+    limits: Limits,
+    wait: WaitMode,
+    pid: u64,
+    /// Upper 32 bits of every id of this run, so ids of an earlier run are
+    /// unknown rather than aliases.
+    epoch: u64,
+    next_index: u32,
+    objects: HashMap<u64, Object, FxBuild>,
+    names: HashMap<String, u64>,
+    cache: WarmCache,
+    stats: ServerStats,
+}
+
+/// The shape part of a registration, in the server's terms.
+#[derive(Clone, Debug)]
+pub struct NewObject {
+    /// The geometry.
+    pub shape: Shape,
+    /// Initial pose.
+    pub pose: Isometry3<f64>,
+    /// Optional unique name.
+    pub name: Option<String>,
+}
+
+impl State {
+    /// An empty store. `epoch` goes into the upper 32 bits of every id (0 is
+    /// replaced by 1, so that no id is 0).
+    pub fn new(limits: Limits, wait: WaitMode, epoch: u32) -> Self {
+        State {
+            limits,
+            wait,
+            pid: u64::from(std::process::id()),
+            epoch: u64::from(epoch.max(1)) << 32,
+            next_index: 1,
+            objects: HashMap::default(),
+            names: HashMap::new(),
+            cache: WarmCache::new(limits.cache_capacity),
+            stats: ServerStats::default(),
+        }
+    }
+
+    /// The limits in force.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The object with this id.
+    pub fn object(&self, id: u64) -> Option<&Object> {
+        self.objects.get(&id)
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether no object is registered.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+
+    /// Current statistics.
+    pub fn stats(&self) -> ServerStats {
+        let c = self.cache.stats();
+        ServerStats {
+            objects: self.objects.len() as u64,
+            cache_entries: self.cache.len() as u64,
+            cache_capacity: self.cache.capacity() as u64,
+            cache_hits: c.hits,
+            cache_misses: c.misses,
+            cache_evictions: c.evictions,
+            ..self.stats
+        }
+    }
+
+    /// What the server tells clients at hello.
+    pub fn info(&self) -> ServerInfo {
+        let clamp = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        ServerInfo {
+            protocol: gjkd_proto::PROTOCOL_VERSION,
+            wait: self.wait as u32,
+            max_batch: clamp(self.limits.max_batch),
+            max_vertices: clamp(self.limits.max_vertices),
+            max_pieces: clamp(self.limits.max_pieces.min(MAX_PIECES)),
+            max_clients: clamp(self.limits.max_clients),
+            max_objects: self.limits.max_objects as u64,
+            pid: self.pid,
+        }
+    }
+
+    /// Adds an object, returning its id.
+    ///
+    /// # Errors
+    /// [`ErrorCode::NameTaken`], [`ErrorCode::TooManyObjects`].
+    pub fn insert(&mut self, new: NewObject, owner: Owner) -> Result<u64, ErrorCode> {
+        if self.objects.len() >= self.limits.max_objects || self.next_index == u32::MAX {
+            return Err(ErrorCode::TooManyObjects);
+        }
+        if let Some(name) = &new.name
+            && self.names.contains_key(name)
+        {
+            return Err(ErrorCode::NameTaken);
+        }
+        let id = self.epoch | u64::from(self.next_index);
+        self.next_index += 1;
+        if let Some(name) = &new.name {
+            self.names.insert(name.clone(), id);
+        }
+        self.objects.insert(
+            id,
+            Object {
+                shape: new.shape,
+                pose: new.pose,
+                owner,
+                name: new.name,
+            },
+        );
+        Ok(id)
+    }
+
+    /// Removes object `id` on behalf of `requester`.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
+    /// objects, [`ErrorCode::NotOwner`] for another client's object.
+    pub fn remove(&mut self, id: u64, requester: u128) -> Result<(), ErrorCode> {
+        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
+        match object.owner {
+            Owner::Scene => return Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
+            Owner::Client(_) => {}
+        }
+        if let Some(object) = self.objects.remove(&id)
+            && let Some(name) = object.name
+        {
+            self.names.remove(&name);
+        }
+        self.cache.forget_object(id);
+        Ok(())
+    }
+
+    /// The id of the object named `name`.
+    pub fn lookup(&self, name: &str) -> Option<u64> {
+        self.names.get(name).copied()
+    }
+
+    /// Forgets the warm starts of a client that has gone away.
+    pub fn forget_client(&mut self, client: u128) {
+        self.cache.forget_client(client);
+    }
+
+    /// Forgets the warm starts of every client for which `alive` is false
+    /// (clients that disconnected or died), so their entries do not wait for
+    /// eviction.
+    pub fn retain_clients(&mut self, alive: impl Fn(u128) -> bool) {
+        self.cache.retain(|k| alive(k.client));
+    }
+
+    /// Answers one query request from `client` (its iceoryx2 client port id,
+    /// which keys its warm-start cache): `results[i]` answers `items[i]`,
+    /// items applied in order. `results` must be as long as `items`; extra
+    /// results are left alone and a short buffer answers only what fits.
+    pub fn handle(&mut self, client: u128, items: &[Item], results: &mut [ItemResult]) {
+        self.stats.requests += 1;
+        for (item, out) in items.iter().zip(results.iter_mut()) {
+            *out = self.item(client, item);
+            self.stats.items += 1;
+            if out.error != 0 {
+                self.stats.item_errors += 1;
+            }
+        }
+    }
+
+    /// Whole-request checks of a query batch of `len` items.
+    pub fn check_batch(&self, len: usize) -> Result<(), ErrorCode> {
+        if len == 0 {
+            Err(ErrorCode::EmptyBatch)
+        } else if len > self.limits.max_batch {
+            Err(ErrorCode::BatchTooLarge)
+        } else {
+            Ok(())
+        }
+    }
+
+    fn item(&mut self, client: u128, item: &Item) -> ItemResult {
+        match ItemKind::from_raw(item.kind) {
+            Some(ItemKind::SetPose) => match self.set_pose(item) {
+                Ok(()) => ItemResult::default(),
+                Err(e) => ItemResult::error(e),
+            },
+            Some(ItemKind::Distance) => self
+                .distance(client, item)
+                .unwrap_or_else(ItemResult::error),
+            None => ItemResult::error(ErrorCode::Malformed),
+        }
+    }
+
+    fn set_pose(&mut self, item: &Item) -> Result<(), ErrorCode> {
+        let object = self
+            .objects
+            .get_mut(&item.a)
+            .ok_or(ErrorCode::UnknownObject)?;
+        object.pose = check_pose(&item.pose_a)?;
+        Ok(())
+    }
+
+    fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
+        if item.flags & !item_flags::ALL != 0 {
+            return Err(ErrorCode::Malformed);
+        }
+        let warm_on = item.flags & item_flags::WARM_START != 0;
+        let options = gjk::Options {
+            tolerance: item.tolerance,
+            max_iterations: item.max_iterations,
+            margin: (item.flags & item_flags::MARGIN != 0).then_some(item.margin),
+            warm_start: warm_on,
+        };
+        if !(options.tolerance.is_finite() && options.tolerance >= 0.0)
+            || options.max_iterations == 0
+            || options.margin.is_some_and(|m| !m.is_finite())
+        {
+            return Err(ErrorCode::InvalidOptions);
+        }
+        let a = self.objects.get(&item.a).ok_or(ErrorCode::UnknownObject)?;
+        let b = self.objects.get(&item.b).ok_or(ErrorCode::UnknownObject)?;
+        let pose_a = if item.flags & item_flags::POSE_A != 0 {
+            check_pose(&item.pose_a)?
+        } else {
+            a.pose
+        };
+        let pose_b = if item.flags & item_flags::POSE_B != 0 {
+            check_pose(&item.pose_b)?
+        } else {
+            b.pose
+        };
+        let key = PairKey {
+            client,
+            a: item.a,
+            b: item.b,
+        };
+        let warm = if warm_on { self.cache.get(&key) } else { None };
+        let answer = match gjk::distance(
+            &a.shape,
+            &pose_a,
+            &b.shape,
+            &pose_b,
+            &options,
+            warm.as_ref(),
+        ) {
+            Ok(answer) => answer,
+            // The cache is keyed by ids that are never reused, so this cannot
+            // happen; if it does, the cold answer is still right.
+            Err(gjk::Error::WarmStartOutOfRange) => {
+                gjk::distance(&a.shape, &pose_a, &b.shape, &pose_b, &options, None)
+                    .map_err(map_gjk_error)?
+            }
+            Err(e) => return Err(map_gjk_error(e)),
+        };
+        if warm_on {
+            self.cache.put(key, answer.warm_start);
+        }
+        let mut flags = 0;
+        if warm.is_some() {
+            flags |= result_flags::WARM_STARTED;
+        }
+        if answer.backup_used {
+            flags |= result_flags::BACKUP_USED;
+        }
+        Ok(ItemResult {
+            distance: answer.distance,
+            lower: answer.lower,
+            upper: answer.upper,
+            penetration: answer.penetration,
+            point_a: answer.point_a.coords.into(),
+            point_b: answer.point_b.coords.into(),
+            normal: answer.normal.into(),
+            error: ErrorCode::Ok as u32,
+            status: status_code(answer.status),
+            iterations: answer.iterations,
+            flags,
+            pieces: answer.pieces,
+        })
+    }
+
+    /// Answers one admin request from admin client port `requester`, with the
+    /// request's slice payload `vertices`.
+    pub fn handle_admin(
+        &mut self,
+        requester: u128,
+        request: &AdminRequest,
+        vertices: &[Vertex],
+    ) -> AdminReply {
+        let op = request.op;
+        let mut reply = AdminReply {
+            op,
+            ..AdminReply::default()
+        };
+        let outcome = match AdminOp::from_raw(op) {
+            Some(AdminOp::Hello) => {
+                reply.info = self.info();
+                Ok(0)
+            }
+            Some(AdminOp::Stats) => {
+                reply.stats = self.stats();
+                Ok(0)
+            }
+            Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
+                .and_then(|new| self.insert(new, Owner::Client(requester))),
+            Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
+            Some(AdminOp::Lookup) => match request.name() {
+                Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
+                None => Err(ErrorCode::Malformed),
+            },
+            None => Err(ErrorCode::Malformed),
+        };
+        match outcome {
+            Ok(id) => reply.id = id,
+            Err(e) => reply.error = e as u32,
+        }
+        reply
+    }
+}
+
+/// The wire value of a gjk status.
+pub fn status_code(s: gjk::Status) -> u32 {
+    use gjkd_proto::Status as W;
+    match s {
+        gjk::Status::Converged => W::Converged as u32,
+        gjk::Status::Farther => W::Farther as u32,
+        gjk::Status::Closer => W::Closer as u32,
+        gjk::Status::IterationCap => W::IterationCap as u32,
+        gjk::Status::ToleranceNotMet => W::ToleranceNotMet as u32,
+    }
+}
+
+/// The wire code of a gjk error.
+pub fn map_gjk_error(e: gjk::Error) -> ErrorCode {
+    match e {
+        gjk::Error::EmptyVertices => ErrorCode::EmptyVertices,
+        gjk::Error::TooManyVertices(_) => ErrorCode::TooManyVertices,
+        gjk::Error::NonFiniteVertex(_) => ErrorCode::NonFiniteVertex,
+        gjk::Error::InvalidRadius(_) => ErrorCode::InvalidRadius,
+        gjk::Error::EmptyCompound => ErrorCode::EmptyCompound,
+        gjk::Error::NonFinitePose => ErrorCode::NonFinitePose,
+        gjk::Error::InvalidOption(_) => ErrorCode::InvalidOptions,
+        gjk::Error::WarmStartOutOfRange => ErrorCode::Internal,
+    }
+}
+
+/// Quaternions whose squared norm is this close to 1 are taken as they are:
+/// that is what nalgebra's own normalisation yields, and re-normalising them
+/// would change the last bits of every answer relative to an in-process call.
+const UNIT_ROUNDING: f64 = 8.0 * f64::EPSILON;
+
+/// How far off unit length a quaternion may be and still be accepted (after
+/// normalising).
+pub const UNIT_TOLERANCE: f64 = 1e-6;
+
+/// The isometry of a wire pose: finite, and a rotation quaternion within
+/// [`UNIT_TOLERANCE`] of unit length (normalised unless it already is, to
+/// round-off).
+///
+/// # Errors
+/// [`ErrorCode::NonFinitePose`], [`ErrorCode::BadQuaternion`].
+pub fn check_pose(p: &Pose) -> Result<Isometry3<f64>, ErrorCode> {
+    if !p
+        .translation
+        .iter()
+        .chain(&p.rotation)
+        .all(|c| c.is_finite())
+    {
+        return Err(ErrorCode::NonFinitePose);
+    }
+    let [i, j, k, w] = p.rotation;
+    let q = Quaternion::new(w, i, j, k);
+    let n2 = q.norm_squared();
+    let rotation = if (n2 - 1.0).abs() <= UNIT_ROUNDING {
+        UnitQuaternion::new_unchecked(q)
+    } else if (n2.sqrt() - 1.0).abs() <= UNIT_TOLERANCE {
+        UnitQuaternion::new_normalize(q)
+    } else {
+        return Err(ErrorCode::BadQuaternion);
+    };
+    let [x, y, z] = p.translation;
+    Ok(Isometry3::from_parts(Translation3::new(x, y, z), rotation))
+}
+
+/// Checks a registration and builds its shape.
+///
+/// # Errors
+/// The specific [`ErrorCode`] of the first problem found.
+pub fn decode_registration(
+    limits: &Limits,
+    request: &AdminRequest,
+    vertices: &[Vertex],
+) -> Result<NewObject, ErrorCode> {
+    if vertices.len() > limits.max_vertices {
+        return Err(ErrorCode::TooManyVertices);
+    }
+    let name = match request.name_len {
+        0 => None,
+        _ => Some(request.name().ok_or(ErrorCode::Malformed)?.to_owned()),
+    };
+    let pose = check_pose(&request.pose)?;
+    let count = request.piece_count as usize;
+    let shape = match request.shape {
+        shape_kind::CONVEX => {
+            if count != 1 {
+                return Err(ErrorCode::Malformed);
+            }
+            let piece = &request.pieces[0];
+            if piece.vertex_count as usize != vertices.len() {
+                return Err(if vertices.is_empty() {
+                    ErrorCode::EmptyVertices
+                } else {
+                    ErrorCode::Malformed
+                });
+            }
+            Shape::Convex(convex(vertices, piece.radius)?)
+        }
+        shape_kind::COMPOUND => {
+            if count == 0 {
+                return Err(ErrorCode::EmptyCompound);
+            }
+            if count > MAX_PIECES || count > limits.max_pieces {
+                return Err(ErrorCode::TooManyPieces);
+            }
+            let table = &request.pieces[..count];
+            let total: u64 = table.iter().map(|p| u64::from(p.vertex_count)).sum();
+            if total != vertices.len() as u64 {
+                return Err(ErrorCode::Malformed);
+            }
+            let mut pieces = Vec::with_capacity(count);
+            let mut start = 0usize;
+            for p in table {
+                let end = start + p.vertex_count as usize;
+                let offset = check_pose(&p.offset)?;
+                pieces.push((offset, convex(&vertices[start..end], p.radius)?));
+                start = end;
+            }
+            Shape::Compound(Compound::new(pieces).map_err(map_gjk_error)?)
+        }
+        _ => return Err(ErrorCode::Malformed),
+    };
+    Ok(NewObject { shape, pose, name })
+}
+
+fn convex(vertices: &[Vertex], radius: f64) -> Result<Convex, ErrorCode> {
+    if vertices.is_empty() {
+        return Err(ErrorCode::EmptyVertices);
+    }
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(ErrorCode::InvalidRadius);
+    }
+    let points: Vec<Point3<f64>> = vertices.iter().map(|&v| v.into()).collect();
+    Convex::new(points, radius).map_err(map_gjk_error)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gjkd_proto::{ObjectId, PieceDesc, QueryOptions};
+    use nalgebra::Vector3;
+
+    fn state() -> State {
+        State::new(Limits::default(), WaitMode::Spin, 3)
+    }
+
+    fn register_box(s: &mut State, owner: u128) -> u64 {
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 8;
+        let verts: Vec<Vertex> = Convex::cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)
+            .expect("box")
+            .vertices()
+            .iter()
+            .map(|&p| p.into())
+            .collect();
+        let reply = s.handle_admin(owner, &req, &verts);
+        assert_eq!(reply.error_code(), ErrorCode::Ok);
+        reply.id
+    }
+
+    fn one(s: &mut State, client: u128, item: Item) -> ItemResult {
+        let mut out = [ItemResult::error(ErrorCode::Internal)];
+        s.handle(client, &[item], &mut out);
+        out[0]
+    }
+
+    #[test]
+    fn answers_match_gjk_bit_for_bit() {
+        let mut s = state();
+        let a = register_box(&mut s, 1);
+        let b = register_box(&mut s, 1);
+        let pb = Isometry3::new(Vector3::new(3.0, 0.5, 0.2), Vector3::new(0.1, 0.2, 0.3));
+        let (a, b) = (ObjectId::from_raw(a), ObjectId::from_raw(b));
+        let r = one(&mut s, 9, Item::set_pose(b, &pb));
+        assert_eq!(r.error_code(), ErrorCode::Ok);
+        let r = one(&mut s, 9, Item::distance(a, b, &QueryOptions::cold()));
+        let shape: Shape = Convex::cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)
+            .expect("box")
+            .into();
+        let opts = gjk::Options {
+            warm_start: false,
+            ..Default::default()
+        };
+        let want =
+            gjk::distance(&shape, &Isometry3::identity(), &shape, &pb, &opts, None).expect("valid");
+        let got = r.answer().expect("ok");
+        assert_eq!(got.distance.to_bits(), want.distance.to_bits());
+        assert_eq!(got.point_a, want.point_a);
+        assert_eq!(got.normal, want.normal);
+        assert_eq!(got.iterations, want.iterations);
+    }
+
+    #[test]
+    fn warm_start_is_per_client_and_counted() {
+        let mut s = state();
+        let a = ObjectId::from_raw(register_box(&mut s, 1));
+        let b = ObjectId::from_raw(register_box(&mut s, 1));
+        let pa = Isometry3::translation(-2.0, 0.0, 0.0);
+        let item = Item::distance(a, b, &QueryOptions::default()).with_pose_a(&pa);
+        assert!(!one(&mut s, 1, item).answer().expect("ok").warm_started);
+        assert!(one(&mut s, 1, item).answer().expect("ok").warm_started);
+        assert!(!one(&mut s, 2, item).answer().expect("ok").warm_started);
+        let st = s.stats();
+        assert_eq!(
+            (st.cache_hits, st.cache_misses, st.cache_entries),
+            (1, 2, 2)
+        );
+    }
+
+    #[test]
+    fn departed_clients_lose_their_warm_starts() {
+        let mut s = state();
+        let a = ObjectId::from_raw(register_box(&mut s, 1));
+        let b = ObjectId::from_raw(register_box(&mut s, 1));
+        let item = Item::distance(a, b, &QueryOptions::default())
+            .with_pose_b(&Isometry3::translation(3.0, 0.0, 0.0));
+        for client in [10, 11, 12] {
+            one(&mut s, client, item);
+        }
+        assert_eq!(s.stats().cache_entries, 3);
+        s.retain_clients(|c| c == 11);
+        assert_eq!(s.stats().cache_entries, 1);
+        assert!(one(&mut s, 11, item).answer().expect("ok").warm_started);
+        assert!(!one(&mut s, 10, item).answer().expect("ok").warm_started);
+    }
+
+    #[test]
+    fn bad_items_get_their_codes() {
+        let mut s = state();
+        let a = ObjectId::from_raw(register_box(&mut s, 1));
+        let ghost = ObjectId::from_raw(12345);
+        let o = QueryOptions::default();
+        let nan = Isometry3::translation(f64::NAN, 0.0, 0.0);
+        let mut bad_q = Item::set_pose(a, &Isometry3::identity());
+        bad_q.pose_a.rotation = [0.0, 0.0, 0.0, 2.0];
+        let mut close_q = bad_q;
+        close_q.pose_a.rotation = [0.0, 0.0, 0.0, 1.0 + 1e-7];
+        let mut kind = Item::distance(a, a, &o);
+        kind.kind = 77;
+        let mut flags = Item::distance(a, a, &o);
+        flags.flags |= 1 << 20;
+        let cases = [
+            (Item::distance(a, ghost, &o), ErrorCode::UnknownObject),
+            (
+                Item::set_pose(ghost, &Isometry3::identity()),
+                ErrorCode::UnknownObject,
+            ),
+            (Item::set_pose(a, &nan), ErrorCode::NonFinitePose),
+            (
+                Item::distance(a, a, &o).with_pose_b(&nan),
+                ErrorCode::NonFinitePose,
+            ),
+            (bad_q, ErrorCode::BadQuaternion),
+            (close_q, ErrorCode::Ok),
+            (
+                Item::distance(
+                    a,
+                    a,
+                    &QueryOptions {
+                        max_iterations: 0,
+                        ..o
+                    },
+                ),
+                ErrorCode::InvalidOptions,
+            ),
+            (
+                Item::distance(
+                    a,
+                    a,
+                    &QueryOptions {
+                        tolerance: -1.0,
+                        ..o
+                    },
+                ),
+                ErrorCode::InvalidOptions,
+            ),
+            (kind, ErrorCode::Malformed),
+            (flags, ErrorCode::Malformed),
+        ];
+        for (item, code) in cases {
+            assert_eq!(one(&mut s, 1, item).error_code(), code, "{item:?}");
+        }
+        assert_eq!(s.check_batch(0), Err(ErrorCode::EmptyBatch));
+        assert_eq!(s.check_batch(1025), Err(ErrorCode::BatchTooLarge));
+        assert_eq!(s.check_batch(1024), Ok(()));
+    }
+
+    #[test]
+    fn registration_errors_are_specific() {
+        let mut s = state();
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        let v = Vertex {
+            x: 1.0,
+            y: 2.0,
+            z: 3.0,
+        };
+        let code = |s: &mut State, req: &AdminRequest, verts: &[Vertex]| {
+            s.handle_admin(1, req, verts).error_code()
+        };
+        assert_eq!(code(&mut s, &req, &[]), ErrorCode::EmptyVertices);
+        req.pieces[0].vertex_count = 1;
+        req.pieces[0].radius = -1.0;
+        assert_eq!(code(&mut s, &req, &[v]), ErrorCode::InvalidRadius);
+        req.pieces[0].radius = 0.5;
+        let nan = Vertex { x: f64::NAN, ..v };
+        assert_eq!(code(&mut s, &req, &[nan]), ErrorCode::NonFiniteVertex);
+        assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::Malformed);
+        let many = vec![v; 100_001];
+        assert_eq!(code(&mut s, &req, &many), ErrorCode::TooManyVertices);
+        req.shape = shape_kind::COMPOUND;
+        req.piece_count = 0;
+        assert_eq!(code(&mut s, &req, &[v]), ErrorCode::EmptyCompound);
+        req.piece_count = 65;
+        assert_eq!(code(&mut s, &req, &[v]), ErrorCode::TooManyPieces);
+        req.piece_count = 2;
+        req.pieces[1] = PieceDesc {
+            vertex_count: 1,
+            ..req.pieces[0]
+        };
+        req.pieces[1].offset.translation[0] = f64::INFINITY;
+        assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::NonFinitePose);
+        req.pieces[1].offset.translation[0] = 2.0;
+        assert!(req.set_name("dumbbell"));
+        let reply = s.handle_admin(1, &req, &[v, v]);
+        assert_eq!(reply.error_code(), ErrorCode::Ok);
+        assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::NameTaken);
+        req.shape = 9;
+        assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::Malformed);
+
+        let mut lookup = AdminRequest::new(AdminOp::Lookup);
+        assert!(lookup.set_name("dumbbell"));
+        assert_eq!(s.handle_admin(5, &lookup, &[]).id, reply.id);
+        let mut remove = AdminRequest::new(AdminOp::Remove);
+        remove.id = reply.id;
+        assert_eq!(code(&mut s, &remove, &[]), ErrorCode::Ok);
+        assert_eq!(
+            s.handle_admin(5, &lookup, &[]).error_code(),
+            ErrorCode::UnknownName
+        );
+        assert_eq!(code(&mut s, &remove, &[]), ErrorCode::UnknownObject);
+    }
+
+    #[test]
+    fn only_the_owner_removes_and_scene_objects_stay() {
+        let mut s = state();
+        let id = register_box(&mut s, 1);
+        assert_eq!(s.remove(id, 2), Err(ErrorCode::NotOwner));
+        let scene = s
+            .insert(
+                NewObject {
+                    shape: Convex::sphere(1.0).expect("sphere").into(),
+                    pose: Isometry3::identity(),
+                    name: Some("fixed".into()),
+                },
+                Owner::Scene,
+            )
+            .expect("room");
+        assert_eq!(s.remove(scene, 1), Err(ErrorCode::ReadOnly));
+        assert_eq!(s.remove(id, 1), Ok(()));
+        assert!(s.object(id).is_none());
+    }
+
+    #[test]
+    fn ids_carry_the_epoch_and_are_not_reused() {
+        let mut s = state();
+        let a = register_box(&mut s, 1);
+        assert_eq!(a >> 32, 3);
+        s.remove(a, 1).expect("owner");
+        let b = register_box(&mut s, 1);
+        assert_ne!(a, b);
+    }
+
+    /// Arbitrary bytes reinterpreted as items never panic the handler.
+    #[test]
+    fn garbage_items_do_not_panic() {
+        let mut s = state();
+        let a = register_box(&mut s, 1);
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..2000 {
+            let mut item = Item::distance(
+                ObjectId::from_raw(a),
+                ObjectId::from_raw(a),
+                &QueryOptions::default(),
+            );
+            item.kind = (next() % 4) as u32;
+            item.flags = (next() % 32) as u32;
+            item.tolerance = f64::from_bits(next());
+            item.margin = f64::from_bits(next());
+            item.max_iterations = (next() % 300) as u32;
+            item.pose_a.translation[0] = f64::from_bits(next());
+            item.pose_b.rotation[1] = f64::from_bits(next());
+            let _ = one(&mut s, 3, item);
+        }
+    }
+}

@@ -1,0 +1,127 @@
+//! The examples of the client's rustdoc, run against a real server: they are
+//! `no_run` there (a doctest cannot start a server), so they are run here, as
+//! written, with only the service name changed.
+
+use gjkd_e2e::Server;
+
+#[test]
+fn crate_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-crate", &[]);
+    let service = server.service.as_str();
+    // --- from client/src/lib.rs, crate docs ---
+    use gjkd_client::{Client, QueryOptions};
+    use nalgebra::{Isometry3, Vector3};
+
+    let mut client = Client::connect(service)?;
+    let ball = client.register_sphere(0.5)?;
+    let crate_ = client.register_cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)?;
+
+    // Poses are stored by the server until changed...
+    client.set_pose(ball, &Isometry3::translation(3.0, 0.0, 0.0))?;
+    let answer = client.distance(crate_, ball, &QueryOptions::default())?;
+    assert!((answer.distance - 1.5).abs() < 1e-9);
+    println!("nearest points {} and {}", answer.point_a, answer.point_b);
+
+    // ...or given per query, leaving the stored ones alone.
+    let answer = client.distance_at(
+        crate_,
+        &Isometry3::identity(),
+        ball,
+        &Isometry3::translation(0.0, 4.0, 0.0),
+        &QueryOptions::default(),
+    )?;
+    assert!((answer.distance - 2.5).abs() < 1e-9);
+    Ok(())
+}
+
+#[test]
+fn batch_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-batch", &[]);
+    let service = server.service.as_str();
+    // --- from client/src/lib.rs, "Batches" ---
+    use gjkd_client::{Client, ErrorCode, Item, ItemResult, QueryOptions};
+    use nalgebra::{Isometry3, Vector3};
+
+    let mut client = Client::connect(service)?;
+    let robot = client.register_cuboid(Vector3::new(0.5, 0.5, 1.0), 0.05)?;
+    let obstacles: Vec<_> = (0..8)
+        .map(|_| client.register_sphere(0.3))
+        .collect::<Result<_, _>>()?;
+    for (i, &o) in obstacles.iter().enumerate() {
+        client.set_pose(o, &Isometry3::translation(2.0 + i as f64, 0.0, 0.0))?;
+    }
+
+    let mut items = Vec::new();
+    let mut results = vec![ItemResult::default(); obstacles.len() + 1];
+    let mut answered = 0;
+    for step in 0..100 {
+        items.clear();
+        let pose = Isometry3::translation(0.05 * step as f64, 0.0, 0.0);
+        items.push(Item::set_pose(robot, &pose));
+        for &o in &obstacles {
+            items.push(Item::distance(robot, o, &QueryOptions::default()));
+        }
+        client.query_batch(&items, &mut results)?;
+        for r in &results[1..] {
+            match r.answer() {
+                Ok(a) => {
+                    answered += 1;
+                    let _ = a.distance;
+                }
+                Err(ErrorCode::UnknownObject) => println!("removed meanwhile"),
+                Err(e) => println!("error: {e}"),
+            }
+        }
+    }
+    // Checks of our own: every query answered, and at the last step the
+    // robot (rounded box, left face at 4.95 - 0.5 - 0.05) has passed the
+    // first obstacle (ball at 2 of radius 0.3).
+    assert_eq!(answered, 800);
+    let last = results[1].answer().expect("ok").distance;
+    let expect: f64 = (0.05 * 99.0 - 0.5 - 0.05) - (2.0 + 0.3);
+    assert!((last - expect).abs() < 1e-9, "{last} vs {expect}");
+    Ok(())
+}
+
+#[test]
+fn compound_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-compound", &[]);
+    let service = server.service.as_str();
+    // --- from client/src/lib.rs, Client::register_compound ---
+    use gjkd_client::{Client, Geometry, Piece};
+    use nalgebra::{Isometry3, Point3};
+
+    let mut client = Client::connect(service)?;
+    let ball = Geometry::Sphere { radius: 0.3 };
+    let bar = Geometry::Capsule {
+        a: Point3::new(-1.0, 0.0, 0.0),
+        b: Point3::new(1.0, 0.0, 0.0),
+        radius: 0.05,
+    };
+    let dumbbell = client.register_compound(&[
+        Piece {
+            offset: Isometry3::translation(-1.0, 0.0, 0.0),
+            geometry: ball,
+        },
+        Piece {
+            offset: Isometry3::identity(),
+            geometry: bar,
+        },
+        Piece {
+            offset: Isometry3::translation(1.0, 0.0, 0.0),
+            geometry: ball,
+        },
+    ])?;
+    // Ours: the far ball is the nearest piece to something on its side.
+    let probe = client.register_sphere(0.2)?;
+    let a = client.distance_at(
+        dumbbell,
+        &Isometry3::identity(),
+        probe,
+        &Isometry3::translation(3.0, 0.0, 0.0),
+        &gjkd_client::QueryOptions::default(),
+    )?;
+    assert!((a.distance - 1.5).abs() < 1e-9, "{}", a.distance);
+    assert_eq!(a.pieces, [2, 0]);
+    Ok(())
+}

@@ -27,6 +27,31 @@ const fn members(mask: usize) -> ([u8; 4], u8) {
 /// computed after those of the subsets they recurse on.
 const BY_SIZE: [u8; 15] = [1, 2, 4, 8, 3, 5, 6, 9, 10, 12, 7, 11, 13, 14, 15];
 
+/// For each new slot `n` and set `all` holding it: the subsets of `all` that
+/// hold `n`, smallest first, so each cofactor's smaller subsets are ready.
+const WITH_NEW: [[([u8; 8], u8); 16]; 4] = {
+    let mut t = [[([0u8; 8], 0u8); 16]; 4];
+    let mut n = 0;
+    while n < 4 {
+        let mut all = 0;
+        while all < 16 {
+            let mut k = 0;
+            while k < 15 {
+                let m = BY_SIZE[k] as usize;
+                if m & (1 << n) != 0 && m & !all == 0 {
+                    let (list, len) = &mut t[n][all];
+                    list[*len as usize] = m as u8;
+                    *len += 1;
+                }
+                k += 1;
+            }
+            all += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
 const MEMBERS: [([u8; 4], u8); 16] = {
     let mut t = [([0u8; 4], 0u8); 16];
     let mut m = 0;
@@ -145,15 +170,10 @@ impl Simplex {
         }
         self.dot[n_us][n_us] = p.y.norm_squared();
         self.all = old | (1 << n);
-        let nbit = 1usize << n;
-        // Subsets containing n, by increasing size, so each cofactor's
-        // smaller subsets are ready. Subsets of `old` keep their values.
-        let all = self.all as usize;
-        for &mask in &BY_SIZE {
-            let mask = mask as usize;
-            if mask & nbit != 0 && mask & !all == 0 {
-                self.cofactors(mask);
-            }
+        // Subsets of `old` keep their cofactors; those holding n are new.
+        let (list, len) = WITH_NEW[n_us & 3][self.all as usize & 15];
+        for &mask in list.iter().take(len as usize) {
+            self.cofactors(mask as usize);
         }
     }
 
@@ -161,19 +181,22 @@ impl Simplex {
     /// `k = min I_s`.
     #[inline]
     fn cofactors(&mut self, mask: usize) {
+        // The `& 15` and `& 3` cost nothing and let the compiler drop every
+        // bounds check in this, the subalgorithm's innermost loop.
+        let mask = mask & 15;
         let (mem, len) = MEMBERS[mask];
         if len == 1 {
-            self.delta[mask][mem[0] as usize] = 1.0;
+            self.delta[mask][mem[0] as usize & 3] = 1.0;
             return;
         }
         for &j in &mem[..len as usize] {
-            let j = j as usize;
+            let j = j as usize & 3;
             let sub = mask & !(1 << j);
             let (smem, slen) = MEMBERS[sub];
-            let k = smem[0] as usize;
+            let k = smem[0] as usize & 3;
             let mut acc = 0.0;
             for &i in &smem[..slen as usize] {
-                let i = i as usize;
+                let i = i as usize & 3;
                 acc += self.delta[sub][i] * (self.dot[i][k] - self.dot[i][j]);
             }
             self.delta[mask][j] = acc;

@@ -676,7 +676,10 @@ fn compound(
         match run.exit {
             Exit::Pruned => continue,
             Exit::Status(Status::IterationCap | Status::ToleranceNotMet) => {
-                trouble = trouble.max_by_severity(ans.status);
+                // ToleranceNotMet outranks IterationCap: it is the worse news.
+                if trouble != Some(Status::ToleranceNotMet) {
+                    trouble = Some(ans.status);
+                }
             }
             Exit::Status(_) => {}
         }
@@ -712,17 +715,4 @@ fn compound(
         },
     };
     out
-}
-
-trait Severity {
-    fn max_by_severity(self, s: Status) -> Option<Status>;
-}
-
-impl Severity for Option<Status> {
-    fn max_by_severity(self, s: Status) -> Option<Status> {
-        match (self, s) {
-            (Some(Status::ToleranceNotMet), _) => self,
-            _ => Some(s),
-        }
-    }
 }

@@ -62,6 +62,156 @@ const MEMBERS: [([u8; 4], u8); 16] = {
     t
 };
 
+/// Runs `$body` with `$m` bound to `$mask` as a constant, one arm per
+/// non-empty subset: inside an arm every table lookup on `$m` is a constant,
+/// so the loops over its members unroll into straight-line code.
+macro_rules! by_mask {
+    ($mask:expr, $m:ident => $body:expr) => {
+        match $mask & 15 {
+            1 => {
+                const $m: usize = 1;
+                $body
+            }
+            2 => {
+                const $m: usize = 2;
+                $body
+            }
+            3 => {
+                const $m: usize = 3;
+                $body
+            }
+            4 => {
+                const $m: usize = 4;
+                $body
+            }
+            5 => {
+                const $m: usize = 5;
+                $body
+            }
+            6 => {
+                const $m: usize = 6;
+                $body
+            }
+            7 => {
+                const $m: usize = 7;
+                $body
+            }
+            8 => {
+                const $m: usize = 8;
+                $body
+            }
+            9 => {
+                const $m: usize = 9;
+                $body
+            }
+            10 => {
+                const $m: usize = 10;
+                $body
+            }
+            11 => {
+                const $m: usize = 11;
+                $body
+            }
+            12 => {
+                const $m: usize = 12;
+                $body
+            }
+            13 => {
+                const $m: usize = 13;
+                $body
+            }
+            14 => {
+                const $m: usize = 14;
+                $body
+            }
+            _ => {
+                const $m: usize = 15;
+                $body
+            }
+        }
+    };
+}
+
+/// Runs `$body` with `$n` and `$all` bound as constants to the newest slot
+/// and the set holding it: the 32 shapes a simplex can have after a push.
+/// `$other` handles anything else (only reachable through a logic error).
+macro_rules! by_shape {
+    ($slot:expr, $set:expr, $n:ident, $all:ident => $body:expr, $other:expr) => {
+        by_shape!(@arms ($slot, $set), $n, $all, $body, $other;
+            0: 1 3 5 7 9 11 13 15;
+            1: 2 3 6 7 10 11 14 15;
+            2: 4 5 6 7 12 13 14 15;
+            3: 8 9 10 11 12 13 14 15)
+    };
+    (@arms $key:expr, $n:ident, $all:ident, $body:expr, $other:expr;
+        $($nv:literal: $($av:literal)*);*) => {
+        match $key {
+            $($(($nv, $av) => {
+                const $n: usize = $nv;
+                const $all: usize = $av;
+                $body
+            })*)*
+            _ => $other,
+        }
+    };
+}
+
+/// For each newest slot `n` and set `all` holding it, the candidates of the
+/// subalgorithm after the "first face" of Section 6: the subsets holding `n`,
+/// smallest first, then the rest (rejected last iteration; tried again for
+/// round-off's sake only).
+const ORDER: [[([u8; 15], u8); 16]; 4] = {
+    let mut t = [[([0u8; 15], 0u8); 16]; 4];
+    let mut n = 0;
+    while n < 4 {
+        let mut all = 0;
+        while all < 16 {
+            let (list, len) = &mut t[n][all];
+            let mut k = 0;
+            while k < 15 {
+                let m = BY_SIZE[k] as usize;
+                if m & (1 << n) != 0 && m & !all == 0 {
+                    list[*len as usize] = m as u8;
+                    *len += 1;
+                }
+                k += 1;
+            }
+            let mut m = 1;
+            while m < 16 {
+                if m & (1 << n) == 0 && m & !all == 0 {
+                    list[*len as usize] = m as u8;
+                    *len += 1;
+                }
+                m += 1;
+            }
+            all += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
+/// For each set `all`, its non-empty subsets, largest first: the candidates
+/// for a fresh `V0`, where the whole set is the likeliest answer.
+const DOWN: [([u8; 15], u8); 16] = {
+    let mut t = [([0u8; 15], 0u8); 16];
+    let mut all = 0;
+    while all < 16 {
+        let (list, len) = &mut t[all];
+        let mut k = 15;
+        while k > 0 {
+            k -= 1;
+            let m = BY_SIZE[k] as usize;
+            if m & !all == 0 {
+                list[*len as usize] = m as u8;
+                *len += 1;
+            }
+        }
+        all += 1;
+    }
+    t
+};
+
 /// One vertex of the simplex: the point of `K` and where it came from.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Vertex {
@@ -158,22 +308,75 @@ impl Simplex {
     }
 
     fn insert(&mut self, n: u8, p: Vertex) {
-        let n_us = n as usize;
+        let n_us = n as usize & 3;
         self.vertices[n_us] = p;
-        let old = self.all;
+        // All four products, used slots or not: branch-free, and a stale slot's
+        // product is never read, since every read goes through a subset of
+        // `all`.
         for i in 0..4 {
-            if old & (1 << i) != 0 {
-                let d = self.vertices[i].y.dot(&p.y);
-                self.dot[i][n_us] = d;
-                self.dot[n_us][i] = d;
-            }
+            let d = self.vertices[i].y.dot(&p.y);
+            self.dot[i][n_us] = d;
+            self.dot[n_us][i] = d;
         }
-        self.dot[n_us][n_us] = p.y.norm_squared();
-        self.all = old | (1 << n);
-        // Subsets of `old` keep their cofactors; those holding n are new.
-        let (list, len) = WITH_NEW[n_us & 3][self.all as usize & 15];
-        for &mask in list.iter().take(len as usize) {
-            self.cofactors(mask as usize);
+        self.all |= 1 << n;
+        // Subsets of the old set keep their cofactors; those holding n are new.
+        // One monomorphised update per (slot, set): the subset lists and the
+        // members of each subset are then constants, and the recursion (5.6)
+        // compiles to straight-line arithmetic.
+        macro_rules! dispatch {
+            ($($n:literal => [$($all:literal),*]),*) => {
+                match (n_us, self.all as usize) {
+                    $($(($n, $all) => self.update::<$n, $all>(),)*)*
+                    _ => {
+                        let (list, len) = WITH_NEW[n_us][self.all as usize & 15];
+                        for &mask in list.iter().take(len as usize) {
+                            self.cofactors(mask as usize);
+                        }
+                    }
+                }
+            };
+        }
+        dispatch!(
+            0 => [1, 3, 5, 7, 9, 11, 13, 15],
+            1 => [2, 3, 6, 7, 10, 11, 14, 15],
+            2 => [4, 5, 6, 7, 12, 13, 14, 15],
+            3 => [8, 9, 10, 11, 12, 13, 14, 15]
+        );
+    }
+
+    /// The cofactors of every subset of `ALL` that holds slot `N`, smallest
+    /// first, unrolled: each step's subset is a constant.
+    #[inline(always)]
+    fn update<const N: usize, const ALL: usize>(&mut self) {
+        macro_rules! step {
+            ($($k:literal)*) => {$(
+                if const { WITH_NEW[N][ALL].1 > $k } {
+                    by_mask!(const { WITH_NEW[N][ALL].0[$k] } as usize, M => self.cofactors_of::<M>());
+                }
+            )*};
+        }
+        step!(0 1 2 3 4 5 6 7);
+    }
+
+    /// [`cofactors`](Self::cofactors) for a subset known at compile time.
+    #[inline(always)]
+    fn cofactors_of<const MASK: usize>(&mut self) {
+        let (mem, len) = const { MEMBERS[MASK] };
+        if len == 1 {
+            self.delta[MASK][mem[0] as usize & 3] = 1.0;
+            return;
+        }
+        for &j in &mem[..len as usize] {
+            let j = j as usize & 3;
+            let sub = MASK & !(1 << j);
+            let (smem, slen) = MEMBERS[sub];
+            let k = smem[0] as usize & 3;
+            let mut acc = 0.0;
+            for &i in &smem[..slen as usize] {
+                let i = i as usize & 3;
+                acc += self.delta[sub][i] * (self.dot[i][k] - self.dot[i][j]);
+            }
+            self.delta[MASK][j] = acc;
         }
     }
 
@@ -208,7 +411,11 @@ impl Simplex {
     /// 5.1), so its ratio to the product of the squared edge lengths is a
     /// product of squared sines, 1 for orthogonal edges and 0 for flat sets.
     fn independent(&self) -> bool {
-        let all = self.all as usize;
+        by_mask!(self.all as usize, ALL => self.independent_in(ALL))
+    }
+
+    #[inline(always)]
+    fn independent_in(&self, all: usize) -> bool {
         let (mem, len) = MEMBERS[all];
         if len < 2 {
             return true;
@@ -224,39 +431,50 @@ impl Simplex {
     }
 
     /// `Δ(Y_s)` of (5.4).
-    #[inline]
+    #[inline(always)]
     fn total(&self, mask: usize) -> f64 {
         let (mem, len) = MEMBERS[mask];
-        mem[..len as usize]
-            .iter()
-            .map(|&i| self.delta[mask][i as usize])
-            .sum()
+        let mut sum = 0.0;
+        for &i in &mem[..len as usize] {
+            sum += self.delta[mask][i as usize & 3];
+        }
+        sum
     }
 
     /// Conditions (1) and (2) of Theorem 5.2.
-    #[inline]
+    #[inline(always)]
     fn interior(&self, mask: usize) -> bool {
         let (mem, len) = MEMBERS[mask];
-        mem[..len as usize]
-            .iter()
-            .all(|&i| self.delta[mask][i as usize] > 0.0)
+        // A loop, not `Iterator::all`, which the compiler may leave as a call
+        // and so lose the constant `mask` of a specialised caller.
+        for &i in &mem[..len as usize] {
+            let d = self.delta[mask][i as usize & 3];
+            if d <= 0.0 || d.is_nan() {
+                return false;
+            }
+        }
+        true
     }
 
-    /// All three conditions of Theorem 5.2 for `mask` within `Y`.
-    #[inline]
-    fn passes(&self, mask: usize) -> bool {
+    /// All three conditions of Theorem 5.2 for `mask` within `Y = all`.
+    #[inline(always)]
+    fn passes_in(&self, mask: usize, all: usize) -> bool {
         if !self.interior(mask) {
             return false;
         }
         if mask == 0b1111 {
             return self.holds_origin();
         }
-        let rest = self.all as usize & !mask;
+        let rest = all & !mask;
         let (rmem, rlen) = MEMBERS[rest];
-        rmem[..rlen as usize].iter().all(|&j| {
-            let j = j as usize;
-            self.delta[mask | (1 << j)][j] <= 0.0
-        })
+        for &j in &rmem[..rlen as usize] {
+            let j = j as usize & 3;
+            let d = self.delta[(mask | (1 << j)) & 15][j];
+            if d > 0.0 || d.is_nan() {
+                return false;
+            }
+        }
+        true
     }
 
     /// Whether the origin is certainly inside the tetrahedron `Y`. Round-off
@@ -287,6 +505,7 @@ impl Simplex {
             .all(|&(v, err)| v.abs() > err && (v > 0.0) == (total > 0.0))
     }
 
+    #[inline(always)]
     fn solution(&self, mask: usize) -> Solution {
         let total = self.total(mask);
         let (mem, len) = MEMBERS[mask];
@@ -322,54 +541,73 @@ impl Simplex {
     pub fn solve(&self) -> Option<Solution> {
         let all = self.all as usize;
         match self.newest {
-            Some(n) => {
-                let nbit = 1usize << n;
-                // First the face that drops the old vertex most aligned with the
-                // newest point: it holds the answer about 80% of the time.
-                let old = all & !nbit;
-                if old == 0 {
-                    return Some(self.solution(nbit));
-                }
-                let first;
-                {
-                    let (mem, len) = MEMBERS[old];
-                    let mut drop = mem[0] as usize;
-                    for &i in &mem[1..len as usize] {
-                        let i = i as usize;
-                        if self.dot[i][n as usize] > self.dot[drop][n as usize] {
-                            drop = i;
-                        }
-                    }
-                    first = all & !(1 << drop);
-                    if self.passes(first) {
-                        return Some(self.solution(first));
-                    }
-                }
-                // Then every other subset holding the newest point, smallest
-                // first; subsets without it were rejected last iteration and
-                // come last, for round-off's sake only.
-                for &mask in &BY_SIZE {
-                    let mask = mask as usize;
-                    if mask != first && mask & !all == 0 && mask & nbit != 0 && self.passes(mask) {
-                        return Some(self.solution(mask));
-                    }
-                }
-                (1..16usize)
-                    .filter(|m| m & !all == 0 && m & nbit == 0)
-                    .find(|&m| self.passes(m))
-                    .map(|m| self.solution(m))
-            }
-            None => {
-                // A fresh V0 (warm start): the whole set is the likeliest answer.
-                BY_SIZE
-                    .iter()
-                    .rev()
-                    .map(|&m| m as usize)
-                    .filter(|&m| m & !all == 0)
-                    .find(|&m| self.passes(m))
-                    .map(|m| self.solution(m))
+            Some(n) => by_shape!(n as usize, all, N, ALL => self.solve_of::<N, ALL>(), {
+                self.solve_any()
+            }),
+            None => self.solve_any(),
+        }
+    }
+
+    /// [`solve`](Self::solve) after a push of slot `N` into the set `ALL`.
+    #[inline(always)]
+    fn solve_of<const N: usize, const ALL: usize>(&self) -> Option<Solution> {
+        let old = ALL & !(1 << N);
+        if old == 0 {
+            return Some(self.solution(ALL));
+        }
+        // First the face that drops the old vertex most aligned with the
+        // newest point: it holds the answer about 80% of the time.
+        let (mem, len) = const { MEMBERS[ALL & !(1 << N)] };
+        let mut drop = mem[0] as usize & 3;
+        for &i in &mem[1..len as usize] {
+            let i = i as usize & 3;
+            if self.dot[i][N] > self.dot[drop][N] {
+                drop = i;
             }
         }
+        let first = ALL & !(1 << drop);
+        if by_mask!(first, M => self.passes_in(M, ALL)) {
+            return Some(self.solution_by(first));
+        }
+        let (list, len) = const { ORDER[N][ALL] };
+        for &m in &list[..len as usize] {
+            let m = m as usize;
+            if m != first && by_mask!(m, M => self.passes_in(M, ALL)) {
+                return Some(self.solution_by(m));
+            }
+        }
+        None
+    }
+
+    /// [`solve`](Self::solve) for a fresh `V0` (a warm start), where the whole
+    /// set is the likeliest answer.
+    fn solve_any(&self) -> Option<Solution> {
+        if self.all == 0 {
+            return None;
+        }
+        by_mask!(self.all as usize, ALL => self.solve_fresh::<ALL>())
+    }
+
+    /// [`solve_any`](Self::solve_any) for the set `ALL`, unrolled.
+    #[inline(always)]
+    fn solve_fresh<const ALL: usize>(&self) -> Option<Solution> {
+        macro_rules! step {
+            ($($k:literal)*) => {$(
+                if const { DOWN[ALL].1 > $k } {
+                    let m = const { DOWN[ALL].0[$k] as usize };
+                    if by_mask!(m, M => self.passes_in(M, ALL)) {
+                        return Some(by_mask!(m, M => self.solution(M)));
+                    }
+                }
+            )*};
+        }
+        step!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14);
+        None
+    }
+
+    /// [`solution`](Self::solution), one specialised body per subset.
+    fn solution_by(&self, mask: usize) -> Solution {
+        by_mask!(mask, M => self.solution(M))
     }
 
     /// The Backup Procedure (6.5): among the subsets with `Δ > 0` and every
@@ -377,39 +615,50 @@ impl Simplex {
     /// Always succeeds: a single point qualifies.
     pub fn backup(&self) -> Solution {
         let all = self.all as usize;
-        let mut best = None;
+        let mut best = 0;
         let mut best_d2 = f64::INFINITY;
         for mask in 1..16usize {
-            if mask & !all != 0 || !self.interior(mask) {
+            if mask & !all != 0 {
                 continue;
             }
-            if mask == 0b1111 && !self.holds_origin() {
-                continue;
-            }
-            let total = self.total(mask);
-            if total <= 0.0 {
-                continue;
-            }
-            let d2 = self.aff_dist2(mask, total);
+            let d2 = by_mask!(mask, M => self.backup_d2(M));
             if d2 < best_d2 {
                 best_d2 = d2;
-                best = Some(mask);
+                best = mask;
             }
         }
         // A singleton always qualifies (Δ = 1); the fallback only guards
         // against a NaN having crept into a dot product.
-        self.solution(best.unwrap_or(all & all.wrapping_neg()))
+        if best == 0 {
+            best = all & all.wrapping_neg();
+        }
+        self.solution_by(best)
+    }
+
+    /// `|v(aff Y_s)|²` for a candidate of the Backup Procedure, infinity for a
+    /// subset that is not one.
+    #[inline(always)]
+    fn backup_d2(&self, mask: usize) -> f64 {
+        if !self.interior(mask) || (mask == 0b1111 && !self.holds_origin()) {
+            return f64::INFINITY;
+        }
+        let total = self.total(mask);
+        if total <= 0.0 || total.is_nan() {
+            return f64::INFINITY;
+        }
+        self.aff_dist2(mask, total)
     }
 
     /// (5.10): `|v(aff Y_s)|² = (1/Δ) Σ_i Δ_i (y_i·y_k)`, `k = min I_s`.
-    #[inline]
+    #[inline(always)]
     fn aff_dist2(&self, mask: usize, total: f64) -> f64 {
         let (mem, len) = MEMBERS[mask];
         let k = mem[0] as usize;
-        let s: f64 = mem[..len as usize]
-            .iter()
-            .map(|&i| self.delta[mask][i as usize] * self.dot[i as usize][k])
-            .sum();
+        let mut s = 0.0;
+        for &i in &mem[..len as usize] {
+            let i = i as usize & 3;
+            s += self.delta[mask][i] * self.dot[i][k & 3];
+        }
         (s / total).max(0.0)
     }
 
@@ -436,8 +685,13 @@ impl Simplex {
 
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
     pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
-        (0..4)
-            .any(|i| mask & (1 << i) != 0 && self.vertices[i].ia == ia && self.vertices[i].ib == ib)
+        // Non-short-circuit: which slot matches is unpredictable, so a bit
+        // mask of matches costs less than the branches of `any`.
+        let mut hit = 0u8;
+        for (i, v) in self.vertices.iter().enumerate() {
+            hit |= u8::from((v.ia == ia) & (v.ib == ib)) << i;
+        }
+        hit & mask != 0
     }
 }
 

@@ -100,6 +100,15 @@ impl Convex {
         if !size.is_finite() {
             return Err(Error::NonFiniteVertex(0));
         }
+        // Pad the scan arrays to whole vector steps with copies of vertex 0:
+        // a copy never beats the original (ties go to the lowest index), and
+        // the vector scan then needs no scalar tail with its unpredictable exit.
+        if len >= 8 {
+            let padded = len.div_ceil(8) * 8;
+            for coord in [&mut xs, &mut ys, &mut zs] {
+                coord.resize(padded, coord[0]);
+            }
+        }
         Ok(Self {
             vertices,
             radius,
@@ -184,15 +193,19 @@ impl Convex {
     }
 
     /// Index of the vertex that maximises `(v - centroid)·d`: the support point
-    /// (3.7). A linear scan, as the paper prescribes, over a layout the compiler
-    /// vectorises; ties go to the lowest index so the answer is deterministic
-    /// whichever code path runs.
+    /// (3.7). A linear scan, as the paper prescribes, over a layout made for
+    /// vector lanes. Exact ties go to the lowest index; a near-tie within the
+    /// last bit may go either way between the AVX2 and portable paths (each
+    /// is a valid support point), but always the same way on one machine.
     #[inline]
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
         #[cfg(target_arch = "x86_64")]
         {
-            if self.xs.len() >= 16 && std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, checked just above.
+            if self.xs.len() >= 8
+                && std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                 return unsafe { scan_avx2(&self.xs, &self.ys, &self.zs, d) };
             }
         }
@@ -298,8 +311,12 @@ impl From<Compound> for Shape {
 }
 
 pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {
-    p.translation.vector.iter().all(|c| c.is_finite())
-        && p.rotation.coords.iter().all(|c| c.is_finite())
+    // x·0 is NaN exactly when x is infinite or NaN; no branch per component.
+    let t = &p.translation.vector;
+    let q = &p.rotation.coords;
+    let poison = t.x * 0.0 + t.y * 0.0 + t.z * 0.0;
+    let poison = poison + q.x * 0.0 + q.y * 0.0 + q.z * 0.0 + q.w * 0.0;
+    poison == 0.0
 }
 
 /// The support scan on 4 independent lanes. Each lane keeps its running maximum
@@ -359,9 +376,84 @@ fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
     idx
 }
 
-/// [`scan`] compiled for AVX2 and FMA, chosen at run time.
+/// [`scan`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
+/// lanes, so the two compare-and-select chains overlap, and the comparison
+/// mask used as it is (the compiler's own vectorisation of [`scan`] spends
+/// five instructions per step converting it to booleans and back). Dot
+/// products are fused multiply-adds, so they may differ from [`scan`]'s in
+/// the last bit; either vertex of such a near-tie is a valid support point.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
-    scan(xs, ys, zs, d)
+    use std::arch::x86_64::*;
+    let n = xs.len().min(ys.len()).min(zs.len());
+    let full = n - n % 8;
+    let (dx, dy, dz) = (
+        _mm256_set1_pd(d.x),
+        _mm256_set1_pd(d.y),
+        _mm256_set1_pd(d.z),
+    );
+    let mut best = [_mm256_set1_pd(f64::NEG_INFINITY); 2];
+    let mut best_i = [_mm256_setzero_pd(); 2];
+    let mut base = [
+        _mm256_setr_pd(0.0, 1.0, 2.0, 3.0),
+        _mm256_setr_pd(4.0, 5.0, 6.0, 7.0),
+    ];
+    let step = _mm256_set1_pd(8.0);
+    let mut i = 0;
+    while i < full {
+        for h in 0..2 {
+            let k = i + 4 * h;
+            // SAFETY: k + 4 <= full <= n, the length of all three slices.
+            let (x, y, z) = unsafe {
+                (
+                    _mm256_loadu_pd(xs.as_ptr().add(k)),
+                    _mm256_loadu_pd(ys.as_ptr().add(k)),
+                    _mm256_loadu_pd(zs.as_ptr().add(k)),
+                )
+            };
+            let dot = _mm256_fmadd_pd(z, dz, _mm256_fmadd_pd(y, dy, _mm256_mul_pd(x, dx)));
+            let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(dot, best[h]);
+            best[h] = _mm256_blendv_pd(best[h], dot, gt);
+            best_i[h] = _mm256_blendv_pd(best_i[h], base[h], gt);
+            base[h] = _mm256_add_pd(base[h], step);
+        }
+        i += 8;
+    }
+    // Merge the eight lanes without branches: at each step a lane takes its
+    // partner's value if larger, or equal with a lower index.
+    let pick = |v: __m256d, i: __m256d, w: __m256d, j: __m256d| {
+        let take = _mm256_or_pd(
+            _mm256_cmp_pd::<_CMP_GT_OQ>(w, v),
+            _mm256_and_pd(
+                _mm256_cmp_pd::<_CMP_EQ_OQ>(w, v),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(j, i),
+            ),
+        );
+        (_mm256_blendv_pd(v, w, take), _mm256_blendv_pd(i, j, take))
+    };
+    let (v, ix) = pick(best[0], best_i[0], best[1], best_i[1]);
+    let (v, ix) = pick(
+        v,
+        ix,
+        _mm256_permute2f128_pd::<1>(v, v),
+        _mm256_permute2f128_pd::<1>(ix, ix),
+    );
+    let (v, ix) = pick(
+        v,
+        ix,
+        _mm256_permute_pd::<0b0101>(v),
+        _mm256_permute_pd::<0b0101>(ix),
+    );
+    let mut top = _mm256_cvtsd_f64(v);
+    let top_i = _mm256_cvtsd_f64(ix);
+    let mut idx = top_i as usize;
+    for i in full..n {
+        let dot = zs[i].mul_add(d.z, ys[i].mul_add(d.y, xs[i] * d.x));
+        if dot > top {
+            top = dot;
+            idx = i;
+        }
+    }
+    idx
 }

@@ -304,7 +304,8 @@ impl<'s> Pair<'s> {
         // Centroids far from their body origins (relative to the shapes'
         // sizes) make rb and the translation cancel: then the offset is
         // taken in world coordinates in double-double and rotated once.
-        let far = ca.coords.norm() + cb.coords.norm() > 16.0 * (a.size() + b.size());
+        let (na, nb) = (a.centroid_norm(), b.centroid_norm());
+        let far = na + nb > 16.0 * (a.size() + b.size());
         let (t, exact) = match world {
             Some((pa, pb)) if far => (
                 pa.rotation
@@ -321,7 +322,8 @@ impl<'s> Pair<'s> {
         let scale = if exact {
             d
         } else {
-            d + ca.coords.norm() + rb.norm() + rel.translation.vector.norm()
+            // |rb| = |z̄2|: a rotation keeps lengths.
+            d + na + nb + rel.translation.vector.norm()
         };
         Pair {
             a,
@@ -338,7 +340,7 @@ impl<'s> Pair<'s> {
     /// `y = z1 - z2` for vertex `ia` of A and `ib` of B. The centroid-midpoint
     /// origin of (6.1) cancels in the difference; what matters is that both
     /// terms are small vectors relative to their centroids.
-    #[inline]
+    #[inline(always)]
     fn vertex(&self, ia: usize, ib: usize) -> Vertex {
         let y = self.a.local(ia) - (self.r * self.b.local(ib) + self.t);
         Vertex {

@@ -35,6 +35,8 @@ pub struct Convex {
     vertices: Vec<Point3<f64>>,
     radius: f64,
     centroid: Point3<f64>,
+    /// `|z̄|`, kept for the per-query precision checks.
+    centroid_norm: f64,
     /// `D(coZ - z̄)` of (6.4): the largest distance of a vertex from the centroid.
     size: f64,
     /// Vertices relative to the centroid, one array per coordinate, so that the
@@ -113,6 +115,7 @@ impl Convex {
             vertices,
             radius,
             centroid,
+            centroid_norm: centroid.coords.norm(),
             size,
             xs,
             ys,
@@ -175,6 +178,11 @@ impl Convex {
         self.centroid
     }
 
+    /// `|centroid|`.
+    pub(crate) fn centroid_norm(&self) -> f64 {
+        self.centroid_norm
+    }
+
     /// The largest distance from the centroid to a vertex: `D(coZ - z̄)` of (6.4),
     /// the radius not included.
     pub fn size(&self) -> f64 {
@@ -199,6 +207,10 @@ impl Convex {
     /// is a valid support point), but always the same way on one machine.
     #[inline]
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
+        if self.xs.len() == 1 {
+            // A sphere's core: nothing to scan.
+            return 0;
+        }
         #[cfg(target_arch = "x86_64")]
         {
             if self.xs.len() >= 8

@@ -281,6 +281,34 @@ impl Simplex {
             self.newest = Some(0);
             return;
         }
+        if (2..=4).contains(&points.len()) {
+            // All points at once: the usual warm start, whose points are still
+            // independent. If the whole set passes the test below, so does
+            // every prefix (Fischer's inequality bounds a Gram determinant by
+            // its leading minor times the last squared edge), and the
+            // incremental pass below would have kept every point.
+            let k = points.len();
+            for (slot, p) in self.vertices.iter_mut().zip(points) {
+                *slot = *p;
+            }
+            for i in 0..k {
+                for j in 0..=i {
+                    let d = self.vertices[i].y.dot(&self.vertices[j].y);
+                    self.dot[i][j] = d;
+                    self.dot[j][i] = d;
+                }
+            }
+            self.all = ((1u32 << k) - 1) as u8;
+            match k {
+                2 => self.fill::<0b11>(),
+                3 => self.fill::<0b111>(),
+                _ => self.fill::<0b1111>(),
+            }
+            if self.independent() {
+                self.newest = None;
+                return;
+            }
+        }
         self.all = 0;
         let mut slot = 0u8;
         for p in points {
@@ -295,6 +323,19 @@ impl Simplex {
             }
         }
         self.newest = None;
+    }
+
+    /// The cofactors of every subset of `ALL`, smallest first, unrolled.
+    #[inline(always)]
+    fn fill<const ALL: usize>(&mut self) {
+        macro_rules! step {
+            ($($k:literal)*) => {$(
+                if const { BY_SIZE[$k] as usize & !ALL == 0 } {
+                    by_mask!(const { BY_SIZE[$k] } as usize, M => self.cofactors_of::<M>());
+                }
+            )*};
+        }
+        step!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14);
     }
 
     /// `Y = V̂ ∪ {p}`: keep `keep`, put `p` in a free slot, and compute the dot

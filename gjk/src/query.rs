@@ -164,9 +164,6 @@ pub fn distance(
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
     options.validate()?;
-    if !pose_is_finite(pose_a) || !pose_is_finite(pose_b) {
-        return Err(Error::NonFinitePose);
-    }
     if let Some(w) = warm {
         let (pa, pb) = (w.pieces[0] as usize, w.pieces[1] as usize);
         let (Some((_, ca)), Some((_, cb))) = (a.piece(pa), b.piece(pb)) else {
@@ -184,7 +181,10 @@ pub fn distance(
     // the world origin cancel exactly when the objects are near each other.
     let rel = pose_a.inv_mul(pose_b);
     if !pose_is_finite(&rel) {
-        // Finite poses whose difference overflows f64 (coordinates near 1e308).
+        // Every component of either pose reaches `rel` through a product with
+        // a unit quaternion's components or a difference of translations, so
+        // NaN or infinity anywhere in the inputs shows here; so do finite
+        // poses whose difference overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }
     let answer = match (a, b) {

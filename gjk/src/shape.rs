@@ -377,7 +377,9 @@ fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
             top_i = best_i[l];
         }
     }
-    let mut idx = top_i as usize;
+    // Through u32: the index is exact and small, and the unsigned 64-bit
+    // conversion costs a dozen instructions without AVX-512.
+    let mut idx = top_i as u32 as usize;
     for i in n - n % LANES..n {
         let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
         if dot > top {
@@ -459,7 +461,9 @@ unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usi
     );
     let mut top = _mm256_cvtsd_f64(v);
     let top_i = _mm256_cvtsd_f64(ix);
-    let mut idx = top_i as usize;
+    // Through u32: the index is exact and small, and the unsigned 64-bit
+    // conversion costs a dozen instructions without AVX-512.
+    let mut idx = top_i as u32 as usize;
     for i in full..n {
         let dot = zs[i].mul_add(d.z, ys[i].mul_add(d.y, xs[i] * d.x));
         if dot > top {

@@ -72,14 +72,46 @@ pub enum Status {
     ToleranceNotMet,
 }
 
-/// The final simplex of a query, as vertex index pairs (Section 8), plus the
-/// pieces it belongs to. Keep it per object pair and hand it back with the next
-/// query of the same pair: it changes the time, never the answer beyond `ε`.
+/// One piece pair's final simplex: its pieces and vertex index pairs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct WarmStart {
+struct PieceSimplex {
     pieces: [u32; 2],
     len: u8,
     pairs: [[u32; 2]; 4],
+}
+
+impl PieceSimplex {
+    fn pairs(&self) -> &[[u32; 2]] {
+        &self.pairs[..(self.len as usize).min(4)]
+    }
+
+    /// The index pairs of `mask`'s vertices in `simplex`.
+    fn of(simplex: &Simplex, mask: u8, pieces: [u32; 2]) -> Self {
+        let mut out = PieceSimplex {
+            pieces,
+            ..Default::default()
+        };
+        for (i, v) in simplex.vertices.iter().enumerate() {
+            if mask & (1 << i) != 0 {
+                out.pairs[out.len as usize] = [v.ia, v.ib];
+                out.len += 1;
+            }
+        }
+        out
+    }
+}
+
+/// The final simplex of a query, as vertex index pairs (Section 8), plus the
+/// pieces it belongs to. Keep it per object pair and hand it back with the next
+/// query of the same pair: it changes the time, never the answer beyond `ε`.
+///
+/// For a compound it also keeps the runner-up piece pair's simplex, so that
+/// along a motion both the nearest pair and the one most likely to take over
+/// start warm (the paper warm-starts every convex pair of its Section 8 scene).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct WarmStart {
+    first: PieceSimplex,
+    second: PieceSimplex,
 }
 
 impl WarmStart {
@@ -90,23 +122,39 @@ impl WarmStart {
         if pairs.len() > 4 {
             return None;
         }
-        let mut w = WarmStart {
+        let mut first = PieceSimplex {
             pieces,
             len: pairs.len() as u8,
             pairs: [[0; 2]; 4],
         };
-        w.pairs[..pairs.len()].copy_from_slice(pairs);
-        Some(w)
+        first.pairs[..pairs.len()].copy_from_slice(pairs);
+        Some(WarmStart {
+            first,
+            second: PieceSimplex::default(),
+        })
     }
 
     /// The `[vertex of A, vertex of B]` index pairs of the simplex.
     pub fn pairs(&self) -> &[[u32; 2]] {
-        &self.pairs[..self.len as usize]
+        self.first.pairs()
     }
 
     /// The `[piece of A, piece of B]` the simplex belongs to.
     pub fn pieces(&self) -> [u32; 2] {
-        self.pieces
+        self.first.pieces
+    }
+
+    /// The kept simplexes: the nearest pair's (possibly empty), then the
+    /// runner-up's if any.
+    fn entries(&self) -> impl Iterator<Item = &PieceSimplex> {
+        std::iter::once(&self.first).chain((self.second.len > 0).then_some(&self.second))
+    }
+
+    /// The index pairs kept for the piece pair `pieces`, if any.
+    fn for_pieces(&self, pieces: [u32; 2]) -> Option<&[[u32; 2]]> {
+        self.entries()
+            .find(|e| e.len > 0 && e.pieces == pieces)
+            .map(|e| e.pairs())
     }
 }
 
@@ -165,18 +213,20 @@ pub fn distance(
 ) -> Result<Answer, Error> {
     options.validate()?;
     if let Some(w) = warm {
-        let (pa, pb) = (w.pieces[0] as usize, w.pieces[1] as usize);
-        let (Some((_, ca)), Some((_, cb))) = (a.piece(pa), b.piece(pb)) else {
-            return Err(Error::WarmStartOutOfRange);
-        };
-        if w.pairs()
-            .iter()
-            .any(|&[i, j]| i as usize >= ca.len() || j as usize >= cb.len())
-        {
-            return Err(Error::WarmStartOutOfRange);
+        for e in w.entries() {
+            let (pa, pb) = (e.pieces[0] as usize, e.pieces[1] as usize);
+            let (Some((_, ca)), Some((_, cb))) = (a.piece(pa), b.piece(pb)) else {
+                return Err(Error::WarmStartOutOfRange);
+            };
+            if e.pairs()
+                .iter()
+                .any(|&[i, j]| i as usize >= ca.len() || j as usize >= cb.len())
+            {
+                return Err(Error::WarmStartOutOfRange);
+            }
         }
     }
-    let warm = warm.filter(|w| options.warm_start && w.len > 0);
+    let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
     // a⁻¹·b: the translations are subtracted before rotating, so poses far from
     // the world origin cancel exactly when the objects are near each other.
     let rel = pose_a.inv_mul(pose_b);
@@ -194,7 +244,7 @@ pub fn distance(
             let run = pair.solve(
                 &mut simplex,
                 options,
-                warm.map(|w| w.pairs()),
+                warm.and_then(|w| w.for_pieces([0, 0])),
                 f64::INFINITY,
             );
             pair.answer(
@@ -539,6 +589,16 @@ impl<'s> Pair<'s> {
         (inner - self.slack).max(0.0)
     }
 
+    /// The certified `(lower, upper)` bounds of a run, after radii, and the
+    /// distance reported between them.
+    #[inline]
+    fn bounds(&self, run: &Run) -> (f64, f64, f64) {
+        let upper = (run.norm + self.slack - self.radii).max(0.0);
+        let lower = (run.lower - self.slack - self.radii).max(0.0);
+        let distance = (run.norm - self.radii).max(0.0).clamp(lower, upper);
+        (lower, upper, distance)
+    }
+
     /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
     /// pieces' offsets in their shapes' body frames.
     fn answer(
@@ -585,9 +645,7 @@ impl<'s> Pair<'s> {
         } else {
             (self.radii - run.norm).max(0.0)
         };
-        let upper = (run.norm + self.slack - self.radii).max(0.0);
-        let lower = (run.lower - self.slack - self.radii).max(0.0);
-        let distance = (run.norm - self.radii).max(0.0).clamp(lower, upper);
+        let (lower, upper, distance) = self.bounds(run);
         Answer {
             distance,
             lower,
@@ -604,9 +662,12 @@ impl<'s> Pair<'s> {
             backup_used: run.backup_used,
             pieces,
             warm_start: WarmStart {
-                pieces,
-                len: len as u8,
-                pairs,
+                first: PieceSimplex {
+                    pieces,
+                    len: len as u8,
+                    pairs,
+                },
+                second: PieceSimplex::default(),
             },
         }
     }
@@ -625,7 +686,18 @@ fn compound(
     warm: Option<&WarmStart>,
 ) -> Answer {
     let (na, nb) = (a.piece_count(), b.piece_count());
-    let mut order: Vec<(f64, u32, u32)> = Vec::with_capacity(na * nb);
+    // Piece pairs with their sphere gaps: on the stack for the usual few
+    // pieces, so a query allocates nothing.
+    const ON_STACK: usize = 16;
+    let mut small = [(0.0f64, 0u32, 0u32); ON_STACK];
+    let mut large = Vec::new();
+    let order: &mut [(f64, u32, u32)] = if na * nb <= ON_STACK {
+        &mut small[..na * nb]
+    } else {
+        large.resize(na * nb, (0.0, 0, 0));
+        &mut large
+    };
+    let mut slot = order.iter_mut();
     for i in 0..na {
         let (oa, ca) = a.piece(i).expect("index below piece_count");
         let centre_a = oa * ca.centroid();
@@ -635,15 +707,22 @@ fn compound(
             let gap = (centre_b - centre_a).norm()
                 - (ca.size() + ca.radius())
                 - (cb.size() + cb.radius());
-            order.push((gap, i as u32, j as u32));
+            if let Some(o) = slot.next() {
+                *o = (gap, i as u32, j as u32);
+            }
         }
     }
-    order.sort_by(|x, y| x.0.total_cmp(&y.0));
-    if let Some(w) = warm
-        && let Some(pos) = order.iter().position(|&(_, i, j)| [i, j] == w.pieces)
-    {
-        let first = order.remove(pos);
-        order.insert(0, first);
+    order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    // Warm piece pairs first, the nearest one in front: its upper bound then
+    // prunes the others from their first iterations.
+    if let Some(w) = warm {
+        for e in [w.second, w.first] {
+            if e.len > 0
+                && let Some(pos) = order.iter().position(|&(_, i, j)| [i, j] == e.pieces)
+            {
+                order[..=pos].rotate_right(1);
+            }
+        }
     }
 
     let mut simplex = Simplex::empty();
@@ -653,6 +732,8 @@ fn compound(
     let mut backup_used = false;
     let mut penetration = 0.0f64;
     let mut trouble: Option<Status> = None;
+    // The two piece pairs with the smallest upper bounds, for the warm start.
+    let mut kept: [(f64, PieceSimplex); 2] = [(f64::INFINITY, PieceSimplex::default()); 2];
     for (k, &(gap, i, j)) in order.iter().enumerate() {
         let cutoff = best.map_or(f64::INFINITY, |b| b.upper);
         // The sphere bound is rough (no slack): only skip on a clear margin.
@@ -663,43 +744,51 @@ fn compound(
         let (ob, cb) = b.piece(j as usize).expect("index below piece_count");
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel, None);
-        let warm_pairs = warm.filter(|w| w.pieces == [i, j]).map(|w| w.pairs());
+        let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
         let run = pair.solve(&mut simplex, options, warm_pairs, cutoff);
-        let ans = pair.answer(
-            &run,
-            &simplex,
-            Place {
-                pose: pose_a,
-                offset: Some(&oa),
-            },
-            Place {
-                pose: pose_b,
-                offset: Some(&ob),
-            },
-            [i, j],
-        );
-        iterations = iterations.saturating_add(ans.iterations);
-        backup_used |= ans.backup_used;
-        lower = lower.min(ans.lower);
-        if run.norm == 0.0 {
-            penetration = penetration.max(ans.penetration);
-        }
-        match run.exit {
-            Exit::Pruned => continue,
-            Exit::Status(Status::IterationCap | Status::ToleranceNotMet) => {
-                // ToleranceNotMet outranks IterationCap: it is the worse news.
-                if trouble != Some(Status::ToleranceNotMet) {
-                    trouble = Some(ans.status);
-                }
+        let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
+        if pair_upper < kept[1].0 {
+            let entry = (pair_upper, PieceSimplex::of(&simplex, run.sol.mask, [i, j]));
+            if pair_upper < kept[0].0 {
+                kept = [entry, kept[0]];
+            } else {
+                kept[1] = entry;
             }
-            Exit::Status(_) => {}
         }
-        let better = best.is_none_or(|b| (ans.upper, ans.distance) < (b.upper, b.distance));
-        if better {
-            best = Some(ans);
+        iterations = iterations.saturating_add(run.iterations);
+        backup_used |= run.backup_used;
+        lower = lower.min(pair_lower);
+        if run.norm == 0.0 {
+            penetration = penetration.max(run.inner + pair.radii);
         }
-        if ans.status == Status::Closer {
-            best = Some(ans);
+        let status = match run.exit {
+            Exit::Pruned => continue,
+            Exit::Status(s) => s,
+        };
+        if matches!(status, Status::IterationCap | Status::ToleranceNotMet)
+            && trouble != Some(Status::ToleranceNotMet)
+        {
+            // ToleranceNotMet outranks IterationCap: it is the worse news.
+            trouble = Some(status);
+        }
+        // Only a pair that becomes the best is turned into an answer.
+        let better = best.is_none_or(|b| (pair_upper, pair_distance) < (b.upper, b.distance));
+        if better || status == Status::Closer {
+            best = Some(pair.answer(
+                &run,
+                &simplex,
+                Place {
+                    pose: pose_a,
+                    offset: Some(&oa),
+                },
+                Place {
+                    pose: pose_b,
+                    offset: Some(&ob),
+                },
+                [i, j],
+            ));
+        }
+        if status == Status::Closer {
             // The pairs not visited still bound the union's distance from
             // below by their sphere gaps (shaded for round-off).
             let rest = order[k + 1..]
@@ -711,6 +800,11 @@ fn compound(
         }
     }
     let mut out = best.expect("the first pair is never skipped or pruned");
+    out.warm_start.second = kept
+        .iter()
+        .map(|k| k.1)
+        .find(|e| e.len > 0 && e.pieces != out.pieces)
+        .unwrap_or_default();
     out.lower = lower.min(out.upper);
     out.iterations = iterations;
     out.backup_used = backup_used;

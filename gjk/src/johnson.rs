@@ -158,8 +158,8 @@ macro_rules! by_shape {
 
 /// For each newest slot `n` and set `all` holding it, the candidates of the
 /// subalgorithm after the "first face" of Section 6: the subsets holding `n`,
-/// smallest first, then the rest (rejected last iteration; tried again for
-/// round-off's sake only).
+/// smallest first (but a full tetrahedron first of all), then the rest
+/// (rejected last iteration; tried again for round-off's sake only).
 const ORDER: [[([u8; 15], u8); 16]; 4] = {
     let mut t = [[([0u8; 15], 0u8); 16]; 4];
     let mut n = 0;
@@ -167,10 +167,17 @@ const ORDER: [[([u8; 15], u8); 16]; 4] = {
         let mut all = 0;
         while all < 16 {
             let (list, len) = &mut t[n][all];
+            // A full tetrahedron is tried right after the first face: when the
+            // origin is inside (the objects intersect) it is the answer, and
+            // when not, its first negative cofactor rejects it at once.
+            if all == 15 {
+                list[0] = 15;
+                *len = 1;
+            }
             let mut k = 0;
             while k < 15 {
                 let m = BY_SIZE[k] as usize;
-                if m & (1 << n) != 0 && m & !all == 0 {
+                if m & (1 << n) != 0 && m & !all == 0 && !(all == 15 && m == 15) {
                     list[*len as usize] = m as u8;
                     *len += 1;
                 }
@@ -526,22 +533,18 @@ impl Simplex {
     /// left to its faces, which then give a `v` within round-off of the origin.
     fn holds_origin(&self) -> bool {
         let [a, b, c, d] = [0, 1, 2, 3].map(|i| self.vertices[i].y);
-        // (p, q, r) -> p·(q×r) with its error bound.
-        let triple = |p: Vector3<f64>, q: Vector3<f64>, r: Vector3<f64>| {
-            let cr = q.cross(&r);
-            (
-                p.dot(&cr),
-                16.0 * f64::EPSILON * p.norm() * q.norm() * r.norm(),
-            )
-        };
         let (ba, ca, da) = (b - a, c - a, d - a);
+        // Each volume p·(q×r) with its error bound 16ε|p||q||r|; the seven
+        // lengths involved are taken once.
+        let [na, nb, nc, nd, nba, nca, nda] = [a, b, c, d, ba, ca, da].map(|x| x.norm());
+        let e = 16.0 * f64::EPSILON;
         let vols = [
-            triple(b, c, d),
-            triple(-a, ca, da),
-            triple(ba, -a, da),
-            triple(ba, ca, -a),
+            (b.dot(&c.cross(&d)), e * nb * nc * nd),
+            ((-a).dot(&ca.cross(&da)), e * na * nca * nda),
+            (ba.dot(&(-a).cross(&da)), e * nba * na * nda),
+            (ba.dot(&ca.cross(&(-a))), e * nba * nca * na),
         ];
-        let (total, _) = triple(ba, ca, da);
+        let total = ba.dot(&ca.cross(&da));
         vols.iter()
             .all(|&(v, err)| v.abs() > err && (v > 0.0) == (total > 0.0))
     }

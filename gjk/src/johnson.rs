@@ -174,11 +174,11 @@ const ORDER: [[([u8; 15], u8); 16]; 4] = {
                 list[0] = 15;
                 *len = 1;
             }
+            let (with, with_len) = WITH_NEW[n][all];
             let mut k = 0;
-            while k < 15 {
-                let m = BY_SIZE[k] as usize;
-                if m & (1 << n) != 0 && m & !all == 0 && !(all == 15 && m == 15) {
-                    list[*len as usize] = m as u8;
+            while k < with_len as usize {
+                if !(all == 15 && with[k] == 15) {
+                    list[*len as usize] = with[k];
                     *len += 1;
                 }
                 k += 1;

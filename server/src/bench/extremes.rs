@@ -7,7 +7,10 @@
 //!   proportion, and the paper's polytopes scaled by the same factors;
 //! - tiny gaps: unit objects 1e-9 to 1e-12 apart, and exact contact;
 //! - degenerate sets: points, segments, flat polygons, duplicated and
-//!   collinear vertices.
+//!   collinear vertices;
+//! - rounded shapes: spheres and capsules against the paper's polytopes and
+//!   each other at random poses (GJK runs on their cores, points and
+//!   segments, and takes the radii off at the end).
 //!
 //! Almost every case is axis-aligned boxes (possibly flat), spheres or
 //! segments placed by translations only, so its distance has a closed form in
@@ -231,5 +234,92 @@ pub fn cases() -> Vec<RawCase> {
     // Flat squares: parallel planes, and side by side in one plane.
     out.push(boxes("degenerate", "flat squares in parallel planes".into(), [1.0, 1.0, 0.0], [0.0; 3], [1.0, 1.0, 0.0], [0.5, 0.25, 0.125]));
     out.push(boxes("degenerate", "flat squares side by side in one plane".into(), [1.0, 1.0, 0.0], [0.0; 3], [1.0, 1.0, 0.0], [2.25, 0.5, 0.0]));
+    rounded(&mut out);
     out
+}
+
+/// A tiny deterministic generator (SplitMix64): the family must be the same
+/// on every run for the reference cache to apply.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    fn direction(&mut self) -> Vector3<f64> {
+        let z = self.range(-1.0, 1.0);
+        let phi = self.range(0.0, std::f64::consts::TAU);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vector3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
+
+/// Spheres against each polytope of the paper's family, and capsules against
+/// capsules, at random poses with gaps from 1e-3 to 3 (references by the
+/// brute force: the radii come off the core distance exactly).
+fn rounded(out: &mut Vec<RawCase>) {
+    let mut rng = Rng(0x0005_eed5);
+    for (i, poly) in gjk::paper::family().into_iter().enumerate() {
+        for k in 0..2 {
+            let r = rng.range(0.2, 1.0);
+            let dir = rng.direction();
+            let reach = poly
+                .vertices()
+                .iter()
+                .map(|v| v.coords.dot(&dir))
+                .fold(f64::NEG_INFINITY, f64::max);
+            let gap = 10f64.powf(rng.range(-3.0, 0.5));
+            let rot = nalgebra::UnitQuaternion::from_scaled_axis(rng.direction() * rng.range(0.0, 3.0));
+            out.push(RawCase {
+                family: "rounded",
+                label: format!("sphere against §7 polytope {} ({k})", i + 1),
+                a: poly.clone().into(),
+                pose_a: Isometry3::identity(),
+                b: Convex::sphere(r).expect("radius").into(),
+                // At least `gap` apart: the support point along `dir` is
+                // the farthest the polytope reaches that way.
+                pose_b: Isometry3::from_parts((dir * (reach + r + gap)).into(), rot),
+                analytic: None,
+            });
+        }
+    }
+    for k in 0..12 {
+        let capsule = |rng: &mut Rng| -> Shape {
+            let half = rng.range(0.2, 2.0);
+            Convex::capsule(
+                Point3::new(0.0, 0.0, -half),
+                Point3::new(0.0, 0.0, half),
+                rng.range(0.05, 0.8),
+            )
+            .expect("capsule")
+            .into()
+        };
+        let a = capsule(&mut rng);
+        let b = capsule(&mut rng);
+        let t = rng.direction() * rng.range(1.0, 5.0);
+        out.push(RawCase {
+            family: "rounded",
+            label: format!("capsule against capsule ({k})"),
+            a,
+            pose_a: Isometry3::from_parts(
+                nalgebra::Translation3::identity(),
+                nalgebra::UnitQuaternion::from_scaled_axis(rng.direction() * rng.range(0.0, 3.0)),
+            ),
+            b,
+            pose_b: Isometry3::from_parts(
+                t.into(),
+                nalgebra::UnitQuaternion::from_scaled_axis(rng.direction() * rng.range(0.0, 3.0)),
+            ),
+            analytic: None,
+        });
+    }
 }

@@ -47,7 +47,7 @@ pub struct LatencyArgs {
     requests: u64,
     /// Longest a configuration may take: fewer requests are sent (never
     /// fewer than --min-requests) when the estimate is longer.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 4.0)]
     max_seconds: f64,
     /// Fewest requests per configuration.
     #[arg(long, default_value_t = 10_000)]
@@ -58,10 +58,43 @@ pub struct LatencyArgs {
     /// Batch sizes (besides the single pair).
     #[arg(long, value_delimiter = ',', default_values_t = [1usize, 8, 64, 512])]
     batches: Vec<usize>,
+    /// Transports to measure (default: all).
+    #[arg(long, value_delimiter = ',', value_enum)]
+    transports: Vec<Transport>,
+    /// Leave the scheduler free to place client and server: by default the
+    /// client is pinned to CPU 0 and every server to CPU 1, as `taskset`
+    /// would, so that a woken server is never queued behind its own spinning
+    /// client on one core.
+    #[arg(long)]
+    no_pin: bool,
+}
+
+/// Pins thread or process `pid` (0: the calling thread) to `cpu`; whether it
+/// worked.
+pub fn pin(pid: libc::pid_t, cpu: usize) -> bool {
+    // SAFETY: a zeroed cpu_set_t is the empty set; CPU_SET writes inside it;
+    // sched_setaffinity reads `size_of::<cpu_set_t>()` bytes of it.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_SET(cpu, &mut set);
+        libc::sched_setaffinity(pid, std::mem::size_of::<libc::cpu_set_t>(), &set) == 0
+    }
+}
+
+/// Lets the calling thread run on every CPU again.
+fn unpin() {
+    // SAFETY: as in `pin`, with every CPU the set can name.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        for cpu in 0..libc::CPU_SETSIZE as usize {
+            libc::CPU_SET(cpu, &mut set);
+        }
+        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
+    }
 }
 
 /// How requests are carried.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Transport {
     /// The handler called directly.
     InProcess,
@@ -266,13 +299,22 @@ fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<ObjectId>) {
     (state, a, b, boxes)
 }
 
-fn start(t: Transport, max_batch: usize, dir: &Path) -> Result<Target, BenchError> {
+fn start(
+    t: Transport,
+    max_batch: usize,
+    dir: &Path,
+    server_cpu: Option<usize>,
+) -> Result<Target, BenchError> {
     if let Some(wait) = t.wait() {
         let service = format!("gjkd-bench-{}-{wait}", std::process::id());
         let server = io(
             "spawn gjkd serve",
             ServerProcess::spawn(&service, &["--wait", wait]),
         )?;
+        if let (Some(cpu), Ok(pid)) = (server_cpu, libc::pid_t::try_from(server.id())) {
+            // The serving loop runs on the process's main thread.
+            pin(pid, cpu);
+        }
         let mut client = Client::builder(&service)
             .timeout(Duration::from_secs(5))
             .connect_timeout(Duration::from_secs(20))
@@ -297,7 +339,10 @@ fn start(t: Transport, max_batch: usize, dir: &Path) -> Result<Target, BenchErro
     let req = Requests::new(a, b, &boxes, max_batch);
     if t == Transport::Uds {
         let path = dir.join(format!("gjkd-bench-{}.sock", std::process::id()));
-        let server = io("bind the unix socket", UdsServer::start(&path, state))?;
+        let server = io(
+            "bind the unix socket",
+            UdsServer::start(&path, state, server_cpu),
+        )?;
         let client = io("connect the unix socket", UdsClient::connect(server.path()))?;
         return Ok(Target::Uds {
             client,
@@ -380,21 +425,41 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
     let mut workloads = vec![Workload::Single];
     workloads.extend(args.batches.iter().map(|&n| Workload::Batch(n.max(1))));
     let gaps = [None, Some(Duration::from_micros(args.gap_us))];
-    let total = Transport::ALL.len() * workloads.len() * gaps.len();
+    let transports: Vec<Transport> = if args.transports.is_empty() {
+        Transport::ALL.to_vec()
+    } else {
+        Transport::ALL
+            .into_iter()
+            .filter(|t| args.transports.contains(t))
+            .collect()
+    };
+    let total = transports.len() * workloads.len() * gaps.len();
     println!(
         "gjkd bench latency: {} transports x {} request shapes x {} pacings, up to {} requests each (at most ~{} s per configuration)\nmachine: {}",
-        Transport::ALL.len(),
+        transports.len(),
         workloads.len(),
         gaps.len(),
         args.requests,
         args.max_seconds,
         super::machine()
     );
+    let pinned = !args.no_pin
+        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+        && pin(0, 0);
+    let server_cpu = pinned.then_some(1);
+    println!(
+        "{}",
+        if pinned {
+            "client pinned to CPU 0, servers to CPU 1"
+        } else {
+            "not pinned: the scheduler places client and servers"
+        }
+    );
     let progress = Progress::new(total as u64);
     let mut rows: Vec<Row> = Vec::new();
-    for t in Transport::ALL {
+    for t in transports {
         progress.step(format!("{}: starting", t.name()));
-        let mut target = start(t, max_batch, &dir)?;
+        let mut target = start(t, max_batch, &dir, server_cpu)?;
         for gap in gaps {
             for &w in &workloads {
                 let pacing = gap.map_or("back-to-back".into(), |g| format!("gap {} µs", g.as_micros()));
@@ -414,10 +479,13 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
         drop(target);
     }
     progress.finish();
-    report(&rows, &dir, &args)
+    if pinned {
+        unpin();
+    }
+    report(&rows, &dir, &args, pinned)
 }
 
-fn report(rows: &[Row], dir: &Path, args: &LatencyArgs) -> Result<(), BenchError> {
+fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<(), BenchError> {
     let mut csv = Csv::new(&[
         "transport", "request", "pacing", "requests", "p50_us", "p90_us", "p99_us", "p99_9_us",
         "max_us", "mean_us",
@@ -472,13 +540,19 @@ fn report(rows: &[Row], dir: &Path, args: &LatencyArgs) -> Result<(), BenchError
     }
     println!("\n{md}{summary}");
     let mut doc = format!(
-        "Machine: {}\n\nCommand: `gjkd bench latency{}` (requests per configuration: up to {}, at most ~{} s each, at least {}; gap {} µs)\n\n",
+        "Machine: {}\n\nCommand: `gjkd bench latency{}{}` (requests per configuration: up to {}, at most ~{} s each, at least {}; gap {} µs; {})\n\n",
         super::machine(),
         if args.common.quick { " --quick" } else { "" },
+        if args.no_pin { " --no-pin" } else { "" },
         args.requests,
         args.max_seconds,
         args.min_requests,
-        args.gap_us
+        args.gap_us,
+        if pinned {
+            "client on CPU 0, servers on CPU 1"
+        } else {
+            "threads not pinned"
+        }
     );
     doc.push_str(&md);
     doc.push_str(&summary);
@@ -539,7 +613,7 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
         let mut charts = Vec::new();
         let workloads: Vec<Workload> = rows
             .iter()
-            .filter(|r| r.transport == Transport::Spin && !r.gap.is_some_and(|_| !gapped) && r.gap.is_some() == gapped)
+            .filter(|r| r.transport == Transport::Spin && r.gap.is_some() == gapped)
             .map(|r| r.workload)
             .collect();
         for w in workloads {
@@ -559,9 +633,12 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
             let y = Axis::fit(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), true);
             charts.push(Chart {
                 title: format!("{}, {what}: round trip by percentile", w.name()),
-                x: Axis::linear("percentile (log scale of 1 - q)", (0.0, 5.0)).with_ticks(nines),
+                x: Axis::linear("percentile (log scale of 1 - q)", (0.0, 5.0))
+                    .with_ticks(nines)
+                    .with_labels(6),
                 y: Axis::log("round trip, µs (log)", y).with_ticks(us_ticks),
                 series,
+                legend: plot::Corner::LowerRight,
             });
         }
         let path = dir.join(file);
@@ -593,6 +670,7 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
             x: Axis::log("pairs per request (log)", x).with_ticks(|v| format!("{v:.0}")),
             y: Axis::log("p50 round trip, µs (log)", y).with_ticks(us_ticks),
             series,
+            legend: plot::Corner::UpperLeft,
         });
     }
     let path = dir.join("latency-p50.svg");
@@ -617,8 +695,8 @@ mod tests {
     fn in_process_and_socket_answers_agree() {
         // The baselines answer the very requests the servers get.
         let dir = std::env::temp_dir();
-        let mut local = start(Transport::InProcess, 8, &dir).expect("local");
-        let mut uds = start(Transport::Uds, 8, &dir).expect("uds");
+        let mut local = start(Transport::InProcess, 8, &dir, None).expect("local");
+        let mut uds = start(Transport::Uds, 8, &dir, None).expect("uds");
         for t in [&mut local, &mut uds] {
             t.call(Workload::Batch(8)).expect("batch");
             t.call(Workload::Single).expect("single");

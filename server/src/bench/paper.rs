@@ -245,12 +245,14 @@ fn report(args: &PaperArgs, dir: &Path, points: &[Point], iterations: &[f64]) ->
             x: Axis::linear("M = total vertices of the pair", (0.0, 210.0)),
             y: Axis::linear("mean time per query, ns", (0.0, y_max)),
             series: time_series,
+            legend: plot::Corner::UpperLeft,
         },
         Chart {
             title: "time per vertex against M".into(),
             x: Axis::linear("M = total vertices of the pair", (0.0, 210.0)),
             y: Axis::log("time per query / M, ns (log)", v),
             series: vertex_series,
+            legend: plot::Corner::UpperRight,
         },
     ];
     let path = dir.join("paper-figure2.svg");

@@ -45,6 +45,8 @@ pub struct Axis {
     pub range: (f64, f64),
     /// Tick label text for a value; `None` for plotters' default.
     pub ticks: Option<fn(&f64) -> String>,
+    /// How many tick labels plotters should aim for.
+    pub labels: usize,
 }
 
 impl Axis {
@@ -55,6 +57,7 @@ impl Axis {
             log: false,
             range,
             ticks: None,
+            labels: 10,
         }
     }
 
@@ -69,6 +72,12 @@ impl Axis {
     /// The same axis with these tick labels.
     pub fn with_ticks(mut self, ticks: fn(&f64) -> String) -> Self {
         self.ticks = Some(ticks);
+        self
+    }
+
+    /// The same axis aiming at `n` tick labels.
+    pub fn with_labels(mut self, n: usize) -> Self {
+        self.labels = n;
         self
     }
 
@@ -105,6 +114,22 @@ pub struct Chart {
     pub y: Axis,
     /// What to draw.
     pub series: Vec<Series>,
+    /// Where the legend goes: a corner the data leaves empty.
+    pub legend: Corner,
+}
+
+/// A corner of the plot area.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Corner {
+    /// Upper left.
+    #[default]
+    UpperLeft,
+    /// Upper right.
+    UpperRight,
+    /// Lower right.
+    LowerRight,
+    /// Lower left.
+    LowerLeft,
 }
 
 /// Colour `i` of a palette that stays readable on white.
@@ -182,6 +207,8 @@ where
     ctx.configure_mesh()
         .x_desc(chart.x.label.as_str())
         .y_desc(chart.y.label.as_str())
+        .x_labels(chart.x.labels)
+        .y_labels(chart.y.labels)
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .light_line_style(WHITE.mix(0.0))
@@ -217,7 +244,12 @@ where
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.3))
             .label_font(("sans-serif", 12))
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(match chart.legend {
+                Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+                Corner::UpperRight => SeriesLabelPosition::UpperRight,
+                Corner::LowerRight => SeriesLabelPosition::LowerRight,
+                Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            })
             .draw()
             .map_err(err)?;
     }
@@ -252,6 +284,7 @@ mod tests {
                 mark: Mark::LinePoints,
                 color: 0,
             }],
+            legend: Corner::LowerRight,
         };
         render(&path, &[chart.clone(), chart], 2, (300, 200)).expect("render");
         let svg = std::fs::read_to_string(&path).expect("svg");

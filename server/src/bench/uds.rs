@@ -59,11 +59,11 @@ pub struct UdsServer {
 
 impl UdsServer {
     /// Binds `path` (removing a stale socket file first) and serves `state`
-    /// on a new thread until dropped.
+    /// on a new thread, pinned to `cpu` if given, until dropped.
     ///
     /// # Errors
     /// When the socket cannot be bound.
-    pub fn start(path: &Path, mut state: State) -> std::io::Result<Self> {
+    pub fn start(path: &Path, mut state: State, cpu: Option<usize>) -> std::io::Result<Self> {
         let _ = std::fs::remove_file(path);
         let listener = UnixListener::bind(path)?;
         let stop = Arc::new(AtomicBool::new(false));
@@ -71,6 +71,9 @@ impl UdsServer {
         let thread = std::thread::Builder::new()
             .name("gjkd-uds".into())
             .spawn(move || {
+                if let Some(cpu) = cpu {
+                    super::latency::pin(0, cpu);
+                }
                 for conn in listener.incoming() {
                     if flag.load(Ordering::Relaxed) {
                         break;
@@ -223,7 +226,7 @@ mod tests {
             Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(7), &QueryOptions::cold()),
         ];
         let path = std::env::temp_dir().join(format!("gjkd-uds-test-{}.sock", std::process::id()));
-        let server = UdsServer::start(&path, state).expect("bind");
+        let server = UdsServer::start(&path, state, None).expect("bind");
         let mut client = UdsClient::connect(server.path()).expect("connect");
         let mut out = [ItemResult::default(); 2];
         for _ in 0..3 {

@@ -24,13 +24,13 @@ pub struct PaperArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Examples per pair and situation.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 100)]
     per_pair: usize,
     /// Calls per timed block.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = 64)]
     reps: u32,
     /// Timing passes; the fastest block of each example is kept.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 5)]
     passes: u32,
 }
 

@@ -612,4 +612,37 @@ mod tests {
         );
         assert!((r.distance - 4.0).abs() < 1e-15);
     }
+
+    #[test]
+    fn paper_family_matches_its_construction() {
+        // The paper's cases are built by sliding along near-point lines, so
+        // a separated case's gap is known; touching and intersecting cases
+        // are at distance 0. (Five pairs, small sets and the facet search
+        // both: the brute force is slow unoptimised.)
+        use gjk::paper::{self, Case};
+        let family = paper::family();
+        let hulls: Vec<Option<Hull>> = family
+            .iter()
+            .enumerate()
+            .map(|(i, c)| [0, 1, 2, 3, 6, 8].contains(&i).then(|| Hull::new(c.vertices())))
+            .collect();
+        for case in Case::ALL {
+            for c in paper::cases(case, 1, 5) {
+                let (Some(ha), Some(hb)) = (&hulls[c.a], &hulls[c.b]) else {
+                    continue;
+                };
+                let r = distance(ha, &c.pose_a, 0.0, hb, &c.pose_b, 0.0);
+                match case {
+                    Case::Separated => {
+                        assert!(r.separated, "pair {}", c.pair);
+                        assert!((r.distance - c.expected).abs() < 1e-9, "pair {}: {r:?} vs {}", c.pair, c.expected);
+                    }
+                    Case::Touching => assert!(r.distance < 1e-9, "pair {}: {r:?}", c.pair),
+                    Case::Intersecting => {
+                        assert!(!r.separated && r.distance == 0.0, "pair {}: {r:?}", c.pair);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -39,13 +39,13 @@ pub struct TradeoffArgs {
     common: CommonArgs,
     /// Examples per pair and situation of the paper's family (20 pairs, 3
     /// situations).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 25)]
     per_pair: usize,
     /// Calls per timed block.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 32)]
     reps: u32,
     /// Timing passes; the fastest block of each query and setting is kept.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 5)]
     passes: u32,
     /// Where the reference distances are cached.
     #[arg(long, default_value = "target/gjkd-bench")]
@@ -677,7 +677,8 @@ fn report(
     println!("\n{text}");
     io("write tradeoff.csv", csv.write(&dir.join("tradeoff.csv")))?;
     io("write tradeoff.md", std::fs::write(dir.join("tradeoff.md"), &text))?;
-    // Per-query errors, for anyone who wants to look at the worst cases.
+    // Per-query times and errors, for anyone who wants to look at the worst
+    // cases.
     let mut detail = Csv::new(&["setting", "family", "query", "truth", "size", "ns", "error_rel_size"]);
     for (s, o) in settings.iter().zip(outcomes) {
         for ((q, ns), e) in queries.iter().zip(&o.ns).zip(&o.err) {
@@ -692,14 +693,14 @@ fn report(
             ]);
         }
     }
-    io(
-        "write tradeoff-queries.csv",
-        detail.write(&dir.join("tradeoff-queries.csv")),
-    )?;
+    // Large: kept beside the reference cache rather than in --out.
+    let detail_path = args.cache_dir.join("tradeoff-queries.csv");
+    io("write tradeoff-queries.csv", detail.write(&detail_path))?;
     pareto_plot(dir, settings, &sums)?;
     println!(
-        "wrote {0}/tradeoff.csv, {0}/tradeoff.md, {0}/tradeoff-queries.csv, {0}/tradeoff-pareto.svg",
-        dir.display()
+        "wrote {0}/tradeoff.csv, {0}/tradeoff.md, {0}/tradeoff-pareto.svg, {1}",
+        dir.display(),
+        detail_path.display()
     );
     Ok(())
 }

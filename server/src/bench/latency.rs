@@ -61,6 +61,11 @@ pub struct LatencyArgs {
     /// Transports to measure (default: all).
     #[arg(long, value_delimiter = ',', value_enum)]
     transports: Vec<Transport>,
+    /// Rounds: every configuration is measured a share at a time in each
+    /// round, servers restarted, so slow spells of a shared machine fall on
+    /// all transports alike.
+    #[arg(long, default_value_t = 4)]
+    rounds: usize,
     /// Leave the scheduler free to place client and server: by default the
     /// client is pinned to CPU 0 and every server to CPU 1, as `taskset`
     /// would, so that a woken server is never queued behind its own spinning
@@ -455,29 +460,68 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
             "not pinned: the scheduler places client and servers"
         }
     );
-    let progress = Progress::new(total as u64);
-    let mut rows: Vec<Row> = Vec::new();
-    for t in transports {
-        progress.step(format!("{}: starting", t.name()));
-        let mut target = start(t, max_batch, &dir, server_cpu)?;
+    let rounds = if args.common.quick { 1 } else { args.rounds.max(1) };
+    let progress = Progress::new((total * rounds) as u64);
+    // Every configuration is measured a share at a time in each round, and
+    // each round starts every server afresh: load that comes and goes on a
+    // shared machine then falls on all transports alike, and the ratios
+    // between them hold.
+    let mut configs: Vec<(Transport, Option<Duration>, Workload)> = Vec::new();
+    for &t in &transports {
         for gap in gaps {
             for &w in &workloads {
-                let pacing = gap.map_or("back-to-back".into(), |g| format!("gap {} µs", g.as_micros()));
-                progress.step(format!("{} {} {}: warming up", t.name(), w.name(), pacing));
-                let n = plan(&args, &mut target, w, gap)?;
-                progress.step(format!("{} {} {}: {n} requests", t.name(), w.name(), pacing));
-                let hist = measure(&mut target, w, gap, n)?;
-                rows.push(Row {
-                    transport: t,
-                    workload: w,
-                    gap,
-                    hist,
-                });
-                progress.inc();
+                configs.push((t, gap, w));
             }
         }
-        drop(target);
     }
+    let mut planned: Vec<u64> = vec![0; configs.len()];
+    let mut hists: Vec<Option<Histogram<u64>>> = vec![None; configs.len()];
+    for round in 0..rounds {
+        for &t in &transports {
+            progress.step(format!("round {}/{rounds}, {}: starting", round + 1, t.name()));
+            let mut target = start(t, max_batch, &dir, server_cpu)?;
+            for (ci, &(ct, gap, w)) in configs.iter().enumerate() {
+                if ct != t {
+                    continue;
+                }
+                let pacing = gap.map_or("back-to-back".into(), |g| format!("gap {} µs", g.as_micros()));
+                let what = format!("round {}/{rounds}, {} {} {}", round + 1, t.name(), w.name(), pacing);
+                progress.step(format!("{what}: warming up"));
+                // The first round also sizes the configuration to the budget;
+                // later ones only warm the caches up.
+                if round == 0 {
+                    planned[ci] = plan(&args, &mut target, w, gap)?;
+                } else {
+                    for _ in 0..100 {
+                        target.call(w)?;
+                    }
+                }
+                let share = planned[ci].div_ceil(rounds as u64);
+                progress.step(format!("{what}: {share} of {} requests", planned[ci]));
+                let h = measure(&mut target, w, gap, share)?;
+                match &mut hists[ci] {
+                    Some(all) => all
+                        .add(&h)
+                        .map_err(|e| BenchError::Other(format!("histogram: {e}")))?,
+                    slot => *slot = Some(h),
+                }
+                progress.inc();
+            }
+            drop(target);
+        }
+    }
+    let rows: Vec<Row> = configs
+        .iter()
+        .zip(hists)
+        .filter_map(|(&(transport, gap, workload), hist)| {
+            hist.map(|hist| Row {
+                transport,
+                workload,
+                gap,
+                hist,
+            })
+        })
+        .collect();
     progress.finish();
     if pinned {
         unpin();
@@ -540,13 +584,14 @@ fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<
     }
     println!("\n{md}{summary}");
     let mut doc = format!(
-        "Machine: {}\n\nCommand: `gjkd bench latency{}{}` (requests per configuration: up to {}, at most ~{} s each, at least {}; gap {} µs; {})\n\n",
+        "Machine: {}\n\nCommand: `gjkd bench latency{}{}` (requests per configuration: up to {}, at most ~{} s each, at least {}, in {} rounds; gap {} µs; {})\n\n",
         super::machine(),
         if args.common.quick { " --quick" } else { "" },
         if args.no_pin { " --no-pin" } else { "" },
         args.requests,
         args.max_seconds,
         args.min_requests,
+        if args.common.quick { 1 } else { args.rounds },
         args.gap_us,
         if pinned {
             "client on CPU 0, servers on CPU 1"

@@ -48,14 +48,24 @@ fn latency_quick_writes_table_csv_and_plots() {
         "--gap-us",
         "20",
     ]);
-    assert!(stdout.contains("Single pair, back to back: p50 spin"), "{stdout}");
+    assert!(
+        stdout.contains("Single pair, back to back: p50 spin"),
+        "{stdout}"
+    );
     let csv = std::fs::read_to_string(dir.join("latency.csv")).expect("latency.csv");
     // Header + 5 transports x 3 request shapes x 2 pacings.
     assert_eq!(csv.lines().count(), 1 + 5 * 3 * 2, "{csv}");
     for t in ["spin", "adaptive", "block", "uds", "in-process"] {
-        assert!(csv.lines().any(|l| l.starts_with(&format!("{t},single,back-to-back"))));
+        assert!(
+            csv.lines()
+                .any(|l| l.starts_with(&format!("{t},single,back-to-back")))
+        );
     }
-    for f in ["latency-back-to-back.svg", "latency-gaps.svg", "latency-p50.svg"] {
+    for f in [
+        "latency-back-to-back.svg",
+        "latency-gaps.svg",
+        "latency-p50.svg",
+    ] {
         let svg = std::fs::read_to_string(dir.join(f)).expect(f);
         assert!(svg.starts_with("<svg"), "{f}");
     }

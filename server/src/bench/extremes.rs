@@ -51,7 +51,14 @@ fn at(t: [f64; 3]) -> Isometry3<f64> {
 
 /// Boxes of half extents `ha`, `hb` at centres `ca`, `cb`, with the closed
 /// form from the inputs as they are in `f64`.
-fn boxes(family: &'static str, label: String, ha: [f64; 3], ca: [f64; 3], hb: [f64; 3], cb: [f64; 3]) -> RawCase {
+fn boxes(
+    family: &'static str,
+    label: String,
+    ha: [f64; 3],
+    ca: [f64; 3],
+    hb: [f64; 3],
+    cb: [f64; 3],
+) -> RawCase {
     let d = super::reference::aabb_distance(
         &Vector3::from(ca),
         &Vector3::from(ha),
@@ -100,7 +107,11 @@ pub fn cases() -> Vec<RawCase> {
         for rel_gap in [1e-1, 1e-4, 1e-9] {
             let h = [scale, 0.5 * scale, 0.25 * scale];
             out.push(boxes(
-                if scale < 1.0 { "tiny scale" } else { "huge scale" },
+                if scale < 1.0 {
+                    "tiny scale"
+                } else {
+                    "huge scale"
+                },
                 format!("boxes of size {scale:e}, gap {rel_gap:e} of it"),
                 h,
                 [0.0; 3],
@@ -111,7 +122,11 @@ pub fn cases() -> Vec<RawCase> {
         let r = scale;
         let gap = 1e-3 * scale;
         out.push(RawCase {
-            family: if scale < 1.0 { "tiny scale" } else { "huge scale" },
+            family: if scale < 1.0 {
+                "tiny scale"
+            } else {
+                "huge scale"
+            },
             label: format!("spheres of radius {scale:e}, gap 1e-3 of it"),
             a: Convex::sphere(r).expect("radius").into(),
             pose_a: Isometry3::identity(),
@@ -145,9 +160,30 @@ pub fn cases() -> Vec<RawCase> {
             analytic: Some((1.0 + gap) - 1.0),
         });
     }
-    out.push(boxes("tiny gap", "unit boxes touching face to face".into(), [1.0; 3], [0.0; 3], [1.0; 3], [2.0, 0.5, 0.25]));
-    out.push(boxes("tiny gap", "unit boxes touching edge to edge".into(), [1.0; 3], [0.0; 3], [1.0; 3], [2.0, 2.0, 0.25]));
-    out.push(boxes("tiny gap", "unit boxes overlapping by 1e-9".into(), [1.0; 3], [0.0; 3], [1.0; 3], [2.0 - 1e-9, 0.5, 0.25]));
+    out.push(boxes(
+        "tiny gap",
+        "unit boxes touching face to face".into(),
+        [1.0; 3],
+        [0.0; 3],
+        [1.0; 3],
+        [2.0, 0.5, 0.25],
+    ));
+    out.push(boxes(
+        "tiny gap",
+        "unit boxes touching edge to edge".into(),
+        [1.0; 3],
+        [0.0; 3],
+        [1.0; 3],
+        [2.0, 2.0, 0.25],
+    ));
+    out.push(boxes(
+        "tiny gap",
+        "unit boxes overlapping by 1e-9".into(),
+        [1.0; 3],
+        [0.0; 3],
+        [1.0; 3],
+        [2.0 - 1e-9, 0.5, 0.25],
+    ));
     // Degenerate sets.
     let point: Shape = Convex::sphere(0.0).expect("point").into();
     out.push(RawCase {
@@ -171,9 +207,13 @@ pub fn cases() -> Vec<RawCase> {
     let segment = |axis: usize| -> Shape {
         let mut e = [0.0; 3];
         e[axis] = 1.0;
-        Convex::capsule(Point3::from(-Vector3::from(e)), Point3::from(Vector3::from(e)), 0.0)
-            .expect("segment")
-            .into()
+        Convex::capsule(
+            Point3::from(-Vector3::from(e)),
+            Point3::from(Vector3::from(e)),
+            0.0,
+        )
+        .expect("segment")
+        .into()
     };
     out.push(RawCase {
         family: "degenerate",
@@ -204,11 +244,7 @@ pub fn cases() -> Vec<RawCase> {
     });
     // A box whose every vertex is given three times.
     let cube = Convex::cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0).expect("cube");
-    let tripled: Vec<Point3<f64>> = cube
-        .vertices()
-        .iter()
-        .flat_map(|v| [*v, *v, *v])
-        .collect();
+    let tripled: Vec<Point3<f64>> = cube.vertices().iter().flat_map(|v| [*v, *v, *v]).collect();
     out.push(RawCase {
         family: "degenerate",
         label: "box with every vertex three times".into(),
@@ -232,8 +268,22 @@ pub fn cases() -> Vec<RawCase> {
         analytic: Some(1.0),
     });
     // Flat squares: parallel planes, and side by side in one plane.
-    out.push(boxes("degenerate", "flat squares in parallel planes".into(), [1.0, 1.0, 0.0], [0.0; 3], [1.0, 1.0, 0.0], [0.5, 0.25, 0.125]));
-    out.push(boxes("degenerate", "flat squares side by side in one plane".into(), [1.0, 1.0, 0.0], [0.0; 3], [1.0, 1.0, 0.0], [2.25, 0.5, 0.0]));
+    out.push(boxes(
+        "degenerate",
+        "flat squares in parallel planes".into(),
+        [1.0, 1.0, 0.0],
+        [0.0; 3],
+        [1.0, 1.0, 0.0],
+        [0.5, 0.25, 0.125],
+    ));
+    out.push(boxes(
+        "degenerate",
+        "flat squares side by side in one plane".into(),
+        [1.0, 1.0, 0.0],
+        [0.0; 3],
+        [1.0, 1.0, 0.0],
+        [2.25, 0.5, 0.0],
+    ));
     rounded(&mut out);
     out
 }
@@ -278,7 +328,8 @@ fn rounded(out: &mut Vec<RawCase>) {
                 .map(|v| v.coords.dot(&dir))
                 .fold(f64::NEG_INFINITY, f64::max);
             let gap = 10f64.powf(rng.range(-3.0, 0.5));
-            let rot = nalgebra::UnitQuaternion::from_scaled_axis(rng.direction() * rng.range(0.0, 3.0));
+            let rot =
+                nalgebra::UnitQuaternion::from_scaled_axis(rng.direction() * rng.range(0.0, 3.0));
             out.push(RawCase {
                 family: "rounded",
                 label: format!("sphere against §7 polytope {} ({k})", i + 1),

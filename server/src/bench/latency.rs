@@ -249,7 +249,9 @@ enum Target {
 impl Target {
     fn call(&mut self, w: Workload) -> Result<(), BenchError> {
         match self {
-            Target::Ipc { client, a, b, req, .. } => match w {
+            Target::Ipc {
+                client, a, b, req, ..
+            } => match w {
                 Workload::Single => {
                     black_box(client.distance(*a, *b, &QueryOptions::default())?);
                 }
@@ -460,7 +462,11 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
             "not pinned: the scheduler places client and servers"
         }
     );
-    let rounds = if args.common.quick { 1 } else { args.rounds.max(1) };
+    let rounds = if args.common.quick {
+        1
+    } else {
+        args.rounds.max(1)
+    };
     let progress = Progress::new((total * rounds) as u64);
     // Every configuration is measured a share at a time in each round, and
     // each round starts every server afresh: load that comes and goes on a
@@ -478,14 +484,26 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
     let mut hists: Vec<Option<Histogram<u64>>> = vec![None; configs.len()];
     for round in 0..rounds {
         for &t in &transports {
-            progress.step(format!("round {}/{rounds}, {}: starting", round + 1, t.name()));
+            progress.step(format!(
+                "round {}/{rounds}, {}: starting",
+                round + 1,
+                t.name()
+            ));
             let mut target = start(t, max_batch, &dir, server_cpu)?;
             for (ci, &(ct, gap, w)) in configs.iter().enumerate() {
                 if ct != t {
                     continue;
                 }
-                let pacing = gap.map_or("back-to-back".into(), |g| format!("gap {} µs", g.as_micros()));
-                let what = format!("round {}/{rounds}, {} {} {}", round + 1, t.name(), w.name(), pacing);
+                let pacing = gap.map_or("back-to-back".into(), |g| {
+                    format!("gap {} µs", g.as_micros())
+                });
+                let what = format!(
+                    "round {}/{rounds}, {} {} {}",
+                    round + 1,
+                    t.name(),
+                    w.name(),
+                    pacing
+                );
                 progress.step(format!("{what}: warming up"));
                 // The first round also sizes the configuration to the budget;
                 // later ones only warm the caches up.
@@ -531,8 +549,16 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
 
 fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<(), BenchError> {
     let mut csv = Csv::new(&[
-        "transport", "request", "pacing", "requests", "p50_us", "p90_us", "p99_us", "p99_9_us",
-        "max_us", "mean_us",
+        "transport",
+        "request",
+        "pacing",
+        "requests",
+        "p50_us",
+        "p90_us",
+        "p99_us",
+        "p99_9_us",
+        "max_us",
+        "mean_us",
     ]);
     let mut md = String::new();
     md.push_str("| transport | request | pacing | requests | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
@@ -602,7 +628,10 @@ fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<
     doc.push_str(&md);
     doc.push_str(&summary);
     io("write latency.csv", csv.write(&dir.join("latency.csv")))?;
-    io("write latency.md", std::fs::write(dir.join("latency.md"), doc))?;
+    io(
+        "write latency.md",
+        std::fs::write(dir.join("latency.md"), doc),
+    )?;
     plots(rows, dir)?;
     println!(
         "wrote {0}/latency.csv, {0}/latency.md, {0}/latency-back-to-back.svg, {0}/latency-gaps.svg, {0}/latency-p50.svg",
@@ -675,7 +704,10 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
                     color: color(r.transport),
                 })
                 .collect();
-            let y = Axis::fit(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), true);
+            let y = Axis::fit(
+                series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+                true,
+            );
             charts.push(Chart {
                 title: format!("{}, {what}: round trip by percentile", w.name()),
                 x: Axis::linear("percentile (log scale of 1 - q)", (0.0, 5.0))
@@ -708,8 +740,14 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
                 color: color(t),
             })
             .collect();
-        let x = Axis::fit(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), true);
-        let y = Axis::fit(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), true);
+        let x = Axis::fit(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+            true,
+        );
+        let y = Axis::fit(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+            true,
+        );
         charts.push(Chart {
             title: format!("median round trip against batch size, {what}"),
             x: Axis::log("pairs per request (log)", x).with_ticks(|v| format!("{v:.0}")),

@@ -108,14 +108,18 @@ pub fn run(args: &PaperArgs) -> Result<(), BenchError> {
                 .iter()
                 .filter(|c| c.pair == pair)
                 .map(|c| {
-                    gjk::distance(&shapes[c.a], &c.pose_a, &shapes[c.b], &c.pose_b, &options, None)
-                        .map_or(f64::NAN, |a| f64::from(a.iterations))
+                    gjk::distance(
+                        &shapes[c.a],
+                        &c.pose_a,
+                        &shapes[c.b],
+                        &c.pose_b,
+                        &options,
+                        None,
+                    )
+                    .map_or(f64::NAN, |a| f64::from(a.iterations))
                 })
                 .collect();
-            let m = examples
-                .iter()
-                .find(|c| c.pair == pair)
-                .map_or(0, |c| c.m);
+            let m = examples.iter().find(|c| c.pair == pair).map_or(0, |c| c.m);
             points.push(Point {
                 case,
                 m,
@@ -144,8 +148,19 @@ fn verdict(f: &Fit) -> String {
     }
 }
 
-fn report(args: &PaperArgs, dir: &Path, points: &[Point], iterations: &[f64]) -> Result<(), BenchError> {
-    let mut csv = Csv::new(&["situation", "M", "mean_ns_per_query", "ns_per_vertex", "mean_iterations"]);
+fn report(
+    args: &PaperArgs,
+    dir: &Path,
+    points: &[Point],
+    iterations: &[f64],
+) -> Result<(), BenchError> {
+    let mut csv = Csv::new(&[
+        "situation",
+        "M",
+        "mean_ns_per_query",
+        "ns_per_vertex",
+        "mean_iterations",
+    ]);
     for (p, it) in points.iter().zip(iterations) {
         csv.row(&[
             p.case.name().to_owned(),
@@ -207,7 +222,10 @@ fn report(args: &PaperArgs, dir: &Path, points: &[Point], iterations: &[f64]) ->
     );
     println!("\n{text}");
     io("write paper.csv", csv.write(&dir.join("paper.csv")))?;
-    io("write paper.md", std::fs::write(dir.join("paper.md"), &text))?;
+    io(
+        "write paper.md",
+        std::fs::write(dir.join("paper.md"), &text),
+    )?;
 
     let mut time_series = Vec::new();
     let mut vertex_series = Vec::new();
@@ -225,7 +243,13 @@ fn report(args: &PaperArgs, dir: &Path, points: &[Point], iterations: &[f64]) ->
             color: ci,
         });
         time_series.push(Series {
-            name: format!("{} fit: {:.0} + {:.2}·M ns, R² {:.2}", case.name(), f.intercept, f.slope, f.r2),
+            name: format!(
+                "{} fit: {:.0} + {:.2}·M ns, R² {:.2}",
+                case.name(),
+                f.intercept,
+                f.slope,
+                f.r2
+            ),
             points: vec![(0.0, f.intercept), (210.0, f.intercept + 210.0 * f.slope)],
             mark: Mark::Line,
             color: ci,
@@ -238,7 +262,12 @@ fn report(args: &PaperArgs, dir: &Path, points: &[Point], iterations: &[f64]) ->
         });
     }
     let y_max = points.iter().map(|p| p.ns).fold(0.0, f64::max) * 1.15;
-    let v = Axis::fit(vertex_series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), true);
+    let v = Axis::fit(
+        vertex_series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.1)),
+        true,
+    );
     let charts = [
         Chart {
             title: "Section 7 (Figure 2): time per query against M".into(),

@@ -453,9 +453,7 @@ pub fn distance(
     // The direction between the nearest candidates separates whenever the
     // hulls are apart; only when it does not is the full axis search needed.
     let witness = (cand > 0.0).then(|| y - x);
-    let quick = witness.map_or(f64::NEG_INFINITY, |w| {
-        gap_along(&pa, &pb, &(w / cand), &x)
-    });
+    let quick = witness.map_or(f64::NEG_INFINITY, |w| gap_along(&pa, &pb, &(w / cand), &x));
     let gap = if quick > 1e-13 * span {
         quick
     } else {
@@ -624,7 +622,11 @@ mod tests {
         let hulls: Vec<Option<Hull>> = family
             .iter()
             .enumerate()
-            .map(|(i, c)| [0, 1, 2, 3, 6, 8].contains(&i).then(|| Hull::new(c.vertices())))
+            .map(|(i, c)| {
+                [0, 1, 2, 3, 6, 8]
+                    .contains(&i)
+                    .then(|| Hull::new(c.vertices()))
+            })
             .collect();
         for case in Case::ALL {
             for c in paper::cases(case, 1, 5) {
@@ -635,7 +637,12 @@ mod tests {
                 match case {
                     Case::Separated => {
                         assert!(r.separated, "pair {}", c.pair);
-                        assert!((r.distance - c.expected).abs() < 1e-9, "pair {}: {r:?} vs {}", c.pair, c.expected);
+                        assert!(
+                            (r.distance - c.expected).abs() < 1e-9,
+                            "pair {}: {r:?} vs {}",
+                            c.pair,
+                            c.expected
+                        );
                     }
                     Case::Touching => assert!(r.distance < 1e-9, "pair {}: {r:?}", c.pair),
                     Case::Intersecting => {

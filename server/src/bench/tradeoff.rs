@@ -430,7 +430,11 @@ pub fn run(args: &TradeoffArgs) -> Result<(), BenchError> {
                     margin: s.margin.map(|f| f * q.size),
                     ..s.options
                 };
-                let warm = if options.warm_start { q.warm.as_ref() } else { None };
+                let warm = if options.warm_start {
+                    q.warm.as_ref()
+                } else {
+                    None
+                };
                 if answers[si][qi].is_none() {
                     answers[si][qi] =
                         Some(gjk::distance(a, &q.pose_a, b, &q.pose_b, &options, warm)?);
@@ -470,10 +474,16 @@ pub fn run(args: &TradeoffArgs) -> Result<(), BenchError> {
                 by_family: BTreeMap::new(),
             };
             for (qi, q) in queries.iter().enumerate() {
-                let Some(ans) = &answers[si][qi] else { continue };
+                let Some(ans) = &answers[si][qi] else {
+                    continue;
+                };
                 let e = (ans.distance - q.truth).abs() / q.size;
                 o.err.push(e);
-                let fam = if q.family.starts_with('§') { "§7" } else { "extremes" };
+                let fam = if q.family.starts_with('§') {
+                    "§7"
+                } else {
+                    "extremes"
+                };
                 let slot = o.by_family.entry(fam.to_owned()).or_insert(0.0);
                 *slot = slot.max(e);
                 if q.truth > 0.0 {
@@ -541,9 +551,21 @@ fn report(
         .unwrap_or(0);
     let base_ns = sums[base].mean_ns;
     let mut csv = Csv::new(&[
-        "setting", "group", "mean_ns", "p50_ns", "p99_ns", "speedup_vs_default", "max_err_rel_size",
-        "mean_err_rel_size", "max_err_rel_distance", "max_err_rel_size_s7", "max_err_rel_size_extremes",
-        "bounds_missed", "wrong_decisions", "iteration_capped", "queries",
+        "setting",
+        "group",
+        "mean_ns",
+        "p50_ns",
+        "p99_ns",
+        "speedup_vs_default",
+        "max_err_rel_size",
+        "mean_err_rel_size",
+        "max_err_rel_distance",
+        "max_err_rel_size_s7",
+        "max_err_rel_size_extremes",
+        "bounds_missed",
+        "wrong_decisions",
+        "iteration_capped",
+        "queries",
     ]);
     let mut md = String::from(
         "| setting | mean ns | p50 ns | p99 ns | speed vs default | max error / size | mean error / size | max error / distance | max error / size, §7 | max error / size, extremes | bounds missed | wrong margin decisions |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
@@ -618,7 +640,9 @@ fn report(
                     m.mean_err,
                     m.max_dist_rel
                 )),
-                None => rec.push_str(&format!("| {want}× | none measured is this fast | | | | |\n")),
+                None => rec.push_str(&format!(
+                    "| {want}× | none measured is this fast | | | | |\n"
+                )),
             }
         }
         rec.push('\n');
@@ -629,7 +653,10 @@ fn report(
     );
     let base_err = sums[base].max_err;
     for (label, cap) in [
-        (format!("as accurate as the default ({base_err:.1e})"), base_err.max(ERR_FLOOR)),
+        (
+            format!("as accurate as the default ({base_err:.1e})"),
+            base_err.max(ERR_FLOOR),
+        ),
         ("1e-12".to_owned(), 1e-12),
         ("1e-9".to_owned(), 1e-9),
         ("1e-6".to_owned(), 1e-6),
@@ -640,7 +667,10 @@ fn report(
             .zip(&sums)
             .zip(outcomes)
             .filter(|((s, m), o)| {
-                s.group != Group::Margin && !s.options.warm_start && m.max_err <= cap && o.misses == 0
+                s.group != Group::Margin
+                    && !s.options.warm_start
+                    && m.max_err <= cap
+                    && o.misses == 0
             })
             .min_by(|a, b| a.0.1.mean_ns.total_cmp(&b.0.1.mean_ns));
         if let Some(((s, m), _)) = pick {
@@ -676,10 +706,21 @@ fn report(
     );
     println!("\n{text}");
     io("write tradeoff.csv", csv.write(&dir.join("tradeoff.csv")))?;
-    io("write tradeoff.md", std::fs::write(dir.join("tradeoff.md"), &text))?;
+    io(
+        "write tradeoff.md",
+        std::fs::write(dir.join("tradeoff.md"), &text),
+    )?;
     // Per-query times and errors, for anyone who wants to look at the worst
     // cases.
-    let mut detail = Csv::new(&["setting", "family", "query", "truth", "size", "ns", "error_rel_size"]);
+    let mut detail = Csv::new(&[
+        "setting",
+        "family",
+        "query",
+        "truth",
+        "size",
+        "ns",
+        "error_rel_size",
+    ]);
     for (s, o) in settings.iter().zip(outcomes) {
         for ((q, ns), e) in queries.iter().zip(&o.ns).zip(&o.err) {
             detail.row(&[
@@ -709,10 +750,18 @@ fn pareto_plot(dir: &Path, settings: &[Setting], sums: &[Summary]) -> Result<(),
     let groups = [Group::TolCold, Group::TolWarm, Group::Cap, Group::Margin];
     let mut charts = Vec::new();
     for (title, err) in [
-        ("worst error against time (Pareto front)", (|m: &Summary| m.max_err) as fn(&Summary) -> f64),
-        ("mean error against time (Pareto front)", |m: &Summary| m.mean_err),
+        (
+            "worst error against time (Pareto front)",
+            (|m: &Summary| m.max_err) as fn(&Summary) -> f64,
+        ),
+        ("mean error against time (Pareto front)", |m: &Summary| {
+            m.mean_err
+        }),
     ] {
-        let pts: Vec<(f64, f64)> = sums.iter().map(|m| (err(m).max(ERR_FLOOR), m.mean_ns)).collect();
+        let pts: Vec<(f64, f64)> = sums
+            .iter()
+            .map(|m| (err(m).max(ERR_FLOOR), m.mean_ns))
+            .collect();
         // Front over (time, error): both are costs.
         let front_idx = pareto_front(&pts.iter().map(|p| (p.1, p.0)).collect::<Vec<_>>());
         let mut series: Vec<Series> = groups
@@ -739,20 +788,25 @@ fn pareto_plot(dir: &Path, settings: &[Setting], sums: &[Summary]) -> Result<(),
             color: 7,
         });
         let x = Axis::fit(pts.iter().map(|p| p.0), true);
-        let y = Axis::fit(pts.iter().map(|p| p.1), true);
+        // Times span less than a decade: a linear axis from 0 reads better.
+        let y_max = pts
+            .iter()
+            .map(|p| p.1)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
         charts.push(Chart {
             title: title.into(),
             x: Axis::log("error / object size (log; 1e-17 = exact)", x)
                 .with_ticks(|v| format!("{v:.0e}")),
-            y: Axis::log("mean time per query, ns (log)", y)
-                .with_ticks(|v| format!("{v:.0}"))
-                .with_labels(5),
+            y: Axis::linear("mean time per query, ns", (0.0, y_max * 1.1))
+                .with_ticks(|v| format!("{v:.0}")),
             series,
-            legend: plot::Corner::UpperRight,
+            legend: plot::Corner::LowerLeft,
         });
     }
     let path = dir.join("tradeoff-pareto.svg");
-    plot::render(&path, &charts, 2, (600, 420)).map_err(|e| BenchError::Plot(path.display().to_string(), e))
+    plot::render(&path, &charts, 2, (600, 420))
+        .map_err(|e| BenchError::Plot(path.display().to_string(), e))
 }
 
 #[cfg(test)]
@@ -767,9 +821,21 @@ mod tests {
             let Some(want) = e.analytic else { continue };
             let (pa, ra) = points_of(&e.a);
             let (pb, rb) = points_of(&e.b);
-            let got = reference::distance(&Hull::new(&pa), &e.pose_a, ra, &Hull::new(&pb), &e.pose_b, rb);
+            let got = reference::distance(
+                &Hull::new(&pa),
+                &e.pose_a,
+                ra,
+                &Hull::new(&pb),
+                &e.pose_b,
+                rb,
+            );
             let size = bounding(&e.a) + bounding(&e.b);
-            let offset = e.pose_a.translation.vector.amax().max(e.pose_b.translation.vector.amax());
+            let offset = e
+                .pose_a
+                .translation
+                .vector
+                .amax()
+                .max(e.pose_b.translation.vector.amax());
             // The brute force works in world coordinates: far from the origin
             // it loses what the offset's ulp hides.
             let tol = 1e-14 * size + 4.0 * f64::EPSILON * offset;

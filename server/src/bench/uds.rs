@@ -195,7 +195,10 @@ impl UdsClient {
         if error != ErrorCode::Ok as u32 || count != items.len() || results.len() < count {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
-                format!("reply error {error}, {count} results for {} items", items.len()),
+                format!(
+                    "reply error {error}, {count} results for {} items",
+                    items.len()
+                ),
             ));
         }
         self.stream
@@ -219,11 +222,27 @@ mod tests {
         reg.pieces[0].radius = 0.5;
         let a = state.handle_admin(1, &reg, &[Vertex::default()]).id;
         let b = state
-            .handle_admin(1, &reg, &[Vertex { x: 3.0, y: 0.0, z: 0.0 }])
+            .handle_admin(
+                1,
+                &reg,
+                &[Vertex {
+                    x: 3.0,
+                    y: 0.0,
+                    z: 0.0,
+                }],
+            )
             .id;
         let items = [
-            Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(b), &QueryOptions::cold()),
-            Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(7), &QueryOptions::cold()),
+            Item::distance(
+                ObjectId::from_raw(a),
+                ObjectId::from_raw(b),
+                &QueryOptions::cold(),
+            ),
+            Item::distance(
+                ObjectId::from_raw(a),
+                ObjectId::from_raw(7),
+                &QueryOptions::cold(),
+            ),
         ];
         let path = std::env::temp_dir().join(format!("gjkd-uds-test-{}.sock", std::process::id()));
         let server = UdsServer::start(&path, state, None).expect("bind");

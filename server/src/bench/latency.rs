@@ -229,7 +229,7 @@ impl Requests {
 /// Something that answers requests.
 enum Target {
     Ipc {
-        client: Client,
+        client: Box<Client>,
         a: ObjectId,
         b: ObjectId,
         req: Requests,
@@ -335,7 +335,7 @@ fn start(
             .collect::<Result<Vec<_>, _>>()?;
         let req = Requests::new(a, b, &boxes, max_batch);
         return Ok(Target::Ipc {
-            client,
+            client: Box::new(client),
             a,
             b,
             req,

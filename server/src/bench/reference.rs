@@ -69,7 +69,8 @@ impl Hull {
                 for k in j + 1..n {
                     let normal = (points[j] - points[i]).cross(&(points[k] - points[i]));
                     let len = normal.norm();
-                    if !(len > 1e-18 * scale * scale) {
+                    // Also skips NaN: only a clearly non-degenerate triple spans a plane.
+                    if len.is_nan() || len <= 1e-18 * scale * scale {
                         continue;
                     }
                     let mut u = normal / len;

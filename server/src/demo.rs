@@ -73,6 +73,11 @@ impl ServerProcess {
         })
     }
 
+    /// The child's process id.
+    pub fn id(&self) -> u32 {
+        self.child.id()
+    }
+
     /// Sends SIGTERM and waits up to five seconds for a clean exit, then
     /// kills. Returns whether it exited cleanly.
     pub fn stop(&mut self) -> bool {

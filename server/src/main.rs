@@ -30,6 +30,9 @@ enum Command {
     /// Start a server, sweep the Section 8 scene through it and print the
     /// distances and the warm-start speed-up.
     Demo(DemoArgs),
+    /// Measurements: `latency`, `tradeoff` (speed against accuracy) and
+    /// `paper` (Section 7). See docs/benchmarks.md.
+    Bench(gjkd::bench::BenchArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -112,6 +115,13 @@ fn main() -> ExitCode {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("gjkd demo: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Bench(args) => match gjkd::bench::run(args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("gjkd bench: {e}");
                 ExitCode::FAILURE
             }
         },

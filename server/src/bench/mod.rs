@@ -1,0 +1,138 @@
+//! `gjkd bench ...`: the measurements behind `docs/benchmarks.md` and
+//! `docs/speed-accuracy.md`, one command each.
+//!
+//! - [`latency`]: round trips through real `gjkd serve` processes in each
+//!   wait mode, beside a Unix-socket server and a plain function call, with
+//!   HdrHistogram percentiles.
+//! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
+//!   and cold starts and early-exit margins, judged by an exact reference
+//!   ([`reference`]) that owes nothing to GJK.
+//! - [`paper`]: the paper's Section 7, time per query against the number of
+//!   vertices `M`.
+//!
+//! Each writes a table to stdout, CSV and SVG plots to `--out`, and shows a
+//! progress bar while it runs. Timing is never asserted anywhere: the tests
+//! cover only the logic (percentiles, fits, the Pareto front, the reference).
+
+use std::path::PathBuf;
+
+pub mod extremes;
+pub mod latency;
+pub mod paper;
+pub mod plot;
+pub mod reference;
+pub mod stats;
+pub mod tradeoff;
+pub mod uds;
+
+/// `gjkd bench` and its subcommands.
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    command: BenchCommand,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum BenchCommand {
+    /// Round-trip latency: spin, block and adaptive servers, a Unix-socket
+    /// server and an in-process call, single pairs and batches, back to back
+    /// and with gaps.
+    Latency(latency::LatencyArgs),
+    /// Speed against accuracy: tolerance, iteration caps, warm/cold starts and
+    /// margins on the paper's family and an extremes family.
+    Tradeoff(tradeoff::TradeoffArgs),
+    /// The paper's Section 7: time per query and per vertex against M.
+    Paper(paper::PaperArgs),
+}
+
+/// Flags every bench command has.
+#[derive(clap::Args, Clone, Debug)]
+pub struct CommonArgs {
+    /// Directory for CSV, SVG and Markdown output (`--out docs/img` to
+    /// refresh the documentation's plots).
+    #[arg(long, default_value = "target/gjkd-bench")]
+    pub out: PathBuf,
+    /// A smoke test: a small fraction of the work, same outputs.
+    #[arg(long)]
+    pub quick: bool,
+}
+
+/// What can stop a bench command.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// Reading or writing a file, or a socket.
+    #[error("{0}: {1}")]
+    Io(String, std::io::Error),
+    /// A gjkd client call.
+    #[error("client: {0}")]
+    Client(#[from] gjkd_client::ClientError),
+    /// The algorithm refused an input (a bug in the bench's inputs).
+    #[error("gjk: {0}")]
+    Gjk(#[from] gjk::Error),
+    /// Drawing a plot.
+    #[error("plot {0}: {1}")]
+    Plot(String, String),
+    /// Anything else.
+    #[error("{0}")]
+    Other(String),
+}
+
+/// `Result::map_err` helper naming what was being done.
+pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T, BenchError> {
+    r.map_err(|e| BenchError::Io(what.into(), e))
+}
+
+/// Runs one `gjkd bench` subcommand.
+///
+/// # Errors
+/// What stopped it.
+pub fn run(args: BenchArgs) -> Result<(), BenchError> {
+    let start = std::time::Instant::now();
+    let what = match args.command {
+        BenchCommand::Latency(a) => {
+            latency::run(&a)?;
+            "latency"
+        }
+        BenchCommand::Tradeoff(a) => {
+            tradeoff::run(&a)?;
+            "tradeoff"
+        }
+        BenchCommand::Paper(a) => {
+            paper::run(&a)?;
+            "paper"
+        }
+    };
+    println!(
+        "\ngjkd bench {what}: finished in {:.1} s (wall time of the whole command)",
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Creates the output directory.
+pub(crate) fn out_dir(common: &CommonArgs) -> Result<PathBuf, BenchError> {
+    io(
+        format!("create {}", common.out.display()),
+        std::fs::create_dir_all(&common.out),
+    )?;
+    Ok(common.out.clone())
+}
+
+/// A one-line description of the machine, for the tables: CPU model, core
+/// count, kernel.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease")
+        .map(|s| s.trim().to_owned())
+        .unwrap_or_default();
+    format!("{cpu}, {cores} cores, Linux {kernel}")
+}

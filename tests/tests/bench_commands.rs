@@ -1,0 +1,86 @@
+//! `gjkd bench` smoke tests: the commands run end to end on the real binary
+//! (`--quick`, few requests) and write their tables and plots. Nothing here
+//! looks at a time: only that the outputs exist and hold every row.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use gjkd_e2e::gjkd_binary;
+
+fn out_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("gjkd-bench-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn run(args: &[&str]) -> String {
+    let out = Command::new(gjkd_binary())
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run gjkd bench");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "gjkd {args:?} failed: {}\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+#[test]
+fn latency_quick_writes_table_csv_and_plots() {
+    let dir = out_dir("latency");
+    let d = dir.to_str().expect("utf-8 temp dir");
+    let stdout = run(&[
+        "bench",
+        "latency",
+        "--quick",
+        "--out",
+        d,
+        "--requests",
+        "60",
+        "--min-requests",
+        "20",
+        "--batches",
+        "1,8",
+        "--gap-us",
+        "20",
+    ]);
+    assert!(
+        stdout.contains("Single pair, back to back: p50 spin"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(dir.join("latency.csv")).expect("latency.csv");
+    // Header + 5 transports x 3 request shapes x 2 pacings.
+    assert_eq!(csv.lines().count(), 1 + 5 * 3 * 2, "{csv}");
+    for t in ["spin", "adaptive", "block", "uds", "in-process"] {
+        assert!(
+            csv.lines()
+                .any(|l| l.starts_with(&format!("{t},single,back-to-back")))
+        );
+    }
+    for f in [
+        "latency-back-to-back.svg",
+        "latency-gaps.svg",
+        "latency-p50.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join(f)).expect(f);
+        assert!(svg.starts_with("<svg"), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn paper_quick_states_whether_the_cost_is_linear() {
+    let dir = out_dir("paper");
+    let d = dir.to_str().expect("utf-8 temp dir");
+    let stdout = run(&["bench", "paper", "--quick", "--out", d]);
+    assert!(stdout.contains("Is the cost linear in M?"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("paper.csv")).expect("paper.csv");
+    // Header + 20 pairs x 3 situations.
+    assert_eq!(csv.lines().count(), 1 + 60);
+    assert!(dir.join("paper-figure2.svg").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -396,6 +396,10 @@ const SPIN_FOR: Duration = Duration::from_micros(100);
 const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
 const YIELD_FOR: Duration = Duration::from_millis(2);
+/// While busy-polling, give the core away this often: a server the kernel
+/// woke onto this core cannot answer while the client holds it (on a busy
+/// 2-core machine that made a client spin out its whole 100 µs).
+const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {
     /// A builder for a client of the deployment named `service` (the server's
@@ -556,6 +560,7 @@ impl Client {
     ) -> Result<R, Waited> {
         let start = Instant::now();
         let mut next_check = start + LIVENESS_AFTER;
+        let mut last_yield = start;
         loop {
             match poll() {
                 Ok(Some(r)) => return Ok(r),
@@ -578,7 +583,12 @@ impl Client {
                 next_check = Instant::now() + LIVENESS_EVERY;
             }
             if waited < SPIN_FOR {
-                std::hint::spin_loop();
+                if now - last_yield >= POLITE_EVERY {
+                    std::thread::yield_now();
+                    last_yield = Instant::now();
+                } else {
+                    std::hint::spin_loop();
+                }
             } else if waited < YIELD_FOR {
                 std::thread::yield_now();
             } else {
@@ -946,6 +956,9 @@ impl Client {
                 .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
             if conn.notify_queries {
                 let _ = conn.wake.notify();
+                // The kernel often wakes the server onto this very core: let
+                // it run now rather than after a spell of polling.
+                std::thread::yield_now();
             }
             Self::await_reply(&self.node, conn, deadline, self.timeout, || {
                 let Some(response) = pending.receive().map_err(ipc_err("query receive"))? else {

@@ -44,6 +44,8 @@ fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError 
 /// sleeps. Long enough to cover a client's think time between queries of one
 /// control cycle, short enough that an idle server costs no CPU.
 pub const ADAPTIVE_SPIN: Duration = Duration::from_micros(50);
+/// While spinning idle, yield the core this often.
+const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 /// Longest sleep in `block` mode: the loop wakes this often to look at the
 /// shutdown flag (signal handlers cannot wake an iceoryx2 wait) and do
@@ -211,6 +213,7 @@ pub fn run(
     ready();
 
     let mut last_request = Instant::now();
+    let mut last_yield = Instant::now();
     let mut last_housekeeping = Instant::now();
     let mut turns: u32 = 0;
     let mut known_clients = 0usize;
@@ -251,6 +254,11 @@ pub fn run(
         };
         if sleep {
             block(&waitset, &listener, &query, &admin);
+        } else if now.duration_since(last_yield) >= POLITE_EVERY {
+            // A client scheduled onto this core could not send while the
+            // server spins: give the core away now and then.
+            std::thread::yield_now();
+            last_yield = Instant::now();
         } else {
             std::hint::spin_loop();
         }

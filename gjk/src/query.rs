@@ -237,7 +237,7 @@ pub fn distance(
         // poses whose difference overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }
-    let answer = match (a, b) {
+    let mut answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)));
             let mut simplex = Simplex::empty();
@@ -263,6 +263,20 @@ pub fn distance(
         }
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
+    if answer.lower > answer.upper {
+        // The bounds contradict each other: round-off beyond the slack. The
+        // one case fuzzing found (NaN weights from overflowing cofactors)
+        // is handled in `solve`; this is the last line of defence. A cold
+        // start is tried first; if that too is inconsistent, the lower
+        // bound is given up (0) rather than returning an interval that
+        // cannot hold.
+        if warm.is_some() {
+            return distance(a, pose_a, b, pose_b, options, None);
+        }
+        answer.lower = 0.0;
+        answer.distance = answer.distance.min(answer.upper);
+        answer.status = Status::ToleranceNotMet;
+    }
     // x·0 is NaN exactly when x is infinite or NaN, and NaN survives the sum:
     // one branch-free pass instead of a test per coordinate.
     let poison = [
@@ -448,6 +462,37 @@ impl<'s> Pair<'s> {
             loop {
                 let v2 = sol.v.norm_squared();
                 let norm = v2.sqrt();
+                if !norm.is_finite() {
+                    // The subalgorithm overflowed: the cofactors of points
+                    // ~1e108 from each other exceed f64 (found by fuzzing,
+                    // gjk/tests/fuzz_regressions.rs), and NaN weights would
+                    // make every bound below meaningless. Keep the last
+                    // finite iterate, or else a single vertex: each is a
+                    // point of the hull, so |v| stays an upper bound.
+                    backup_used = true;
+                    let best = match prev {
+                        Some((p, _)) => p,
+                        None => {
+                            let i = simplex.all.trailing_zeros().min(3) as usize;
+                            let mut lambda = [0.0; 4];
+                            lambda[i] = 1.0;
+                            Solution {
+                                mask: 1 << i,
+                                v: simplex.vertices[i].y,
+                                lambda,
+                            }
+                        }
+                    };
+                    return Run {
+                        inner: 0.0,
+                        sol: best,
+                        norm: best.v.norm(),
+                        lower,
+                        iterations,
+                        exit: Exit::Status(Status::ToleranceNotMet),
+                        backup_used,
+                    };
+                }
                 let finish = |exit, sol: Solution, lower: f64| {
                     let norm = sol.v.norm();
                     Run {
@@ -595,7 +640,9 @@ impl<'s> Pair<'s> {
     fn bounds(&self, run: &Run) -> (f64, f64, f64) {
         let upper = (run.norm + self.slack - self.radii).max(0.0);
         let lower = (run.lower - self.slack - self.radii).max(0.0);
-        let distance = (run.norm - self.radii).max(0.0).clamp(lower, upper);
+        // Not `clamp`: it panics when round-off beyond the slack has put
+        // `lower` above `upper`; `distance` repairs that case.
+        let distance = (run.norm - self.radii).max(0.0).max(lower).min(upper);
         (lower, upper, distance)
     }
 

@@ -2,7 +2,8 @@
 //!
 //! The gjkd distance server as a library: the object store and its request
 //! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
-//! ([`scene`]), the iceoryx2 serving loop ([`server`]) and the built-in demo
+//! ([`scene`]), the state file that keeps objects across crashes
+//! ([`persist`]), the iceoryx2 serving loop ([`server`]) and the built-in demo
 //! ([`demo`]). The `gjkd` binary is a thin command line over these.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the
@@ -32,6 +33,7 @@
 
 pub mod cache;
 pub mod demo;
+pub mod persist;
 pub mod scene;
 pub mod server;
 pub mod state;

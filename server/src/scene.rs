@@ -50,7 +50,7 @@ use gjk::{Compound, Convex, Shape};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 
-use crate::state::{NewObject, Owner, State};
+use crate::state::{NewObject, State};
 
 /// What can be wrong with a scene file.
 #[derive(Debug, thiserror::Error)]
@@ -259,18 +259,26 @@ impl Scene {
     }
 
     /// Adds every object to `state` as a read-only scene object, in file
-    /// order, returning their ids.
+    /// order, returning their ids. A scene object restored from the state
+    /// file with the same name and geometry keeps its id, so clients that
+    /// looked it up before a crash can go on using the id; restored scene
+    /// objects the file no longer has are dropped.
     ///
     /// # Errors
-    /// [`SceneError::Object`] for an invalid shape or pose, a duplicate name or
-    /// too many objects; objects before it stay added.
+    /// [`SceneError::Object`] for an invalid shape or pose, a duplicate name
+    /// (within the file, or taken by a client's object restored from the
+    /// state file) or too many objects; objects before it stay added.
     pub fn install(&self, state: &mut State) -> Result<Vec<u64>, SceneError> {
         let mut ids = Vec::with_capacity(self.objects.len());
+        let mut seen = std::collections::HashSet::new();
         for spec in &self.objects {
             let fail = |reason: String| SceneError::Object {
                 name: spec.name.clone(),
                 reason,
             };
+            if !seen.insert(spec.name.as_str()) {
+                return Err(fail(gjkd_proto::ErrorCode::NameTaken.to_string()));
+            }
             if spec.name.is_empty() || spec.name.len() > gjkd_proto::MAX_NAME_LEN {
                 return Err(fail(format!(
                     "names must be 1 to {} bytes long",
@@ -285,10 +293,11 @@ impl Scene {
                 name: Some(spec.name.clone()),
             };
             let id = state
-                .insert(new, Owner::Scene)
+                .adopt_scene_object(new)
                 .map_err(|e| fail(e.to_string()))?;
             ids.push(id);
         }
+        state.drop_scene_objects_except(&ids);
         Ok(ids)
     }
 }

@@ -15,6 +15,7 @@ use gjkd_proto::{
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use crate::cache::{FxBuild, PairKey, WarmCache};
+use crate::persist::{Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
 
 /// Limits the server enforces, also used to size the iceoryx2 services.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,12 +52,19 @@ impl Default for Limits {
     }
 }
 
-/// Who may change an object.
+/// Who may remove an object.
+///
+/// A client is identified by the id of its iceoryx2 node: one per
+/// `gjkd-client` `Client`, kept for the `Client`'s whole life, across its
+/// reconnections and across server restarts (the id is stored in the state
+/// file). A client *process* that restarts has a new node, so objects
+/// registered by its previous life can no longer be removed by anyone; they
+/// stay until the state file is removed (see `docs/reliability.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Owner {
     /// Loaded from the scene file at start: read-only.
     Scene,
-    /// Registered by the admin client port with this id.
+    /// Registered by the client whose iceoryx2 node has this id.
     Client(u128),
 }
 
@@ -87,6 +95,16 @@ pub struct State {
     names: HashMap<String, u64>,
     cache: WarmCache,
     stats: ServerStats,
+    /// Where registrations and removals are written before they are
+    /// acknowledged; `None` when persistence is off.
+    store: Option<Store>,
+    /// A pose changed since the last write: poses are written lazily (see
+    /// [`State::flush`]), since updating them is the hot path.
+    poses_dirty: bool,
+    /// Writes of the state file that failed.
+    persist_errors: u64,
+    /// Query clients connected, as last seen by the serving loop.
+    clients: u64,
 }
 
 /// The shape part of a registration, in the server's terms.
@@ -114,7 +132,175 @@ impl State {
             names: HashMap::new(),
             cache: WarmCache::new(limits.cache_capacity),
             stats: ServerStats::default(),
+            store: None,
+            poses_dirty: false,
+            persist_errors: 0,
+            clients: 0,
         }
+    }
+
+    /// A store holding the objects of `snapshot` with their exact ids, its
+    /// id counter continuing where the snapshot's stopped (so no id is ever
+    /// handed out twice).
+    ///
+    /// # Errors
+    /// A description of the problem if the snapshot does not pass
+    /// [`Snapshot::validate`] or holds more objects than `limits` allow;
+    /// nothing is half-loaded.
+    pub fn restore(limits: Limits, wait: WaitMode, snapshot: &Snapshot) -> Result<Self, String> {
+        snapshot.validate()?;
+        if snapshot.objects.len() > limits.max_objects {
+            return Err(format!(
+                "{} objects stored, the limit is {}",
+                snapshot.objects.len(),
+                limits.max_objects
+            ));
+        }
+        let mut state = State::new(limits, wait, snapshot.epoch);
+        state.next_index = snapshot.next_index;
+        for o in &snapshot.objects {
+            let object = Object {
+                shape: o.shape.to_shape()?,
+                pose: o.pose.to_isometry().ok_or("bad pose")?,
+                owner: match o.owner {
+                    StoredOwner::Scene => Owner::Scene,
+                    StoredOwner::Client(c) => Owner::Client(c),
+                },
+                name: o.name.clone(),
+            };
+            if let Some(name) = &object.name {
+                state.names.insert(name.clone(), o.id);
+            }
+            state.objects.insert(o.id, object);
+        }
+        Ok(state)
+    }
+
+    /// Everything needed to rebuild this store: id counter and objects, in
+    /// id order.
+    pub fn snapshot(&self) -> Snapshot {
+        let mut objects: Vec<StoredObject> = self
+            .objects
+            .iter()
+            .map(|(&id, o)| StoredObject {
+                id,
+                owner: match o.owner {
+                    Owner::Scene => StoredOwner::Scene,
+                    Owner::Client(c) => StoredOwner::Client(c),
+                },
+                name: o.name.clone(),
+                pose: StoredPose::from_isometry(&o.pose),
+                shape: StoredShape::from_shape(&o.shape),
+            })
+            .collect();
+        objects.sort_unstable_by_key(|o| o.id);
+        Snapshot {
+            epoch: (self.epoch >> 32) as u32,
+            next_index: self.next_index,
+            objects,
+        }
+    }
+
+    /// Turns persistence on: from now on every registration and removal is
+    /// written to `store` before it is acknowledged.
+    pub fn set_store(&mut self, store: Store) {
+        self.store = Some(store);
+    }
+
+    /// The state file, when persistence is on.
+    pub fn store(&self) -> Option<&Store> {
+        self.store.as_ref()
+    }
+
+    /// Writes the state file now (when persistence is on).
+    ///
+    /// # Errors
+    /// The write error; the previous file is then intact.
+    pub fn persist(&mut self) -> Result<(), crate::persist::StoreError> {
+        let Some(store) = &self.store else {
+            return Ok(());
+        };
+        match store.write(&self.snapshot()) {
+            Ok(()) => {
+                self.poses_dirty = false;
+                Ok(())
+            }
+            Err(e) => {
+                self.persist_errors += 1;
+                Err(e)
+            }
+        }
+    }
+
+    /// Writes the state file if a stored pose changed since the last write.
+    /// Called by the serving loop when idle and at shutdown: pose updates
+    /// are not worth an fsync each, so the pose a restarted server gives an
+    /// object is the one of the last write (geometry, id, name and owner are
+    /// always current).
+    ///
+    /// # Errors
+    /// As [`State::persist`].
+    pub fn flush(&mut self) -> Result<(), crate::persist::StoreError> {
+        if self.poses_dirty {
+            self.persist()
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Records how many query clients are connected (for [`State::stats`]).
+    pub fn set_clients(&mut self, clients: usize) {
+        self.clients = clients as u64;
+    }
+
+    /// Installs a scene object: an object restored from the state file with
+    /// the same name, the same geometry and scene ownership keeps its id
+    /// (and takes the scene's pose); otherwise a new object is inserted.
+    /// Call [`State::drop_scene_objects_except`] after the whole scene.
+    ///
+    /// # Errors
+    /// As [`State::insert`].
+    pub fn adopt_scene_object(&mut self, new: NewObject) -> Result<u64, ErrorCode> {
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && let Some(old) = self.objects.get_mut(&id)
+            && old.owner == Owner::Scene
+            && old.shape == new.shape
+        {
+            old.pose = new.pose;
+            return Ok(id);
+        }
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && self.objects.get(&id).is_some_and(|o| o.owner == Owner::Scene)
+        {
+            // The scene file changed this object: the new one replaces it.
+            self.drop_object(id);
+        }
+        self.insert(new, Owner::Scene)
+    }
+
+    /// Removes the scene objects restored from the state file that the
+    /// current scene no longer has.
+    pub fn drop_scene_objects_except(&mut self, keep: &[u64]) {
+        let doomed: Vec<u64> = self
+            .objects
+            .iter()
+            .filter(|(id, o)| o.owner == Owner::Scene && !keep.contains(id))
+            .map(|(&id, _)| id)
+            .collect();
+        for id in doomed {
+            self.drop_object(id);
+        }
+    }
+
+    fn drop_object(&mut self, id: u64) -> Option<Object> {
+        let object = self.objects.remove(&id)?;
+        if let Some(name) = &object.name {
+            self.names.remove(name);
+        }
+        self.cache.forget_object(id);
+        Some(object)
     }
 
     /// The limits in force.
@@ -147,6 +333,8 @@ impl State {
             cache_hits: c.hits,
             cache_misses: c.misses,
             cache_evictions: c.evictions,
+            clients: self.clients,
+            persist_errors: self.persist_errors,
             ..self.stats
         }
     }
@@ -196,25 +384,14 @@ impl State {
         Ok(id)
     }
 
-    /// Removes object `id` on behalf of `requester`.
+    /// Removes object `id` on behalf of `requester`, and writes the state
+    /// file (when persistence is on) before returning.
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
     /// objects, [`ErrorCode::NotOwner`] for another client's object.
     pub fn remove(&mut self, id: u64, requester: u128) -> Result<(), ErrorCode> {
-        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
-        match object.owner {
-            Owner::Scene => return Err(ErrorCode::ReadOnly),
-            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
-            Owner::Client(_) => {}
-        }
-        if let Some(object) = self.objects.remove(&id)
-            && let Some(name) = object.name
-        {
-            self.names.remove(&name);
-        }
-        self.cache.forget_object(id);
-        Ok(())
+        self.remove_committed(id, requester).map(|_| ())
     }
 
     /// The id of the object named `name`.
@@ -279,6 +456,7 @@ impl State {
             .get_mut(&item.a)
             .ok_or(ErrorCode::UnknownObject)?;
         object.pose = check_pose(&item.pose_a)?;
+        self.poses_dirty = true;
         Ok(())
     }
 
@@ -360,8 +538,12 @@ impl State {
         })
     }
 
-    /// Answers one admin request from admin client port `requester`, with the
-    /// request's slice payload `vertices`.
+    /// Answers one admin request from client `requester` (the id of its
+    /// iceoryx2 node, see [`Owner`]), with the request's slice payload
+    /// `vertices`. With persistence on, a registration or removal is written
+    /// to the state file before this returns; if the write fails the change
+    /// is undone and the reply is [`ErrorCode::Internal`], so an
+    /// acknowledged change is always on disk.
     pub fn handle_admin(
         &mut self,
         requester: u128,
@@ -383,8 +565,14 @@ impl State {
                 Ok(0)
             }
             Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
-                .and_then(|new| self.insert(new, Owner::Client(requester))),
-            Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
+                .and_then(|new| self.insert(new, Owner::Client(requester)))
+                .and_then(|id| {
+                    self.commit().map(|()| id).map_err(|e| {
+                        self.drop_object(id);
+                        e
+                    })
+                }),
+            Some(AdminOp::Remove) => self.remove_committed(request.id, requester),
             Some(AdminOp::Lookup) => match request.name() {
                 Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
                 None => Err(ErrorCode::Malformed),
@@ -396,6 +584,37 @@ impl State {
             Err(e) => reply.error = e as u32,
         }
         reply
+    }
+}
+
+impl State {
+    /// Writes the state file after a registration or removal; the error is
+    /// what the client is told if that fails.
+    fn commit(&mut self) -> Result<(), ErrorCode> {
+        self.persist().map_err(|e| {
+            tracing::error!("{e}; the change is undone");
+            ErrorCode::Internal
+        })
+    }
+
+    fn remove_committed(&mut self, id: u64, requester: u128) -> Result<u64, ErrorCode> {
+        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
+        match object.owner {
+            Owner::Scene => return Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
+            Owner::Client(_) => {}
+        }
+        let Some(object) = self.drop_object(id) else {
+            return Err(ErrorCode::UnknownObject);
+        };
+        if let Err(e) = self.commit() {
+            if let Some(name) = &object.name {
+                self.names.insert(name.clone(), id);
+            }
+            self.objects.insert(id, object);
+            return Err(e);
+        }
+        Ok(id)
     }
 }
 

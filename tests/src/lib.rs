@@ -64,11 +64,16 @@ pub fn unique_service(tag: &str) -> String {
 
 /// A running `gjkd serve`, stopped (SIGTERM, then SIGKILL) when dropped, so
 /// that a failing test leaves no server behind.
+///
+/// Unless its arguments say `--no-persist` or `--state-file`, it keeps its
+/// objects in a state file in a fresh temporary directory (removed on drop),
+/// never in the user's `~/.local/state`; [`Server::restart`] reuses it.
 pub struct Server {
     child: Option<Child>,
     /// Its service name.
     pub service: String,
     args: Vec<String>,
+    state_dir: Option<PathBuf>,
 }
 
 impl Server {
@@ -80,13 +85,28 @@ impl Server {
 
     /// Starts `gjkd serve --service SERVICE` with `args`.
     pub fn start_on(service: &str, args: &[&str]) -> Self {
+        let mut args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+        let mut state_dir = None;
+        if !args.iter().any(|a| a == "--no-persist" || a == "--state-file") {
+            let dir = std::env::temp_dir().join(format!("{service}.state"));
+            let _ = std::fs::remove_dir_all(&dir);
+            args.push("--state-file".into());
+            args.push(dir.join("objects").to_string_lossy().into_owned());
+            state_dir = Some(dir);
+        }
         let mut server = Server {
             child: None,
             service: service.to_owned(),
-            args: args.iter().map(|s| s.to_string()).collect(),
+            args,
+            state_dir,
         };
         server.spawn();
         server
+    }
+
+    /// The state file, when the helper chose it.
+    pub fn state_file(&self) -> Option<PathBuf> {
+        self.state_dir.as_ref().map(|d| d.join("objects"))
     }
 
     fn spawn(&mut self) {
@@ -183,6 +203,9 @@ impl Server {
 impl Drop for Server {
     fn drop(&mut self) {
         self.terminate();
+        if let Some(dir) = &self.state_dir {
+            let _ = std::fs::remove_dir_all(dir);
+        }
     }
 }
 

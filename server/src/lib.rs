@@ -33,6 +33,7 @@
 
 pub mod cache;
 pub mod demo;
+pub mod journal;
 pub mod persist;
 pub mod scene;
 pub mod server;

@@ -219,7 +219,7 @@ fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
             State::new(limits, wait, epoch())
         }
     };
-    state.set_store(store);
+    state.set_store(store).map_err(|e| e.to_string())?;
     Ok(state)
 }
 

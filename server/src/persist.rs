@@ -192,6 +192,8 @@ pub struct StoredObject {
     pub pose: StoredPose,
     /// Its geometry.
     pub shape: StoredShape,
+    /// Its slot in the pose journal ([`crate::journal`]).
+    pub slot: u32,
 }
 
 /// Everything the state file holds: the id counter and the objects.
@@ -319,7 +321,13 @@ impl Snapshot {
         }
         let mut ids = std::collections::HashSet::new();
         let mut names = std::collections::HashSet::new();
+        let mut slots = std::collections::HashSet::new();
         for o in &self.objects {
+            // Slots are dense (reused after removals): one far beyond the
+            // object count is corruption, and would size the journal absurdly.
+            if o.slot as usize > self.objects.len() * 2 + 1024 || !slots.insert(o.slot) {
+                return Err(format!("bad or repeated journal slot {}", o.slot));
+            }
             let (epoch, index) = ((o.id >> 32) as u32, o.id as u32);
             if epoch != self.epoch || index == 0 || index >= self.next_index {
                 return Err(format!("id {:#x} outside this store", o.id));
@@ -572,6 +580,7 @@ mod tests {
                     name: Some("cube".into()),
                     pose,
                     shape: cube,
+                    slot: 0,
                 },
                 StoredObject {
                     id: id(7),
@@ -579,6 +588,7 @@ mod tests {
                     name: None,
                     pose: StoredPose::from_isometry(&Isometry3::identity()),
                     shape: dumbbell,
+                    slot: 3,
                 },
             ],
         }
@@ -620,7 +630,10 @@ mod tests {
             for bit in 0..8 {
                 let mut b = bytes.clone();
                 b[i] ^= 1 << bit;
-                assert!(Snapshot::decode(&b).is_err(), "flip of bit {bit} of byte {i}");
+                assert!(
+                    Snapshot::decode(&b).is_err(),
+                    "flip of bit {bit} of byte {i}"
+                );
             }
         }
     }
@@ -657,6 +670,8 @@ mod tests {
             }),
             Box::new(|s| s.objects[1].shape = StoredShape::Compound(vec![])),
             Box::new(|s| s.epoch = 0),
+            Box::new(|s| s.objects[1].slot = 0),
+            Box::new(|s| s.objects[1].slot = 1 << 30),
         ];
         for (i, spoil) in cases.iter().enumerate() {
             let mut s = sample();

@@ -347,6 +347,39 @@ half_extents = [0.2, 0.2, 0.2]
 offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
 "#;
 
+    /// After a restart the same scene keeps its ids; a changed scene gets
+    /// new ids for what changed and loses what it dropped; a duplicate name
+    /// in one file is an error.
+    #[test]
+    fn scene_ids_survive_a_restart_and_follow_changes() {
+        let scene = Scene::from_toml(EXAMPLE).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        let mut again =
+            State::restore(Limits::default(), WaitMode::Spin, &state.snapshot()).expect("restores");
+        assert_eq!(scene.install(&mut again).expect("valid"), ids);
+        assert_eq!(again.len(), ids.len());
+
+        let changed = EXAMPLE
+            .replace("radius = 0.5", "radius = 0.6")
+            .replace("name = \"wedge\"", "name = \"prism\"");
+        let changed = Scene::from_toml(&changed).expect("parses");
+        let mut third =
+            State::restore(Limits::default(), WaitMode::Spin, &again.snapshot()).expect("restores");
+        let new_ids = changed.install(&mut third).expect("valid");
+        assert_ne!(new_ids[0], ids[0], "the ball changed");
+        assert_eq!(new_ids[1..3], ids[1..3]);
+        assert_ne!(new_ids[3], ids[3], "the wedge became a prism");
+        assert_eq!(third.lookup("wedge"), None);
+        assert_eq!(third.len(), 5);
+
+        let twice =
+            format!("{EXAMPLE}\n[[object]]\nname = \"ball\"\ntype = \"sphere\"\nradius = 0.5\n");
+        let twice = Scene::from_toml(&twice).expect("parses");
+        let mut fresh = State::new(Limits::default(), WaitMode::Spin, 1);
+        assert!(twice.install(&mut fresh).is_err());
+    }
+
     #[test]
     fn the_documented_example_loads() {
         let scene = Scene::from_toml(EXAMPLE).expect("parses");

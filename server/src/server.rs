@@ -248,7 +248,7 @@ pub fn run(
             forget_departed_clients(&query_service, &mut state);
             state.set_clients(query_service.dynamic_config().number_of_clients());
             if let Err(e) = state.flush() {
-                error!("cannot write the poses to the state file: {e}");
+                error!("cannot sync the pose journal: {e}");
             }
         }
         let sleep = match options.wait {
@@ -264,7 +264,7 @@ pub fn run(
     }
     info!(service = %options.service, "shutting down");
     if let Err(e) = state.flush() {
-        error!("cannot write the poses to the state file: {e}");
+        error!("cannot sync the pose journal: {e}");
     }
     // Ports, services and the node are dropped here, in reverse order of
     // creation, which removes the services' shared memory.
@@ -385,14 +385,13 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
     }
 }
 
-type AdminService =
-    iceoryx2::service::port_factory::request_response::PortFactory<
-        ipc::Service,
-        [Vertex],
-        AdminRequest,
-        AdminReply,
-        (),
-    >;
+type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Vertex],
+    AdminRequest,
+    AdminReply,
+    (),
+>;
 
 /// The owner identity of admin client port `port`: the id of the iceoryx2
 /// node that created it. A `gjkd-client` `Client` keeps its node for its

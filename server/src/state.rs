@@ -15,6 +15,7 @@ use gjkd_proto::{
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use crate::cache::{FxBuild, PairKey, WarmCache};
+use crate::journal::Journal;
 use crate::persist::{Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
 
 /// Limits the server enforces, also used to size the iceoryx2 services.
@@ -79,6 +80,8 @@ pub struct Object {
     pub owner: Owner,
     /// Name for look-ups, if any.
     pub name: Option<String>,
+    /// Its slot in the pose journal (see [`crate::journal`]).
+    pub slot: u32,
 }
 
 /// Everything the server holds.
@@ -98,9 +101,13 @@ pub struct State {
     /// Where registrations and removals are written before they are
     /// acknowledged; `None` when persistence is off.
     store: Option<Store>,
-    /// A pose changed since the last write: poses are written lazily (see
-    /// [`State::flush`]), since updating them is the hot path.
-    poses_dirty: bool,
+    /// Latest poses, kept where a crash of this process cannot lose them
+    /// (present when `store` is).
+    journal: Option<Journal>,
+    /// Journal slots of removed objects, for reuse.
+    free_slots: Vec<u32>,
+    /// Lowest slot never used.
+    next_slot: u32,
     /// Writes of the state file that failed.
     persist_errors: u64,
     /// Query clients connected, as last seen by the serving loop.
@@ -133,7 +140,9 @@ impl State {
             cache: WarmCache::new(limits.cache_capacity),
             stats: ServerStats::default(),
             store: None,
-            poses_dirty: false,
+            journal: None,
+            free_slots: Vec::new(),
+            next_slot: 0,
             persist_errors: 0,
             clients: 0,
         }
@@ -167,12 +176,20 @@ impl State {
                     StoredOwner::Client(c) => Owner::Client(c),
                 },
                 name: o.name.clone(),
+                slot: o.slot,
             };
             if let Some(name) = &object.name {
                 state.names.insert(name.clone(), o.id);
             }
             state.objects.insert(o.id, object);
         }
+        let mut used: Vec<u32> = snapshot.objects.iter().map(|o| o.slot).collect();
+        used.sort_unstable();
+        state.next_slot = used.last().map_or(0, |&m| m + 1);
+        state.free_slots = (0..state.next_slot)
+            .rev()
+            .filter(|s| used.binary_search(s).is_err())
+            .collect();
         Ok(state)
     }
 
@@ -191,6 +208,7 @@ impl State {
                 name: o.name.clone(),
                 pose: StoredPose::from_isometry(&o.pose),
                 shape: StoredShape::from_shape(&o.shape),
+                slot: o.slot,
             })
             .collect();
         objects.sort_unstable_by_key(|o| o.id);
@@ -202,9 +220,51 @@ impl State {
     }
 
     /// Turns persistence on: from now on every registration and removal is
-    /// written to `store` before it is acknowledged.
-    pub fn set_store(&mut self, store: Store) {
+    /// written to `store` before it is acknowledged, and every pose update
+    /// goes to the pose journal next to it. Poses the journal holds for the
+    /// objects already here (restored from the state file) replace theirs:
+    /// they are the latest ones before a crash.
+    ///
+    /// # Errors
+    /// When the journal cannot be opened; persistence stays off then.
+    pub fn set_store(&mut self, store: Store) -> Result<(), crate::persist::StoreError> {
+        let path = crate::journal::path_for(store.path());
+        let mut journal =
+            Journal::open(&path).map_err(|source| crate::persist::StoreError::Io {
+                what: "cannot open the pose journal",
+                path: path.clone(),
+                source,
+            })?;
+        for (&id, o) in self.objects.iter_mut() {
+            if let Some(pose) = journal.read(o.slot, id) {
+                o.pose = pose;
+            }
+        }
+        for (&id, o) in &self.objects {
+            journal.write(o.slot, id, &o.pose).map_err(|source| {
+                crate::persist::StoreError::Io {
+                    what: "cannot write the pose journal",
+                    path: path.clone(),
+                    source,
+                }
+            })?;
+        }
+        self.journal = Some(journal);
         self.store = Some(store);
+        Ok(())
+    }
+
+    /// Writes `pose` of object `id` (in `slot`) to the journal, if any. A
+    /// failure (the file cannot grow: disk full) costs only durability of
+    /// this pose, not the update itself, so it is counted and logged.
+    fn journal_pose(&mut self, slot: u32, id: u64) {
+        let (Some(journal), Some(o)) = (self.journal.as_mut(), self.objects.get(&id)) else {
+            return;
+        };
+        if let Err(e) = journal.write(slot, id, &o.pose) {
+            self.persist_errors += 1;
+            tracing::error!("cannot write the pose journal: {e}");
+        }
     }
 
     /// The state file, when persistence is on.
@@ -221,10 +281,7 @@ impl State {
             return Ok(());
         };
         match store.write(&self.snapshot()) {
-            Ok(()) => {
-                self.poses_dirty = false;
-                Ok(())
-            }
+            Ok(()) => Ok(()),
             Err(e) => {
                 self.persist_errors += 1;
                 Err(e)
@@ -232,19 +289,16 @@ impl State {
         }
     }
 
-    /// Writes the state file if a stored pose changed since the last write.
-    /// Called by the serving loop when idle and at shutdown: pose updates
-    /// are not worth an fsync each, so the pose a restarted server gives an
-    /// object is the one of the last write (geometry, id, name and owner are
-    /// always current).
+    /// Asks the kernel to put the pose journal on disk if poses changed.
+    /// Only a machine crash needs this (the journal's pages outlive the
+    /// process); called when idle and at shutdown.
     ///
     /// # Errors
-    /// As [`State::persist`].
-    pub fn flush(&mut self) -> Result<(), crate::persist::StoreError> {
-        if self.poses_dirty {
-            self.persist()
-        } else {
-            Ok(())
+    /// The `msync` error.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.journal {
+            Some(j) => j.sync(),
+            None => Ok(()),
         }
     }
 
@@ -268,11 +322,16 @@ impl State {
             && old.shape == new.shape
         {
             old.pose = new.pose;
+            let slot = old.slot;
+            self.journal_pose(slot, id);
             return Ok(id);
         }
         if let Some(name) = &new.name
             && let Some(&id) = self.names.get(name)
-            && self.objects.get(&id).is_some_and(|o| o.owner == Owner::Scene)
+            && self
+                .objects
+                .get(&id)
+                .is_some_and(|o| o.owner == Owner::Scene)
         {
             // The scene file changed this object: the new one replaces it.
             self.drop_object(id);
@@ -299,6 +358,7 @@ impl State {
         if let Some(name) = &object.name {
             self.names.remove(name);
         }
+        self.free_slots.push(object.slot);
         self.cache.forget_object(id);
         Some(object)
     }
@@ -372,6 +432,11 @@ impl State {
         if let Some(name) = &new.name {
             self.names.insert(name.clone(), id);
         }
+        let slot = self.free_slots.pop().unwrap_or_else(|| {
+            let s = self.next_slot;
+            self.next_slot += 1;
+            s
+        });
         self.objects.insert(
             id,
             Object {
@@ -379,8 +444,11 @@ impl State {
                 pose: new.pose,
                 owner,
                 name: new.name,
+                slot,
             },
         );
+        // The slot may hold a removed object's last pose: overwrite it now.
+        self.journal_pose(slot, id);
         Ok(id)
     }
 
@@ -456,7 +524,12 @@ impl State {
             .get_mut(&item.a)
             .ok_or(ErrorCode::UnknownObject)?;
         object.pose = check_pose(&item.pose_a)?;
-        self.poses_dirty = true;
+        if let Some(journal) = &mut self.journal
+            && let Err(e) = journal.write(object.slot, item.a, &object.pose)
+        {
+            self.persist_errors += 1;
+            tracing::error!("cannot write the pose journal: {e}");
+        }
         Ok(())
     }
 
@@ -608,6 +681,9 @@ impl State {
             return Err(ErrorCode::UnknownObject);
         };
         if let Err(e) = self.commit() {
+            if self.free_slots.last() == Some(&object.slot) {
+                self.free_slots.pop();
+            }
             if let Some(name) = &object.name {
                 self.names.insert(name.clone(), id);
             }
@@ -991,6 +1067,70 @@ mod tests {
         s.remove(a, 1).expect("owner");
         let b = register_box(&mut s, 1);
         assert_ne!(a, b);
+    }
+
+    #[test]
+    fn a_restored_store_keeps_ids_owners_answers_and_counter() {
+        let mut s = state();
+        let a = register_box(&mut s, 41);
+        let b = register_box(&mut s, 42);
+        let gone = register_box(&mut s, 41);
+        s.remove(gone, 41).expect("owner");
+        let pb = Isometry3::new(Vector3::new(3.0, 0.5, 0.2), Vector3::new(0.1, 0.2, 0.3));
+        let (ia, ib) = (ObjectId::from_raw(a), ObjectId::from_raw(b));
+        one(&mut s, 1, Item::set_pose(ib, &pb));
+        let before = one(&mut s, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+
+        let snap = s.snapshot();
+        let bytes = snap.encode().expect("encodes");
+        let back = crate::persist::Snapshot::decode(&bytes).expect("decodes");
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("valid");
+        assert_eq!(r.len(), 2);
+        let after = one(&mut r, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+        assert_eq!(
+            after, before,
+            "same ids, same poses, same answer bit for bit"
+        );
+        assert_eq!(r.remove(a, 42), Err(ErrorCode::NotOwner));
+        let c = register_box(&mut r, 41);
+        assert!(c > gone, "the counter continues past removed ids");
+        assert_eq!(r.remove(a, 41), Ok(()));
+        let too_few = Limits {
+            max_objects: 1,
+            ..Limits::default()
+        };
+        assert!(State::restore(too_few, WaitMode::Spin, &back).is_err());
+    }
+
+    #[test]
+    fn a_failed_write_undoes_the_change_and_says_internal() {
+        let dir = std::env::temp_dir().join(format!("gjkd-state-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(crate::persist::Store::open(&path).expect("store"))
+            .expect("journal");
+        let kept = register_box(&mut s, 1);
+        assert!(path.exists());
+        // A directory where the file should be: every rename onto it fails.
+        std::fs::remove_file(&path).expect("rm");
+        std::fs::create_dir(&path).expect("block the path");
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        assert!(req.set_name("ghost"));
+        let reply = s.handle_admin(1, &req, &[Vertex::default()]);
+        assert_eq!(reply.error_code(), ErrorCode::Internal);
+        assert_eq!(s.len(), 1, "the unwritten object is not kept");
+        assert_eq!(s.lookup("ghost"), None);
+        assert_eq!(s.remove(kept, 1), Err(ErrorCode::Internal));
+        assert!(s.object(kept).is_some(), "the unwritten removal is undone");
+        assert_eq!(s.stats().persist_errors, 2);
+        std::fs::remove_dir(&path).expect("unblock");
+        assert_eq!(s.remove(kept, 1), Ok(()));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// Arbitrary bytes reinterpreted as items never panic the handler.

@@ -87,7 +87,10 @@ impl Server {
     pub fn start_on(service: &str, args: &[&str]) -> Self {
         let mut args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
         let mut state_dir = None;
-        if !args.iter().any(|a| a == "--no-persist" || a == "--state-file") {
+        if !args
+            .iter()
+            .any(|a| a == "--no-persist" || a == "--state-file")
+        {
             let dir = std::env::temp_dir().join(format!("{service}.state"));
             let _ = std::fs::remove_dir_all(&dir);
             args.push("--state-file".into());

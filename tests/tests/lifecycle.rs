@@ -56,13 +56,19 @@ fn a_killed_server_is_reported_and_a_restarted_one_serves() {
             Err(e) => panic!("restarted server not reached: {e}"),
         }
     };
-    assert_eq!(stats.objects, 2, "the restarted server reloaded both objects");
+    assert_eq!(
+        stats.objects, 2,
+        "the restarted server reloaded both objects"
+    );
     // Same ids, same answers; and this client still owns what it registered
     // (its identity is its node, which outlived the server).
     check(&mut client, a, b);
     client.remove(b).expect("still the owner after the restart");
     let (a2, b2) = spheres(&mut client);
-    assert!(a2 != a && b2 != b && a2 != b && b2 != a, "ids are never reused");
+    assert!(
+        a2 != a && b2 != b && a2 != b && b2 != a,
+        "ids are never reused"
+    );
 }
 
 #[test]

@@ -274,7 +274,7 @@ mod tests {
             j.write(3, 13, &Isometry3::identity()).expect("write");
             // Dropped without sync on purpose: the page cache keeps it.
         }
-        let mut j = Journal::open(&path).expect("reopen");
+        let j = Journal::open(&path).expect("reopen");
         assert_eq!(j.read(0, 11), Some(p), "bit for bit");
         assert_eq!(j.read(5000, 12), Some(p));
         assert_eq!(j.read(0, 12), None, "another object's slot");

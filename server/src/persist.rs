@@ -651,7 +651,8 @@ mod tests {
     /// writer or a hand-edited file would give) is refused as a whole.
     #[test]
     fn consistent_but_invalid_content_is_refused() {
-        let cases: Vec<Box<dyn Fn(&mut Snapshot)>> = vec![
+        type Spoil = Box<dyn Fn(&mut Snapshot)>;
+        let cases: Vec<Spoil> = vec![
             Box::new(|s| s.next_index = 7),
             Box::new(|s| s.objects[1].id = s.objects[0].id),
             Box::new(|s| s.objects[0].id ^= 1 << 40),

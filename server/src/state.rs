@@ -640,9 +640,8 @@ impl State {
             Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
                 .and_then(|new| self.insert(new, Owner::Client(requester)))
                 .and_then(|id| {
-                    self.commit().map(|()| id).map_err(|e| {
+                    self.commit().map(|()| id).inspect_err(|_| {
                         self.drop_object(id);
-                        e
                     })
                 }),
             Some(AdminOp::Remove) => self.remove_committed(request.id, requester),

@@ -490,9 +490,18 @@ pub fn load_or_quarantine(path: &Path) -> Result<Loaded, StoreError> {
                 .duration_since(std::time::UNIX_EPOCH)
                 .map(|d| d.as_secs())
                 .unwrap_or(0);
-            let mut aside = path.as_os_str().to_owned();
-            aside.push(format!(".corrupt-{secs}"));
-            let aside = PathBuf::from(aside);
+            // Never over an earlier corrupt file of the same second.
+            let aside = (0..)
+                .map(|n| {
+                    let mut a = path.as_os_str().to_owned();
+                    a.push(format!(".corrupt-{secs}"));
+                    if n > 0 {
+                        a.push(format!(".{n}"));
+                    }
+                    PathBuf::from(a)
+                })
+                .find(|a| !a.exists())
+                .unwrap_or_else(|| path.with_extension("corrupt"));
             // If it cannot be moved, starting empty would overwrite it at
             // the first registration: refuse to start instead.
             std::fs::rename(path, &aside).map_err(|e| StoreError::Io {

@@ -104,10 +104,14 @@ fn a_server_killed_under_load_loses_no_object_and_clients_notice_in_time() {
     );
     assert!(services_exist(&server.service));
     let stats = client.stats().expect("stats");
-    assert_eq!(
-        stats.objects,
-        regs.len() as u64,
-        "every acknowledged registration is back, nothing else"
+    // Every acknowledged registration is back. A registration in flight at
+    // the kill may have been written without its reply reaching the client
+    // (at most one per client): it is back too, but nobody printed its id.
+    let acked = regs.len() as u64;
+    assert!(
+        (acked..=acked + loaders.len() as u64).contains(&stats.objects),
+        "{} objects back for {acked} acknowledged",
+        stats.objects
     );
     check_objects(&mut client, &regs, "after restart");
 }

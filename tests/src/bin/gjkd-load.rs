@@ -149,6 +149,8 @@ fn main() {
         eprintln!("usage: gjkd-load SERVICE load|victim|endless SEED [COUNT]");
         std::process::exit(2);
     }
+    // iceoryx2 warns about every dead node it cleans up: noise here.
+    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
     let service = &args[1];
     let seed: u64 = args[3].parse().expect("seed");
     let mut load = match Load::new(service, seed) {

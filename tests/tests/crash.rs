@@ -211,7 +211,8 @@ fn a_corrupt_state_file_is_set_aside_never_half_loaded() {
     }
     server.terminate();
     let good = std::fs::read(&path).expect("state file");
-    let spoilers: [(&str, Box<dyn Fn(&mut Vec<u8>)>); 3] = [
+    type Spoil = Box<dyn Fn(&mut Vec<u8>)>;
+    let spoilers: [(&str, Spoil); 3] = [
         ("truncated", Box::new(|b| b.truncate(b.len() - 7))),
         ("bit flip", Box::new(|b| b[40] ^= 0x10)),
         ("version", Box::new(|b| b[8] = 9)),

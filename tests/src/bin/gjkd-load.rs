@@ -193,7 +193,7 @@ fn main() {
                 let start = Instant::now();
                 // A registration now and then, so that some are acknowledged
                 // right before the crash.
-                let outcome = if round % 20 == 0 {
+                let outcome = if round.is_multiple_of(20) {
                     let k = (round / 20) as usize % load.zoo.len();
                     let solid = load.zoo[k].clone();
                     solid.register(&mut load.client).map(|id| {

@@ -506,6 +506,12 @@ impl State {
     }
 
     fn item(&mut self, client: u128, item: &Item) -> ItemResult {
+        // Unknown flag bits and a non-zero reserved word are refused rather
+        // than ignored, so that a later protocol version can give them a
+        // meaning without old servers silently answering something else.
+        if item.flags & !item_flags::ALL != 0 || item.reserved != 0 {
+            return ItemResult::error(ErrorCode::Malformed);
+        }
         match ItemKind::from_raw(item.kind) {
             Some(ItemKind::SetPose) => match self.set_pose(item) {
                 Ok(()) => ItemResult::default(),
@@ -534,9 +540,6 @@ impl State {
     }
 
     fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
-        if item.flags & !item_flags::ALL != 0 {
-            return Err(ErrorCode::Malformed);
-        }
         let warm_on = item.flags & item_flags::WARM_START != 0;
         let options = gjk::Options {
             tolerance: item.tolerance,
@@ -628,7 +631,14 @@ impl State {
             op,
             ..AdminReply::default()
         };
-        let outcome = match AdminOp::from_raw(op) {
+        let op_kind = AdminOp::from_raw(op);
+        // Only a registration carries vertices: any other request with a
+        // slice is malformed (and would otherwise be silently ignored).
+        if !vertices.is_empty() && op_kind != Some(AdminOp::Register) {
+            reply.error = ErrorCode::Malformed as u32;
+            return reply;
+        }
+        let outcome = match op_kind {
             Some(AdminOp::Hello) => {
                 reply.info = self.info();
                 Ok(0)
@@ -781,6 +791,9 @@ pub fn decode_registration(
                 return Err(ErrorCode::Malformed);
             }
             let piece = &request.pieces[0];
+            if piece.reserved != 0 {
+                return Err(ErrorCode::Malformed);
+            }
             if piece.vertex_count as usize != vertices.len() {
                 return Err(if vertices.is_empty() {
                     ErrorCode::EmptyVertices
@@ -798,6 +811,9 @@ pub fn decode_registration(
                 return Err(ErrorCode::TooManyPieces);
             }
             let table = &request.pieces[..count];
+            if table.iter().any(|p| p.reserved != 0) {
+                return Err(ErrorCode::Malformed);
+            }
             let total: u64 = table.iter().map(|p| u64::from(p.vertex_count)).sum();
             if total != vertices.len() as u64 {
                 return Err(ErrorCode::Malformed);
@@ -1036,6 +1052,121 @@ mod tests {
             ErrorCode::UnknownName
         );
         assert_eq!(code(&mut s, &remove, &[]), ErrorCode::UnknownObject);
+    }
+
+    /// The strictness added for the reliability work: reserved words,
+    /// unknown flags on any item kind, vertices on a non-registration, ids
+    /// at the edges of the range.
+    #[test]
+    fn reserved_fields_stray_slices_and_edge_ids_are_refused() {
+        let mut s = state();
+        let a = ObjectId::from_raw(register_box(&mut s, 1));
+        let mut reserved = Item::distance(a, a, &QueryOptions::default());
+        reserved.reserved = 1;
+        let mut pose_flags = Item::set_pose(a, &Isometry3::identity());
+        pose_flags.flags = 1 << 9;
+        let mut pose_reserved = Item::set_pose(a, &Isometry3::identity());
+        pose_reserved.reserved = 7;
+        for item in [reserved, pose_flags, pose_reserved] {
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::Malformed);
+        }
+        let epoch_of_a = a.raw() & !0xFFFF_FFFF;
+        for raw in [
+            0,
+            u64::MAX,
+            epoch_of_a,
+            epoch_of_a | 0xFFFF_FFFF,
+            a.raw() ^ (1 << 40),
+        ] {
+            let ghost = ObjectId::from_raw(raw);
+            let item = Item::distance(a, ghost, &QueryOptions::default());
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::UnknownObject);
+            let mut rm = AdminRequest::new(AdminOp::Remove);
+            rm.id = raw;
+            assert_eq!(
+                s.handle_admin(1, &rm, &[]).error_code(),
+                ErrorCode::UnknownObject
+            );
+        }
+        let v = [Vertex::default()];
+        for op in [
+            AdminOp::Hello,
+            AdminOp::Stats,
+            AdminOp::Remove,
+            AdminOp::Lookup,
+        ] {
+            let mut req = AdminRequest::new(op);
+            req.id = a.raw();
+            assert_eq!(
+                s.handle_admin(1, &req, &v).error_code(),
+                ErrorCode::Malformed,
+                "{op:?}"
+            );
+        }
+        assert!(
+            s.object(a.raw()).is_some(),
+            "the stray remove removed nothing"
+        );
+        let mut reg = AdminRequest::new(AdminOp::Register);
+        reg.shape = shape_kind::CONVEX;
+        reg.piece_count = 1;
+        reg.pieces[0].vertex_count = 1;
+        reg.pieces[0].reserved = 3;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.shape = shape_kind::COMPOUND;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.pieces[0].reserved = 0;
+        assert_eq!(s.handle_admin(1, &reg, &v).error_code(), ErrorCode::Ok);
+        // Quaternions: zero and NaN; registration poses as well as items.
+        reg.pose.rotation = [0.0; 4];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::BadQuaternion
+        );
+        reg.pose.rotation = [f64::NAN, 0.0, 0.0, 1.0];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::NonFinitePose
+        );
+        reg.pose = Pose::IDENTITY;
+        reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.5];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::BadQuaternion
+        );
+        reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.0];
+        // Names: too long a length, bad UTF-8.
+        reg.name_len = 65;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.name_len = 1;
+        reg.name[0] = 0xC3;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        // Options: infinite tolerance, infinite margin.
+        for o in [
+            QueryOptions {
+                tolerance: f64::INFINITY,
+                ..QueryOptions::default()
+            },
+            QueryOptions {
+                margin: Some(f64::NEG_INFINITY),
+                ..QueryOptions::default()
+            },
+        ] {
+            let item = Item::distance(a, a, &o);
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::InvalidOptions);
+        }
     }
 
     #[test]

@@ -1170,6 +1170,28 @@ mod tests {
     }
 
     #[test]
+    fn a_full_server_refuses_and_recovers_room_on_removal() {
+        let limits = Limits {
+            max_objects: 2,
+            ..Limits::default()
+        };
+        let mut s = State::new(limits, WaitMode::Spin, 5);
+        let a = register_box(&mut s, 1);
+        register_box(&mut s, 1);
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        let v = [Vertex::default()];
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::TooManyObjects
+        );
+        s.remove(a, 1).expect("owner");
+        assert_eq!(s.handle_admin(1, &req, &v).error_code(), ErrorCode::Ok);
+    }
+
+    #[test]
     fn only_the_owner_removes_and_scene_objects_stay() {
         let mut s = state();
         let id = register_box(&mut s, 1);

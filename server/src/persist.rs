@@ -34,6 +34,7 @@
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::os::unix::fs::{DirBuilderExt, OpenOptionsExt};
+use std::os::unix::io::AsRawFd;
 use std::path::{Path, PathBuf};
 
 use gjk::{Compound, Convex, Shape};
@@ -358,6 +359,10 @@ impl Snapshot {
 pub struct Store {
     path: PathBuf,
     tmp: PathBuf,
+    /// `<file>.lock`, held (`flock`) for the store's life: two servers on
+    /// one state file would overwrite each other's objects. The kernel
+    /// drops the lock when the process dies, `kill -9` included.
+    _lock: File,
 }
 
 /// Why a state file could not be written or read.
@@ -401,10 +406,12 @@ pub enum Loaded {
 
 impl Store {
     /// A store at `path`. Creates the parent directory (owner-only, 0700)
-    /// if missing; an existing directory's mode is left alone.
+    /// if missing (an existing directory's mode is left alone), and takes
+    /// the lock that keeps a second server off the same file.
     ///
     /// # Errors
-    /// When the directory cannot be created.
+    /// When the directory cannot be created, or another process holds the
+    /// lock (another server uses this state file).
     pub fn open(path: impl Into<PathBuf>) -> Result<Self, StoreError> {
         let path = path.into();
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -414,11 +421,31 @@ impl Store {
                 .create(dir)
                 .map_err(io("cannot create directory", dir))?;
         }
+        let mut lock_path = path.clone().into_os_string();
+        lock_path.push(".lock");
+        let lock_path = PathBuf::from(lock_path);
+        let lock = OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .mode(0o600)
+            .open(&lock_path)
+            .map_err(io("cannot open the lock file", &lock_path))?;
+        // SAFETY: flock(2) on a descriptor we own.
+        if unsafe { libc::flock(lock.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+            let e = std::io::Error::last_os_error();
+            return Err(StoreError::Io {
+                what: "state file in use by another gjkd server (lock held)",
+                path: lock_path,
+                source: e,
+            });
+        }
         let mut tmp = path.clone().into_os_string();
         tmp.push(format!(".tmp-{}", std::process::id()));
         Ok(Store {
             path,
             tmp: tmp.into(),
+            _lock: lock,
         })
     }
 
@@ -718,12 +745,17 @@ mod tests {
             Loaded::Snapshot(s) => assert_eq!(s, sample()),
             other => panic!("{other:?}"),
         }
-        // No temporary file is left behind.
-        let names: Vec<_> = std::fs::read_dir(path.parent().expect("dir"))
+        // No temporary file is left behind: the state file and the lock.
+        let mut names: Vec<_> = std::fs::read_dir(path.parent().expect("dir"))
             .expect("list")
             .map(|e| e.expect("entry").file_name())
             .collect();
-        assert_eq!(names.len(), 1, "{names:?}");
+        names.sort();
+        assert_eq!(names, ["x.objects", "x.objects.lock"], "{names:?}");
+        // A second store on the same file is refused while this one lives
+        // (flock locks are per open file description, so this holds within
+        // one process too).
+        assert!(Store::open(&path).is_err());
 
         let mut bytes = std::fs::read(&path).expect("read");
         bytes.truncate(bytes.len() - 3);

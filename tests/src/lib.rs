@@ -92,7 +92,11 @@ impl Server {
             .iter()
             .any(|a| a == "--no-persist" || a == "--state-file")
         {
-            let dir = std::env::temp_dir().join(format!("{service}.state"));
+            // One directory per Server value: a second server started on the
+            // same service must not share (or wipe) the first one's file.
+            static DIRS: AtomicU32 = AtomicU32::new(0);
+            let n = DIRS.fetch_add(1, Ordering::Relaxed);
+            let dir = std::env::temp_dir().join(format!("{service}.{n}.state"));
             let _ = std::fs::remove_dir_all(&dir);
             args.push("--state-file".into());
             args.push(dir.join("objects").to_string_lossy().into_owned());

@@ -246,3 +246,22 @@ fn a_corrupt_state_file_is_set_aside_never_half_loaded() {
     let mut client = server.client(Duration::from_secs(5));
     assert_eq!(client.stats().expect("stats").objects, 3);
 }
+
+/// A second server pointed at a state file in use refuses to start instead
+/// of overwriting the first one's objects.
+#[test]
+fn a_state_file_in_use_is_not_shared() {
+    let first = Server::start("lock-a", &["--wait", "block"]);
+    let path = first.state_file().expect("state file");
+    let mut client = first.client(Duration::from_secs(5));
+    let id = client.register_sphere(0.5).expect("registered");
+    let path_arg = path.to_str().expect("utf-8").to_owned();
+    let mut second = Server::start("lock-b", &["--wait", "block", "--state-file", &path_arg]);
+    let status = second.wait_exit().expect("second server exits by itself");
+    assert!(!status.success());
+    assert_eq!(client.stats().expect("stats").objects, 1);
+    client.remove(id).expect("first server still owns its file");
+    let bytes = std::fs::read(&path).expect("state file");
+    let snap = gjkd::persist::Snapshot::decode(&bytes).expect("intact");
+    assert!(snap.objects.is_empty());
+}

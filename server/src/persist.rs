@@ -651,6 +651,7 @@ mod tests {
                 assert!(matches!(err, FormatError::Length { .. }), "{len}: {err}");
             }
         }
+        eprintln!("{} truncations refused", bytes.len());
         let mut longer = bytes.clone();
         longer.push(0);
         assert!(matches!(
@@ -672,6 +673,7 @@ mod tests {
                 );
             }
         }
+        eprintln!("{} single-bit flips refused", bytes.len() * 8);
     }
 
     #[test]

@@ -94,23 +94,34 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let (pa, pb) = (b.pose(), b.pose());
+    let debug = std::env::var_os("GJK_FUZZ_DEBUG").is_some();
     let options = Options {
         tolerance: if b.u8() % 2 == 0 { Options::default().tolerance } else { b.f64() },
         max_iterations: 1 + b.u32() % 200,
         margin: if b.u8() % 3 == 0 { Some(b.f64()) } else { None },
         warm_start: true,
     };
+    if debug {
+        eprintln!("a = {sa:?}\nb = {sb:?}\npose_a = {pa:?}\npose_b = {pb:?}\noptions = {options:?}");
+    }
     let Ok(first) = gjk::distance(&sa, &pa, &sb, &pb, &options, None) else {
         return;
     };
     check(&first);
     // Warm from its own simplex at new poses, then from a made-up one.
     let (qa, qb) = (b.pose(), b.pose());
+    if debug {
+        eprintln!("first = {first:?}\nwarm at pose_a = {qa:?}\npose_b = {qb:?}");
+    }
     if let Ok(again) = gjk::distance(&sa, &qa, &sb, &qb, &options, Some(&first.warm_start)) {
         check(&again);
     }
     let pairs: Vec<[u32; 2]> = (0..1 + b.u8() % 4).map(|_| [b.u32() % 32, b.u32() % 32]).collect();
-    if let Some(w) = WarmStart::new([b.u32() % 4, b.u32() % 4], &pairs)
+    let w = WarmStart::new([b.u32() % 4, b.u32() % 4], &pairs);
+    if debug {
+        eprintln!("made-up warm start {w:?}");
+    }
+    if let Some(w) = w
         && let Ok(made_up) = gjk::distance(&sa, &pa, &sb, &pb, &options, Some(&w))
     {
         check(&made_up);

@@ -187,7 +187,7 @@ pub fn distance(
         // Finite poses whose difference overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }
-    let answer = match (a, b) {
+    let mut answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)));
             let mut simplex = Simplex::empty();
@@ -213,6 +213,20 @@ pub fn distance(
         }
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
+    if answer.lower > answer.upper {
+        // The bounds contradict each other: round-off exceeded the slack.
+        // Found by fuzzing (gjk/tests/fuzz_regressions.rs): a simplex warm
+        // from other poses, with coordinates 1e8 apart in magnitude, gave a
+        // |v| below the true distance. A cold start is tried first; if that
+        // too is inconsistent, the lower bound is given up (0) rather than
+        // returning an interval that cannot hold.
+        if warm.is_some() {
+            return distance(a, pose_a, b, pose_b, options, None);
+        }
+        answer.lower = 0.0;
+        answer.distance = answer.distance.min(answer.upper);
+        answer.status = Status::ToleranceNotMet;
+    }
     let finite = [
         answer.distance,
         answer.lower,
@@ -576,7 +590,9 @@ impl<'s> Pair<'s> {
         };
         let upper = (run.norm + self.slack - self.radii).max(0.0);
         let lower = (run.lower - self.slack - self.radii).max(0.0);
-        let distance = (run.norm - self.radii).max(0.0).clamp(lower, upper);
+        // Not `clamp`: it panics when round-off beyond the slack has put
+        // `lower` above `upper`; `distance` repairs that case.
+        let distance = (run.norm - self.radii).max(0.0).max(lower).min(upper);
         Answer {
             distance,
             lower,

@@ -440,6 +440,7 @@ impl Store {
                 source: e,
             });
         }
+        remove_stale_temporaries(&path);
         let mut tmp = path.clone().into_os_string();
         tmp.push(format!(".tmp-{}", std::process::id()));
         Ok(Store {
@@ -540,6 +541,31 @@ pub fn load_or_quarantine(path: &Path) -> Result<Loaded, StoreError> {
                 reason,
                 moved_to: aside,
             })
+        }
+    }
+}
+
+/// Removes `<file>.tmp-*` left by a server killed in the middle of a
+/// write (the state file itself is intact: the rename never happened).
+/// Only called with the lock held, so no live server is writing them.
+fn remove_stale_temporaries(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
+        return;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let mut prefix = name.to_owned();
+    prefix.push(".tmp-");
+    let prefix = prefix.to_string_lossy().into_owned();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        if e.file_name().to_string_lossy().starts_with(&prefix) {
+            let _ = std::fs::remove_file(e.path());
         }
     }
 }
@@ -733,7 +759,15 @@ mod tests {
         ));
         let _ = std::fs::remove_dir_all(&dir);
         let path = dir.join("sub").join("x.objects");
+        // What a writer killed before its rename leaves behind.
+        std::fs::DirBuilder::new()
+            .recursive(true)
+            .mode(0o700)
+            .create(path.parent().expect("dir"))
+            .expect("dir");
+        std::fs::write(dir.join("sub").join("x.objects.tmp-999999"), b"half").expect("tmp");
         let store = Store::open(&path).expect("dir");
+        assert!(!dir.join("sub").join("x.objects.tmp-999999").exists());
         assert!(matches!(store.load_or_quarantine(), Ok(Loaded::Missing)));
         store.write(&sample()).expect("write");
         let mode = std::fs::metadata(&path).expect("file").permissions().mode();

@@ -8,7 +8,7 @@
 use std::sync::Mutex;
 
 use gjkd::state::{Limits, State};
-use gjkd_proto::{AdminRequest, Item, ItemResult, Vertex, WaitMode};
+use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, Vertex, WaitMode, shape_kind};
 use libfuzzer_sys::fuzz_target;
 
 /// Reinterprets bytes as `T`s: every wire type is plain old data whose every
@@ -49,18 +49,36 @@ fuzz_target!(|data: &[u8]| {
     let state = guard.as_mut().expect("just set");
     let client = u128::from(op % 3);
     if op % 2 == 0 {
-        let split = std::mem::size_of::<AdminRequest>().min(rest.len());
-        let (head, tail) = rest.split_at(split);
-        let Some(mut request) = read::<AdminRequest>(head).pop() else {
+        // The header is larger than libFuzzer's default input limit, so the
+        // input overwrites a prefix of a plausible registration (chosen by
+        // the first byte, in 8-byte steps) and the rest is the vertex slice.
+        let Some((&len, rest)) = rest.split_first() else {
             return;
         };
+        let split = (usize::from(len) * 8)
+            .min(rest.len())
+            .min(std::mem::size_of::<AdminRequest>());
+        let (head, tail) = rest.split_at(split);
+        let mut request = AdminRequest::new(AdminOp::Register);
+        request.shape = shape_kind::CONVEX;
+        request.piece_count = 1;
+        request.pieces[0].vertex_count = (tail.len() / std::mem::size_of::<Vertex>()) as u32;
+        // SAFETY: `head` is at most the size of AdminRequest, a repr(C)
+        // struct of integers, floats and byte arrays, valid for any bits.
+        unsafe {
+            std::ptr::copy_nonoverlapping(
+                head.as_ptr(),
+                (&raw mut request).cast::<u8>(),
+                head.len(),
+            );
+        }
         // Often a real operation, so the decoder gets past the first check.
         if op % 4 == 0 {
-            request.op = 2;
+            request.op = AdminOp::Register as u32;
         }
         let vertices = read::<Vertex>(tail);
         let reply = state.handle_admin(client, &request, &vertices);
-        if reply.error == 0 && request.op == 2 {
+        if reply.error == 0 && request.op == AdminOp::Register as u32 {
             assert!(state.object(reply.id).is_some(), "acknowledged but absent");
         }
     } else {
@@ -71,7 +89,7 @@ fuzz_target!(|data: &[u8]| {
             for (k, item) in items.iter_mut().enumerate() {
                 if item.flags & 0x100 != 0 {
                     item.a = ids[(item.a as usize) % ids.len()];
-                    item.b = ids[(item.b as usize + k) % ids.len()];
+                    item.b = ids[(item.b as usize).wrapping_add(k) % ids.len()];
                     item.flags &= 0xff;
                     item.kind = 1 + item.kind % 2;
                 }

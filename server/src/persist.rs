@@ -57,6 +57,10 @@ pub const HEADER_LEN: usize = 24;
 /// guards against absurd files).
 pub const MAX_PAYLOAD: u64 = 1 << 36;
 
+/// Journal slots above this are refused on load (a journal of 4 Mi slots
+/// is 288 MiB; the default object limit is 1 Mi).
+pub const MAX_SLOTS: u32 = 1 << 22;
+
 /// A pose as stored: translation and quaternion `[i, j, k, w]`, exactly the
 /// bits of the in-memory isometry.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -324,9 +328,10 @@ impl Snapshot {
         let mut names = std::collections::HashSet::new();
         let mut slots = std::collections::HashSet::new();
         for o in &self.objects {
-            // Slots are dense (reused after removals): one far beyond the
-            // object count is corruption, and would size the journal absurdly.
-            if o.slot as usize > self.objects.len() * 2 + 1024 || !slots.insert(o.slot) {
+            // Slots are reused after removals, so they stay below the peak
+            // number of objects; one past MAX_SLOTS could only come from a
+            // buggy writer, and would size the journal absurdly.
+            if o.slot >= MAX_SLOTS || !slots.insert(o.slot) {
                 return Err(format!("bad or repeated journal slot {}", o.slot));
             }
             let (epoch, index) = ((o.id >> 32) as u32, o.id as u32);

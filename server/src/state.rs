@@ -1254,6 +1254,26 @@ mod tests {
         assert!(State::restore(too_few, WaitMode::Spin, &back).is_err());
     }
 
+    /// Many objects registered and most removed: the survivors may sit in
+    /// high journal slots, and the file must still load.
+    #[test]
+    fn a_store_that_shrank_restores() {
+        let mut s = state();
+        let ids: Vec<u64> = (0..3000).map(|_| register_box(&mut s, 1)).collect();
+        for &id in &ids[..2990] {
+            s.remove(id, 1).expect("owner");
+        }
+        let snap = s.snapshot();
+        assert!(snap.objects.iter().any(|o| o.slot > 2000));
+        let bytes = snap.encode().expect("encodes");
+        let back = crate::persist::Snapshot::decode(&bytes).expect("a valid file");
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("restores");
+        assert_eq!(r.len(), 10);
+        // Freed slots are reused before new ones.
+        let fresh = register_box(&mut r, 1);
+        assert!(r.object(fresh).expect("there").slot < 2990);
+    }
+
     #[test]
     fn a_failed_write_undoes_the_change_and_says_internal() {
         let dir = std::env::temp_dir().join(format!("gjkd-state-{}", std::process::id()));

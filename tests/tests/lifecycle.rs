@@ -272,3 +272,28 @@ offset = { translation = [0.05, 0.0, 0.0] }
     assert!(client.lookup("table").is_ok());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A hung server (SIGSTOP) is reported within the call's timeout, as a
+/// timeout: it is still there, it just does not answer. Once it resumes,
+/// it serves the same objects.
+#[test]
+fn a_hung_server_times_out_and_serves_again_when_resumed() {
+    let server = Server::start("hung", &["--wait", "block"]);
+    let timeout = Duration::from_millis(500);
+    let mut client = server.client(timeout);
+    let (a, b) = spheres(&mut client);
+    let pid = libc::pid_t::try_from(server.pid().expect("running")).expect("pid");
+    // SAFETY: kill(2) on the server we spawned.
+    unsafe { libc::kill(pid, libc::SIGSTOP) };
+    let start = Instant::now();
+    let err = client
+        .distance(a, b, &QueryOptions::default())
+        .expect_err("stopped");
+    let took = start.elapsed();
+    // SAFETY: as above.
+    unsafe { libc::kill(pid, libc::SIGCONT) };
+    eprintln!("hung server reported after {took:?}: {err}");
+    assert_eq!(err, ClientError::Timeout(timeout));
+    assert!(took < timeout + Duration::from_millis(500), "{took:?}");
+    check(&mut client, a, b);
+}

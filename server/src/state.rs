@@ -1274,6 +1274,70 @@ mod tests {
         assert!(r.object(fresh).expect("there").slot < 2990);
     }
 
+    /// The input `fuzz/` found (`gjk/tests/fuzz_regressions.rs`), through
+    /// the server: a warm query across poses with 1e108 and 1e100
+    /// coordinates. It used to panic inside gjk (answered `Internal` by the
+    /// serving loop's catch_unwind); now it is answered with ordered bounds.
+    #[test]
+    fn the_fuzz_found_warm_start_is_answered() {
+        let mut s = state();
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 4;
+        req.pieces[0].radius = 6.4000000000000006e100;
+        let v = |x: f64, y: f64, z: f64| Vertex { x, y, z };
+        let a = s.handle_admin(
+            1,
+            &req,
+            &[
+                v(9.9e100, 9.900000000000002e108, 9.9e100),
+                v(9.9e100, 9.9e100, 9.9e100),
+                v(9.9e100, 9.9e100, 9.9e100),
+                v(6.1875, 9.9e100, 9.9e100),
+            ],
+        );
+        req.pieces[0].radius = 0.0;
+        let b = s.handle_admin(
+            1,
+            &req,
+            &[
+                v(9.9e100, 9.9e100, -6.25),
+                v(-6.25, -6.25, -6.25),
+                v(-6.25, -6.25, -6.25),
+                v(-6.25, -6.25, -6.25),
+            ],
+        );
+        let (a, b) = (ObjectId::from_raw(a.id), ObjectId::from_raw(b.id));
+        let pose = |w: f64, i: f64, j: f64, k: f64| {
+            Isometry3::from_parts(
+                Translation3::new(-6.25, -6.25, -6.25),
+                UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
+            )
+        };
+        let o = QueryOptions {
+            tolerance: 2.220446049250313e-14,
+            max_iterations: 55,
+            ..QueryOptions::default()
+        };
+        let p = pose(-0.5, -0.5, -0.5, -0.5);
+        let turned = pose(
+            -0.51231551957856,
+            -0.51231551957856,
+            -0.51231551957856,
+            0.46108396762070397,
+        );
+        for (pa, pb) in [(p, p), (p, turned)] {
+            let item = Item::distance(a, b, &o).with_pose_a(&pa).with_pose_b(&pb);
+            let got = one(&mut s, 9, item).answer().expect("answered");
+            assert!(
+                got.lower <= got.distance && got.distance <= got.upper,
+                "{got:?}"
+            );
+            assert!(got.distance > 7e100 && got.distance < 8e100, "{got:?}");
+        }
+    }
+
     #[test]
     fn a_failed_write_undoes_the_change_and_says_internal() {
         let dir = std::env::temp_dir().join(format!("gjkd-state-{}", std::process::id()));

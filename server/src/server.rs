@@ -228,7 +228,6 @@ pub fn run(
         let now = Instant::now();
         if served > 0 {
             last_request = now;
-            continue;
         }
         let since = now.duration_since(last_housekeeping);
         if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
@@ -250,6 +249,9 @@ pub fn run(
             if let Err(e) = state.flush() {
                 error!("cannot sync the pose journal: {e}");
             }
+        }
+        if served > 0 {
+            continue;
         }
         let sleep = match options.wait {
             WaitMode::Spin => false,

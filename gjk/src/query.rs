@@ -214,12 +214,12 @@ pub fn distance(
         _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
     };
     if answer.lower > answer.upper {
-        // The bounds contradict each other: round-off exceeded the slack.
-        // Found by fuzzing (gjk/tests/fuzz_regressions.rs): a simplex warm
-        // from other poses, with coordinates 1e8 apart in magnitude, gave a
-        // |v| below the true distance. A cold start is tried first; if that
-        // too is inconsistent, the lower bound is given up (0) rather than
-        // returning an interval that cannot hold.
+        // The bounds contradict each other: round-off beyond the slack. The
+        // one case fuzzing found (NaN weights from overflowing cofactors)
+        // is handled in `solve`; this is the last line of defence. A cold
+        // start is tried first; if that too is inconsistent, the lower
+        // bound is given up (0) rather than returning an interval that
+        // cannot hold.
         if warm.is_some() {
             return distance(a, pose_a, b, pose_b, options, None);
         }
@@ -401,6 +401,38 @@ impl<'s> Pair<'s> {
             loop {
                 let v2 = sol.v.norm_squared();
                 let norm = v2.sqrt();
+                if !norm.is_finite() {
+                    // The subalgorithm overflowed: the cofactors of points
+                    // ~1e108 from each other exceed f64 (found by fuzzing,
+                    // gjk/tests/fuzz_regressions.rs), and NaN weights would
+                    // make every bound below meaningless. Keep the last
+                    // finite iterate, or else a single vertex: each is a
+                    // point of the hull, so |v| stays an upper bound.
+                    backup_used = true;
+                    let best = match prev {
+                        Some((p, _)) => p,
+                        None => {
+                            let i = simplex.all.trailing_zeros().min(3) as usize;
+                            let mut lambda = [0.0; 4];
+                            lambda[i] = 1.0;
+                            Solution {
+                                mask: 1 << i,
+                                v: simplex.vertices[i].y,
+                                lambda,
+                            }
+                        }
+                    };
+                    let finish_best = Run {
+                        inner: 0.0,
+                        sol: best,
+                        norm: best.v.norm(),
+                        lower,
+                        iterations,
+                        exit: Exit::Status(Status::ToleranceNotMet),
+                        backup_used,
+                    };
+                    return finish_best;
+                }
                 let finish = |exit, sol: Solution, lower: f64| {
                     let norm = sol.v.norm();
                     Run {

@@ -45,8 +45,11 @@ fn check_warm(
     ans
 }
 
-/// Vertices of magnitude 1e100 and 1e108 next to ones of magnitude 1: the
-/// lower bound came out above the upper one and `clamp` panicked.
+/// Vertices of magnitude 1e100 and 1e108 next to ones of magnitude 1,
+/// queried warm from another pose: the subalgorithm's cofactors overflowed
+/// to NaN weights, `|v|` became NaN, the upper bound fell to 0 under the
+/// lower one and `clamp` panicked. Now the last finite iterate is kept and
+/// the answer agrees with brute force.
 #[test]
 fn mixed_magnitudes_1e108_and_1() {
     let a: Shape = Convex::new(

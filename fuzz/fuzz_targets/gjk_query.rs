@@ -59,8 +59,10 @@ impl Bytes<'_> {
         let t = Translation3::new(self.f64(), self.f64(), self.f64());
         let q = Quaternion::new(self.f64(), self.f64(), self.f64(), self.f64());
         // Only unit quaternions reach the query (the server checks them);
-        // a NaN or zero one becomes the identity.
-        let r = UnitQuaternion::try_new(q, 0.0).unwrap_or_else(UnitQuaternion::identity);
+        // a NaN, zero or underflowing one becomes the identity.
+        let r = UnitQuaternion::try_new(q, 0.0)
+            .filter(|r| (r.coords.norm() - 1.0).abs() < 1e-6)
+            .unwrap_or_else(UnitQuaternion::identity);
         Isometry3::from_parts(t, r)
     }
 
@@ -88,6 +90,36 @@ fn check(a: &gjk::Answer) {
     assert!(a.lower >= 0.0 && a.penetration >= 0.0, "negative bound: {a:?}");
 }
 
+/// The lower bound can never exceed the distance between any vertex of A
+/// and any vertex of B (less the radii), up to round-off of their size.
+fn check_lower_against_vertices(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    ans: &gjk::Answer,
+) {
+    let (Shape::Convex(ca), Shape::Convex(cb)) = (a, b) else {
+        return;
+    };
+    let wa: Vec<Point3<f64>> = ca.vertices().iter().map(|p| pa * p).collect();
+    let wb: Vec<Point3<f64>> = cb.vertices().iter().map(|p| pb * p).collect();
+    let mut scale: f64 = 0.0;
+    let mut nearest = f64::INFINITY;
+    for x in &wa {
+        for y in &wb {
+            nearest = nearest.min((x - y).norm());
+            scale = scale.max(x.coords.amax()).max(y.coords.amax());
+        }
+    }
+    let bound = nearest - ca.radius() - cb.radius();
+    if !bound.is_finite() || !scale.is_finite() {
+        return;
+    }
+    let slack = 1e-9 * (scale + nearest + ca.radius() + cb.radius());
+    assert!(ans.lower <= bound.max(0.0) + slack, "lower {} above vertex bound {bound}: {ans:?}", ans.lower);
+}
+
 fuzz_target!(|data: &[u8]| {
     let mut b = Bytes(data);
     let (Some(sa), Some(sb)) = (b.shape(), b.shape()) else {
@@ -108,6 +140,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     check(&first);
+    check_lower_against_vertices(&sa, &pa, &sb, &pb, &first);
     // Warm from its own simplex at new poses, then from a made-up one.
     let (qa, qb) = (b.pose(), b.pose());
     if debug {
@@ -115,6 +148,7 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(again) = gjk::distance(&sa, &qa, &sb, &qb, &options, Some(&first.warm_start)) {
         check(&again);
+        check_lower_against_vertices(&sa, &qa, &sb, &qb, &again);
     }
     let pairs: Vec<[u32; 2]> = (0..1 + b.u8() % 4).map(|_| [b.u32() % 32, b.u32() % 32]).collect();
     let w = WarmStart::new([b.u32() % 4, b.u32() % 4], &pairs);

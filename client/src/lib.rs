@@ -82,10 +82,21 @@
 //! Every call returns within the client's timeout (default one second, see
 //! [`ClientBuilder::timeout`]). If the server has died or stopped, the call
 //! fails with [`ClientError::ServerGone`]; later calls reconnect by themselves
-//! once a server serves the name again. Object ids do not survive a server
-//! restart: after one, re-register (or [`Client::lookup`] scene objects by
-//! name again); old ids get [`ErrorCode::UnknownObject`], never some other
-//! object.
+//! once a server serves the name again. A server started with persistence
+//! (the default of `gjkd serve`) reloads every object whose registration it
+//! acknowledged, with the same id, geometry, name, owner and latest stored
+//! pose, so after a restart the same ids go on working and this `Client`
+//! can still remove what it registered. A server started with
+//! `--no-persist` starts empty: old ids then get
+//! [`ErrorCode::UnknownObject`], never some other object. Warm starts are
+//! not kept across a restart (the first query of each pair is cold).
+//!
+//! ## Bad input
+//!
+//! Every field of every request is checked by the server; each bad value has
+//! its own [`ErrorCode`] (the full table is in `docs/errors.md`), a bad item
+//! fails alone while the rest of its batch is answered, and nothing a client
+//! sends can make the server panic or lose an object.
 //!
 //! A `Client` is not `Send` (iceoryx2 ports are bound to their thread): create
 //! one per thread. Each holds one iceoryx2 node and two client ports.

@@ -897,6 +897,13 @@ pub struct ServerStats {
     pub cache_misses: u64,
     /// Entries evicted to stay within the capacity.
     pub cache_evictions: u64,
+    /// Query clients connected, as of the server's last housekeeping
+    /// (every few seconds): a client that died drops out once its death
+    /// is detected.
+    pub clients: u64,
+    /// Writes of the state file that failed (each failed registration or
+    /// removal was refused with [`ErrorCode::Internal`] and undone).
+    pub persist_errors: u64,
 }
 
 /// The admin service's answer.

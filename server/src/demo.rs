@@ -227,8 +227,8 @@ fn median(mut v: Vec<Duration>) -> Duration {
 /// disagrees with the in-process computation.
 pub fn run(steps: &[usize], repeats: usize) -> Result<(), DemoError> {
     let service = format!("gjkd-demo-{}", std::process::id());
-    let mut server =
-        ServerProcess::spawn(&service, &["--wait", "spin"]).map_err(DemoError::Spawn)?;
+    let mut server = ServerProcess::spawn(&service, &["--wait", "spin", "--no-persist"])
+        .map_err(DemoError::Spawn)?;
     let outcome = run_with_server(&service, steps, repeats);
     let clean = server.stop();
     let () = outcome?;

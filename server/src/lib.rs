@@ -2,8 +2,10 @@
 //!
 //! The gjkd distance server as a library: the object store and its request
 //! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
-//! ([`scene`]), the iceoryx2 serving loop ([`server`]), the built-in demo
-//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`]). The `gjkd` binary is a thin command line over these.
+//! ([`scene`]), the state file that keeps objects across crashes
+//! ([`persist`]), the iceoryx2 serving loop ([`server`]), the built-in demo
+//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`]). The `gjkd`
+//! binary is a thin command line over these.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the
 //! request's bytes, so they can be tested and fuzzed without any IPC:
@@ -33,6 +35,8 @@
 pub mod bench;
 pub mod cache;
 pub mod demo;
+pub mod journal;
+pub mod persist;
 pub mod scene;
 pub mod server;
 pub mod state;

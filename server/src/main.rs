@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use gjkd::persist::{Loaded, Store};
 use gjkd::scene::Scene;
 use gjkd::server::{ServeOptions, run};
 use gjkd::state::{Limits, State};
@@ -86,6 +87,16 @@ struct ServeArgs {
     /// Most warm-start cache entries (one per client and ordered pair).
     #[arg(long, default_value_t = Limits::default().cache_capacity)]
     cache_capacity: usize,
+    /// State file: registered objects are written here before each
+    /// registration or removal is acknowledged, and reloaded at start with
+    /// the same ids. Default
+    /// `${XDG_STATE_HOME:-$HOME/.local/state}/gjkd/<service>.objects`
+    /// (directory created 0700, file 0600).
+    #[arg(long, value_name = "PATH", conflicts_with = "no_persist")]
+    state_file: Option<PathBuf>,
+    /// Keep objects in memory only: they are lost when the server stops.
+    #[arg(long)]
+    no_persist: bool,
 }
 
 #[derive(Args, Debug)]
@@ -138,7 +149,17 @@ fn serve(args: ServeArgs) -> ExitCode {
         max_objects: args.max_objects,
         cache_capacity: args.cache_capacity,
     };
-    let mut state = State::new(limits, args.wait.into(), epoch());
+    let mut state = if args.no_persist {
+        State::new(limits, args.wait.into(), epoch())
+    } else {
+        match open_state(&args, limits) {
+            Ok(state) => state,
+            Err(message) => {
+                error!("{message}");
+                return ExitCode::FAILURE;
+            }
+        }
+    };
     if let Some(path) = &args.scene {
         match Scene::load(path).and_then(|s| s.install(&mut state)) {
             Ok(ids) => info!(scene = %path.display(), objects = ids.len(), "scene loaded"),
@@ -147,6 +168,12 @@ fn serve(args: ServeArgs) -> ExitCode {
                 return ExitCode::FAILURE;
             }
         }
+    }
+    // Written once at start: a read-only directory fails now rather than at
+    // the first registration, and the scene's ids become durable.
+    if let Err(e) = state.persist() {
+        error!("{e}");
+        return ExitCode::FAILURE;
     }
     let shutdown = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
@@ -166,6 +193,44 @@ fn serve(args: ServeArgs) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The state of a persisting server: restored from its state file, or
+/// empty when there is none or it was corrupt (set aside, never half-loaded).
+fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
+    let path = args
+        .state_file
+        .clone()
+        .or_else(|| gjkd::persist::default_path(&args.service))
+        .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file or --no-persist")?;
+    let store = Store::open(&path).map_err(|e| e.to_string())?;
+    let wait = args.wait.into();
+    let mut state = match store.load_or_quarantine().map_err(|e| e.to_string())? {
+        Loaded::Missing => {
+            info!(file = %path.display(), "no state file yet: starting empty");
+            State::new(limits, wait, epoch())
+        }
+        Loaded::Snapshot(snapshot) => {
+            let state = State::restore(limits, wait, &snapshot).map_err(|e| {
+                format!(
+                    "cannot restore {} ({e}); raise the limits or move the file away",
+                    path.display()
+                )
+            })?;
+            info!(file = %path.display(), objects = state.len(), "objects restored");
+            state
+        }
+        Loaded::Corrupt { reason, moved_to } => {
+            error!(
+                file = %path.display(),
+                moved_to = %moved_to.display(),
+                "state file is corrupt ({reason}): set aside, starting with no objects"
+            );
+            State::new(limits, wait, epoch())
+        }
+    };
+    state.set_store(store).map_err(|e| e.to_string())?;
+    Ok(state)
 }
 
 /// Upper half of every object id of this run: differs between runs so that a

@@ -50,7 +50,7 @@ use gjk::{Compound, Convex, Shape};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 
-use crate::state::{NewObject, Owner, State};
+use crate::state::{NewObject, State};
 
 /// What can be wrong with a scene file.
 #[derive(Debug, thiserror::Error)]
@@ -259,18 +259,26 @@ impl Scene {
     }
 
     /// Adds every object to `state` as a read-only scene object, in file
-    /// order, returning their ids.
+    /// order, returning their ids. A scene object restored from the state
+    /// file with the same name and geometry keeps its id, so clients that
+    /// looked it up before a crash can go on using the id; restored scene
+    /// objects the file no longer has are dropped.
     ///
     /// # Errors
-    /// [`SceneError::Object`] for an invalid shape or pose, a duplicate name or
-    /// too many objects; objects before it stay added.
+    /// [`SceneError::Object`] for an invalid shape or pose, a duplicate name
+    /// (within the file, or taken by a client's object restored from the
+    /// state file) or too many objects; objects before it stay added.
     pub fn install(&self, state: &mut State) -> Result<Vec<u64>, SceneError> {
         let mut ids = Vec::with_capacity(self.objects.len());
+        let mut seen = std::collections::HashSet::new();
         for spec in &self.objects {
             let fail = |reason: String| SceneError::Object {
                 name: spec.name.clone(),
                 reason,
             };
+            if !seen.insert(spec.name.as_str()) {
+                return Err(fail(gjkd_proto::ErrorCode::NameTaken.to_string()));
+            }
             if spec.name.is_empty() || spec.name.len() > gjkd_proto::MAX_NAME_LEN {
                 return Err(fail(format!(
                     "names must be 1 to {} bytes long",
@@ -285,10 +293,11 @@ impl Scene {
                 name: Some(spec.name.clone()),
             };
             let id = state
-                .insert(new, Owner::Scene)
+                .adopt_scene_object(new)
                 .map_err(|e| fail(e.to_string()))?;
             ids.push(id);
         }
+        state.drop_scene_objects_except(&ids);
         Ok(ids)
     }
 }
@@ -337,6 +346,39 @@ type = "box"
 half_extents = [0.2, 0.2, 0.2]
 offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
 "#;
+
+    /// After a restart the same scene keeps its ids; a changed scene gets
+    /// new ids for what changed and loses what it dropped; a duplicate name
+    /// in one file is an error.
+    #[test]
+    fn scene_ids_survive_a_restart_and_follow_changes() {
+        let scene = Scene::from_toml(EXAMPLE).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        let mut again =
+            State::restore(Limits::default(), WaitMode::Spin, &state.snapshot()).expect("restores");
+        assert_eq!(scene.install(&mut again).expect("valid"), ids);
+        assert_eq!(again.len(), ids.len());
+
+        let changed = EXAMPLE
+            .replace("radius = 0.5", "radius = 0.6")
+            .replace("name = \"wedge\"", "name = \"prism\"");
+        let changed = Scene::from_toml(&changed).expect("parses");
+        let mut third =
+            State::restore(Limits::default(), WaitMode::Spin, &again.snapshot()).expect("restores");
+        let new_ids = changed.install(&mut third).expect("valid");
+        assert_ne!(new_ids[0], ids[0], "the ball changed");
+        assert_eq!(new_ids[1..3], ids[1..3]);
+        assert_ne!(new_ids[3], ids[3], "the wedge became a prism");
+        assert_eq!(third.lookup("wedge"), None);
+        assert_eq!(third.len(), 5);
+
+        let twice =
+            format!("{EXAMPLE}\n[[object]]\nname = \"ball\"\ntype = \"sphere\"\nradius = 0.5\n");
+        let twice = Scene::from_toml(&twice).expect("parses");
+        let mut fresh = State::new(Limits::default(), WaitMode::Spin, 1);
+        assert!(twice.install(&mut fresh).is_err());
+    }
 
     #[test]
     fn the_documented_example_loads() {

@@ -57,6 +57,10 @@ const BLOCK_SLICE: Duration = Duration::from_millis(50);
 /// milliseconds that must not land in the middle of a burst of queries.
 const HOUSEKEEPING_PERIOD: Duration = Duration::from_secs(2);
 const IDLE_BEFORE_HOUSEKEEPING: Duration = Duration::from_millis(20);
+/// A server that is never idle still looks for dead clients this often, or
+/// the state of a client killed while others keep it busy would never be
+/// freed.
+const HOUSEKEEPING_FORCED: Duration = Duration::from_secs(5);
 
 /// In spin mode, the admin service is polled once per this many idle loop
 /// turns: each poll scans every connected client, and registrations are rare.
@@ -216,22 +220,22 @@ pub fn run(
     let mut last_yield = Instant::now();
     let mut last_housekeeping = Instant::now();
     let mut turns: u32 = 0;
-    let mut known_clients = 0usize;
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
         let mut served = serve_queries(&query, &mut state);
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
         if options.wait != WaitMode::Spin || turns.is_multiple_of(ADMIN_POLL_EVERY) {
-            served += serve_admin(&admin, &mut state);
+            served += serve_admin(&admin, &admin_service, &mut state);
         }
         let now = Instant::now();
         if served > 0 {
             last_request = now;
-            continue;
         }
-        if now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
-            && now.duration_since(last_housekeeping) > HOUSEKEEPING_PERIOD
+        let since = now.duration_since(last_housekeeping);
+        if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
+            && since > HOUSEKEEPING_PERIOD)
+            || since > HOUSEKEEPING_FORCED
         {
             last_housekeeping = now;
             let cleaned = node.try_cleanup_dead_nodes();
@@ -241,11 +245,16 @@ pub fn run(
                     "cleaned up resources of dead clients"
                 );
             }
-            let clients = query_service.dynamic_config().number_of_clients();
-            if clients < known_clients {
-                forget_departed_clients(&query_service, &mut state);
+            // Always compared with the live list, not the count: a client
+            // that died while another connected leaves the count unchanged.
+            forget_departed_clients(&query_service, &mut state);
+            state.set_clients(query_service.dynamic_config().number_of_clients());
+            if let Err(e) = state.flush() {
+                error!("cannot sync the pose journal: {e}");
             }
-            known_clients = clients;
+        }
+        if served > 0 {
+            continue;
         }
         let sleep = match options.wait {
             WaitMode::Spin => false,
@@ -264,6 +273,9 @@ pub fn run(
         }
     }
     info!(service = %options.service, "shutting down");
+    if let Err(e) = state.flush() {
+        error!("cannot sync the pose journal: {e}");
+    }
     // Ports, services and the node are dropped here, in reverse order of
     // creation, which removes the services' shared memory.
     Ok(())
@@ -383,8 +395,34 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
     }
 }
 
+type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Vertex],
+    AdminRequest,
+    AdminReply,
+    (),
+>;
+
+/// The owner identity of admin client port `port`: the id of the iceoryx2
+/// node that created it. A `gjkd-client` `Client` keeps its node for its
+/// whole life, so the identity survives its reconnections and a server
+/// restart, where port ids do not. A port that is already gone (its
+/// process died after sending) keeps its port id, which owns nothing.
+fn owner_of(service: &AdminService, port: u128) -> u128 {
+    let mut owner = port;
+    service.dynamic_config().list_clients(|c| {
+        if c.client_id.value() == port {
+            owner = c.node_id.value();
+            CallbackProgression::Stop
+        } else {
+            CallbackProgression::Continue
+        }
+    });
+    owner
+}
+
 /// Answers every admin request waiting; returns how many.
-fn serve_admin(admin: &AdminServer, state: &mut State) -> usize {
+fn serve_admin(admin: &AdminServer, service: &AdminService, state: &mut State) -> usize {
     let mut served = 0;
     loop {
         let request = match admin.receive() {
@@ -397,7 +435,7 @@ fn serve_admin(admin: &AdminServer, state: &mut State) -> usize {
         };
         served += 1;
         let header = request.user_header();
-        let client = request.origin().value();
+        let client = owner_of(service, request.origin().value());
         let vertices = request.payload();
         let reply = catch_unwind(AssertUnwindSafe(|| {
             state.handle_admin(client, header, vertices)

@@ -15,6 +15,8 @@ use gjkd_proto::{
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use crate::cache::{FxBuild, PairKey, WarmCache};
+use crate::journal::Journal;
+use crate::persist::{Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
 
 /// Limits the server enforces, also used to size the iceoryx2 services.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,12 +53,19 @@ impl Default for Limits {
     }
 }
 
-/// Who may change an object.
+/// Who may remove an object.
+///
+/// A client is identified by the id of its iceoryx2 node: one per
+/// `gjkd-client` `Client`, kept for the `Client`'s whole life, across its
+/// reconnections and across server restarts (the id is stored in the state
+/// file). A client *process* that restarts has a new node, so objects
+/// registered by its previous life can no longer be removed by anyone; they
+/// stay until the state file is removed (see `docs/reliability.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Owner {
     /// Loaded from the scene file at start: read-only.
     Scene,
-    /// Registered by the admin client port with this id.
+    /// Registered by the client whose iceoryx2 node has this id.
     Client(u128),
 }
 
@@ -71,6 +80,8 @@ pub struct Object {
     pub owner: Owner,
     /// Name for look-ups, if any.
     pub name: Option<String>,
+    /// Its slot in the pose journal (see [`crate::journal`]).
+    pub slot: u32,
 }
 
 /// Everything the server holds.
@@ -87,6 +98,20 @@ pub struct State {
     names: HashMap<String, u64>,
     cache: WarmCache,
     stats: ServerStats,
+    /// Where registrations and removals are written before they are
+    /// acknowledged; `None` when persistence is off.
+    store: Option<Store>,
+    /// Latest poses, kept where a crash of this process cannot lose them
+    /// (present when `store` is).
+    journal: Option<Journal>,
+    /// Journal slots of removed objects, for reuse.
+    free_slots: Vec<u32>,
+    /// Lowest slot never used.
+    next_slot: u32,
+    /// Writes of the state file that failed.
+    persist_errors: u64,
+    /// Query clients connected, as last seen by the serving loop.
+    clients: u64,
 }
 
 /// The shape part of a registration, in the server's terms.
@@ -114,7 +139,228 @@ impl State {
             names: HashMap::new(),
             cache: WarmCache::new(limits.cache_capacity),
             stats: ServerStats::default(),
+            store: None,
+            journal: None,
+            free_slots: Vec::new(),
+            next_slot: 0,
+            persist_errors: 0,
+            clients: 0,
         }
+    }
+
+    /// A store holding the objects of `snapshot` with their exact ids, its
+    /// id counter continuing where the snapshot's stopped (so no id is ever
+    /// handed out twice).
+    ///
+    /// # Errors
+    /// A description of the problem if the snapshot does not pass
+    /// [`Snapshot::validate`] or holds more objects than `limits` allow;
+    /// nothing is half-loaded.
+    pub fn restore(limits: Limits, wait: WaitMode, snapshot: &Snapshot) -> Result<Self, String> {
+        snapshot.validate()?;
+        if snapshot.objects.len() > limits.max_objects {
+            return Err(format!(
+                "{} objects stored, the limit is {}",
+                snapshot.objects.len(),
+                limits.max_objects
+            ));
+        }
+        let mut state = State::new(limits, wait, snapshot.epoch);
+        state.next_index = snapshot.next_index;
+        for o in &snapshot.objects {
+            let object = Object {
+                shape: o.shape.to_shape()?,
+                pose: o.pose.to_isometry().ok_or("bad pose")?,
+                owner: match o.owner {
+                    StoredOwner::Scene => Owner::Scene,
+                    StoredOwner::Client(c) => Owner::Client(c),
+                },
+                name: o.name.clone(),
+                slot: o.slot,
+            };
+            if let Some(name) = &object.name {
+                state.names.insert(name.clone(), o.id);
+            }
+            state.objects.insert(o.id, object);
+        }
+        let mut used: Vec<u32> = snapshot.objects.iter().map(|o| o.slot).collect();
+        used.sort_unstable();
+        state.next_slot = used.last().map_or(0, |&m| m + 1);
+        state.free_slots = (0..state.next_slot)
+            .rev()
+            .filter(|s| used.binary_search(s).is_err())
+            .collect();
+        Ok(state)
+    }
+
+    /// Everything needed to rebuild this store: id counter and objects, in
+    /// id order.
+    pub fn snapshot(&self) -> Snapshot {
+        let mut objects: Vec<StoredObject> = self
+            .objects
+            .iter()
+            .map(|(&id, o)| StoredObject {
+                id,
+                owner: match o.owner {
+                    Owner::Scene => StoredOwner::Scene,
+                    Owner::Client(c) => StoredOwner::Client(c),
+                },
+                name: o.name.clone(),
+                pose: StoredPose::from_isometry(&o.pose),
+                shape: StoredShape::from_shape(&o.shape),
+                slot: o.slot,
+            })
+            .collect();
+        objects.sort_unstable_by_key(|o| o.id);
+        Snapshot {
+            epoch: (self.epoch >> 32) as u32,
+            next_index: self.next_index,
+            objects,
+        }
+    }
+
+    /// Turns persistence on: from now on every registration and removal is
+    /// written to `store` before it is acknowledged, and every pose update
+    /// goes to the pose journal next to it. Poses the journal holds for the
+    /// objects already here (restored from the state file) replace theirs:
+    /// they are the latest ones before a crash.
+    ///
+    /// # Errors
+    /// When the journal cannot be opened; persistence stays off then.
+    pub fn set_store(&mut self, store: Store) -> Result<(), crate::persist::StoreError> {
+        let path = crate::journal::path_for(store.path());
+        let mut journal =
+            Journal::open(&path).map_err(|source| crate::persist::StoreError::Io {
+                what: "cannot open the pose journal",
+                path: path.clone(),
+                source,
+            })?;
+        for (&id, o) in self.objects.iter_mut() {
+            if let Some(pose) = journal.read(o.slot, id) {
+                o.pose = pose;
+            }
+        }
+        for (&id, o) in &self.objects {
+            journal.write(o.slot, id, &o.pose).map_err(|source| {
+                crate::persist::StoreError::Io {
+                    what: "cannot write the pose journal",
+                    path: path.clone(),
+                    source,
+                }
+            })?;
+        }
+        self.journal = Some(journal);
+        self.store = Some(store);
+        Ok(())
+    }
+
+    /// Writes `pose` of object `id` (in `slot`) to the journal, if any. A
+    /// failure (the file cannot grow: disk full) costs only durability of
+    /// this pose, not the update itself, so it is counted and logged.
+    fn journal_pose(&mut self, slot: u32, id: u64) {
+        let (Some(journal), Some(o)) = (self.journal.as_mut(), self.objects.get(&id)) else {
+            return;
+        };
+        if let Err(e) = journal.write(slot, id, &o.pose) {
+            self.persist_errors += 1;
+            tracing::error!("cannot write the pose journal: {e}");
+        }
+    }
+
+    /// The state file, when persistence is on.
+    pub fn store(&self) -> Option<&Store> {
+        self.store.as_ref()
+    }
+
+    /// Writes the state file now (when persistence is on).
+    ///
+    /// # Errors
+    /// The write error; the previous file is then intact.
+    pub fn persist(&mut self) -> Result<(), crate::persist::StoreError> {
+        let Some(store) = &self.store else {
+            return Ok(());
+        };
+        match store.write(&self.snapshot()) {
+            Ok(()) => Ok(()),
+            Err(e) => {
+                self.persist_errors += 1;
+                Err(e)
+            }
+        }
+    }
+
+    /// Asks the kernel to put the pose journal on disk if poses changed.
+    /// Only a machine crash needs this (the journal's pages outlive the
+    /// process); called when idle and at shutdown.
+    ///
+    /// # Errors
+    /// The `msync` error.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.journal {
+            Some(j) => j.sync(),
+            None => Ok(()),
+        }
+    }
+
+    /// Records how many query clients are connected (for [`State::stats`]).
+    pub fn set_clients(&mut self, clients: usize) {
+        self.clients = clients as u64;
+    }
+
+    /// Installs a scene object: an object restored from the state file with
+    /// the same name, the same geometry and scene ownership keeps its id
+    /// (and takes the scene's pose); otherwise a new object is inserted.
+    /// Call [`State::drop_scene_objects_except`] after the whole scene.
+    ///
+    /// # Errors
+    /// As [`State::insert`].
+    pub fn adopt_scene_object(&mut self, new: NewObject) -> Result<u64, ErrorCode> {
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && let Some(old) = self.objects.get_mut(&id)
+            && old.owner == Owner::Scene
+            && old.shape == new.shape
+        {
+            old.pose = new.pose;
+            let slot = old.slot;
+            self.journal_pose(slot, id);
+            return Ok(id);
+        }
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && self
+                .objects
+                .get(&id)
+                .is_some_and(|o| o.owner == Owner::Scene)
+        {
+            // The scene file changed this object: the new one replaces it.
+            self.drop_object(id);
+        }
+        self.insert(new, Owner::Scene)
+    }
+
+    /// Removes the scene objects restored from the state file that the
+    /// current scene no longer has.
+    pub fn drop_scene_objects_except(&mut self, keep: &[u64]) {
+        let doomed: Vec<u64> = self
+            .objects
+            .iter()
+            .filter(|(id, o)| o.owner == Owner::Scene && !keep.contains(id))
+            .map(|(&id, _)| id)
+            .collect();
+        for id in doomed {
+            self.drop_object(id);
+        }
+    }
+
+    fn drop_object(&mut self, id: u64) -> Option<Object> {
+        let object = self.objects.remove(&id)?;
+        if let Some(name) = &object.name {
+            self.names.remove(name);
+        }
+        self.free_slots.push(object.slot);
+        self.cache.forget_object(id);
+        Some(object)
     }
 
     /// The limits in force.
@@ -147,6 +393,8 @@ impl State {
             cache_hits: c.hits,
             cache_misses: c.misses,
             cache_evictions: c.evictions,
+            clients: self.clients,
+            persist_errors: self.persist_errors,
             ..self.stats
         }
     }
@@ -184,6 +432,11 @@ impl State {
         if let Some(name) = &new.name {
             self.names.insert(name.clone(), id);
         }
+        let slot = self.free_slots.pop().unwrap_or_else(|| {
+            let s = self.next_slot;
+            self.next_slot += 1;
+            s
+        });
         self.objects.insert(
             id,
             Object {
@@ -191,30 +444,22 @@ impl State {
                 pose: new.pose,
                 owner,
                 name: new.name,
+                slot,
             },
         );
+        // The slot may hold a removed object's last pose: overwrite it now.
+        self.journal_pose(slot, id);
         Ok(id)
     }
 
-    /// Removes object `id` on behalf of `requester`.
+    /// Removes object `id` on behalf of `requester`, and writes the state
+    /// file (when persistence is on) before returning.
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
     /// objects, [`ErrorCode::NotOwner`] for another client's object.
     pub fn remove(&mut self, id: u64, requester: u128) -> Result<(), ErrorCode> {
-        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
-        match object.owner {
-            Owner::Scene => return Err(ErrorCode::ReadOnly),
-            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
-            Owner::Client(_) => {}
-        }
-        if let Some(object) = self.objects.remove(&id)
-            && let Some(name) = object.name
-        {
-            self.names.remove(&name);
-        }
-        self.cache.forget_object(id);
-        Ok(())
+        self.remove_committed(id, requester).map(|_| ())
     }
 
     /// The id of the object named `name`.
@@ -261,6 +506,12 @@ impl State {
     }
 
     fn item(&mut self, client: u128, item: &Item) -> ItemResult {
+        // Unknown flag bits and a non-zero reserved word are refused rather
+        // than ignored, so that a later protocol version can give them a
+        // meaning without old servers silently answering something else.
+        if item.flags & !item_flags::ALL != 0 || item.reserved != 0 {
+            return ItemResult::error(ErrorCode::Malformed);
+        }
         match ItemKind::from_raw(item.kind) {
             Some(ItemKind::SetPose) => match self.set_pose(item) {
                 Ok(()) => ItemResult::default(),
@@ -279,13 +530,16 @@ impl State {
             .get_mut(&item.a)
             .ok_or(ErrorCode::UnknownObject)?;
         object.pose = check_pose(&item.pose_a)?;
+        if let Some(journal) = &mut self.journal
+            && let Err(e) = journal.write(object.slot, item.a, &object.pose)
+        {
+            self.persist_errors += 1;
+            tracing::error!("cannot write the pose journal: {e}");
+        }
         Ok(())
     }
 
     fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
-        if item.flags & !item_flags::ALL != 0 {
-            return Err(ErrorCode::Malformed);
-        }
         let warm_on = item.flags & item_flags::WARM_START != 0;
         let options = gjk::Options {
             tolerance: item.tolerance,
@@ -360,8 +614,12 @@ impl State {
         })
     }
 
-    /// Answers one admin request from admin client port `requester`, with the
-    /// request's slice payload `vertices`.
+    /// Answers one admin request from client `requester` (the id of its
+    /// iceoryx2 node, see [`Owner`]), with the request's slice payload
+    /// `vertices`. With persistence on, a registration or removal is written
+    /// to the state file before this returns; if the write fails the change
+    /// is undone and the reply is [`ErrorCode::Internal`], so an
+    /// acknowledged change is always on disk.
     pub fn handle_admin(
         &mut self,
         requester: u128,
@@ -373,7 +631,14 @@ impl State {
             op,
             ..AdminReply::default()
         };
-        let outcome = match AdminOp::from_raw(op) {
+        let op_kind = AdminOp::from_raw(op);
+        // Only a registration carries vertices: any other request with a
+        // slice is malformed (and would otherwise be silently ignored).
+        if !vertices.is_empty() && op_kind != Some(AdminOp::Register) {
+            reply.error = ErrorCode::Malformed as u32;
+            return reply;
+        }
+        let outcome = match op_kind {
             Some(AdminOp::Hello) => {
                 reply.info = self.info();
                 Ok(0)
@@ -383,8 +648,13 @@ impl State {
                 Ok(0)
             }
             Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
-                .and_then(|new| self.insert(new, Owner::Client(requester))),
-            Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
+                .and_then(|new| self.insert(new, Owner::Client(requester)))
+                .and_then(|id| {
+                    self.commit().map(|()| id).inspect_err(|_| {
+                        self.drop_object(id);
+                    })
+                }),
+            Some(AdminOp::Remove) => self.remove_committed(request.id, requester),
             Some(AdminOp::Lookup) => match request.name() {
                 Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
                 None => Err(ErrorCode::Malformed),
@@ -396,6 +666,40 @@ impl State {
             Err(e) => reply.error = e as u32,
         }
         reply
+    }
+}
+
+impl State {
+    /// Writes the state file after a registration or removal; the error is
+    /// what the client is told if that fails.
+    fn commit(&mut self) -> Result<(), ErrorCode> {
+        self.persist().map_err(|e| {
+            tracing::error!("{e}; the change is undone");
+            ErrorCode::Internal
+        })
+    }
+
+    fn remove_committed(&mut self, id: u64, requester: u128) -> Result<u64, ErrorCode> {
+        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
+        match object.owner {
+            Owner::Scene => return Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
+            Owner::Client(_) => {}
+        }
+        let Some(object) = self.drop_object(id) else {
+            return Err(ErrorCode::UnknownObject);
+        };
+        if let Err(e) = self.commit() {
+            if self.free_slots.last() == Some(&object.slot) {
+                self.free_slots.pop();
+            }
+            if let Some(name) = &object.name {
+                self.names.insert(name.clone(), id);
+            }
+            self.objects.insert(id, object);
+            return Err(e);
+        }
+        Ok(id)
     }
 }
 
@@ -487,6 +791,9 @@ pub fn decode_registration(
                 return Err(ErrorCode::Malformed);
             }
             let piece = &request.pieces[0];
+            if piece.reserved != 0 {
+                return Err(ErrorCode::Malformed);
+            }
             if piece.vertex_count as usize != vertices.len() {
                 return Err(if vertices.is_empty() {
                     ErrorCode::EmptyVertices
@@ -504,6 +811,9 @@ pub fn decode_registration(
                 return Err(ErrorCode::TooManyPieces);
             }
             let table = &request.pieces[..count];
+            if table.iter().any(|p| p.reserved != 0) {
+                return Err(ErrorCode::Malformed);
+            }
             let total: u64 = table.iter().map(|p| u64::from(p.vertex_count)).sum();
             if total != vertices.len() as u64 {
                 return Err(ErrorCode::Malformed);
@@ -744,6 +1054,143 @@ mod tests {
         assert_eq!(code(&mut s, &remove, &[]), ErrorCode::UnknownObject);
     }
 
+    /// The strictness added for the reliability work: reserved words,
+    /// unknown flags on any item kind, vertices on a non-registration, ids
+    /// at the edges of the range.
+    #[test]
+    fn reserved_fields_stray_slices_and_edge_ids_are_refused() {
+        let mut s = state();
+        let a = ObjectId::from_raw(register_box(&mut s, 1));
+        let mut reserved = Item::distance(a, a, &QueryOptions::default());
+        reserved.reserved = 1;
+        let mut pose_flags = Item::set_pose(a, &Isometry3::identity());
+        pose_flags.flags = 1 << 9;
+        let mut pose_reserved = Item::set_pose(a, &Isometry3::identity());
+        pose_reserved.reserved = 7;
+        for item in [reserved, pose_flags, pose_reserved] {
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::Malformed);
+        }
+        let epoch_of_a = a.raw() & !0xFFFF_FFFF;
+        for raw in [
+            0,
+            u64::MAX,
+            epoch_of_a,
+            epoch_of_a | 0xFFFF_FFFF,
+            a.raw() ^ (1 << 40),
+        ] {
+            let ghost = ObjectId::from_raw(raw);
+            let item = Item::distance(a, ghost, &QueryOptions::default());
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::UnknownObject);
+            let mut rm = AdminRequest::new(AdminOp::Remove);
+            rm.id = raw;
+            assert_eq!(
+                s.handle_admin(1, &rm, &[]).error_code(),
+                ErrorCode::UnknownObject
+            );
+        }
+        let v = [Vertex::default()];
+        for op in [
+            AdminOp::Hello,
+            AdminOp::Stats,
+            AdminOp::Remove,
+            AdminOp::Lookup,
+        ] {
+            let mut req = AdminRequest::new(op);
+            req.id = a.raw();
+            assert_eq!(
+                s.handle_admin(1, &req, &v).error_code(),
+                ErrorCode::Malformed,
+                "{op:?}"
+            );
+        }
+        assert!(
+            s.object(a.raw()).is_some(),
+            "the stray remove removed nothing"
+        );
+        let mut reg = AdminRequest::new(AdminOp::Register);
+        reg.shape = shape_kind::CONVEX;
+        reg.piece_count = 1;
+        reg.pieces[0].vertex_count = 1;
+        reg.pieces[0].reserved = 3;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.shape = shape_kind::COMPOUND;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.pieces[0].reserved = 0;
+        assert_eq!(s.handle_admin(1, &reg, &v).error_code(), ErrorCode::Ok);
+        // Quaternions: zero and NaN; registration poses as well as items.
+        reg.pose.rotation = [0.0; 4];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::BadQuaternion
+        );
+        reg.pose.rotation = [f64::NAN, 0.0, 0.0, 1.0];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::NonFinitePose
+        );
+        reg.pose = Pose::IDENTITY;
+        reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.5];
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::BadQuaternion
+        );
+        reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.0];
+        // Names: too long a length, bad UTF-8.
+        reg.name_len = 65;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        reg.name_len = 1;
+        reg.name[0] = 0xC3;
+        assert_eq!(
+            s.handle_admin(1, &reg, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        // Options: infinite tolerance, infinite margin.
+        for o in [
+            QueryOptions {
+                tolerance: f64::INFINITY,
+                ..QueryOptions::default()
+            },
+            QueryOptions {
+                margin: Some(f64::NEG_INFINITY),
+                ..QueryOptions::default()
+            },
+        ] {
+            let item = Item::distance(a, a, &o);
+            assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::InvalidOptions);
+        }
+    }
+
+    #[test]
+    fn a_full_server_refuses_and_recovers_room_on_removal() {
+        let limits = Limits {
+            max_objects: 2,
+            ..Limits::default()
+        };
+        let mut s = State::new(limits, WaitMode::Spin, 5);
+        let a = register_box(&mut s, 1);
+        register_box(&mut s, 1);
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        let v = [Vertex::default()];
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::TooManyObjects
+        );
+        s.remove(a, 1).expect("owner");
+        assert_eq!(s.handle_admin(1, &req, &v).error_code(), ErrorCode::Ok);
+    }
+
     #[test]
     fn only_the_owner_removes_and_scene_objects_stay() {
         let mut s = state();
@@ -772,6 +1219,154 @@ mod tests {
         s.remove(a, 1).expect("owner");
         let b = register_box(&mut s, 1);
         assert_ne!(a, b);
+    }
+
+    #[test]
+    fn a_restored_store_keeps_ids_owners_answers_and_counter() {
+        let mut s = state();
+        let a = register_box(&mut s, 41);
+        let b = register_box(&mut s, 42);
+        let gone = register_box(&mut s, 41);
+        s.remove(gone, 41).expect("owner");
+        let pb = Isometry3::new(Vector3::new(3.0, 0.5, 0.2), Vector3::new(0.1, 0.2, 0.3));
+        let (ia, ib) = (ObjectId::from_raw(a), ObjectId::from_raw(b));
+        one(&mut s, 1, Item::set_pose(ib, &pb));
+        let before = one(&mut s, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+
+        let snap = s.snapshot();
+        let bytes = snap.encode().expect("encodes");
+        let back = crate::persist::Snapshot::decode(&bytes).expect("decodes");
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("valid");
+        assert_eq!(r.len(), 2);
+        let after = one(&mut r, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+        assert_eq!(
+            after, before,
+            "same ids, same poses, same answer bit for bit"
+        );
+        assert_eq!(r.remove(a, 42), Err(ErrorCode::NotOwner));
+        let c = register_box(&mut r, 41);
+        assert!(c > gone, "the counter continues past removed ids");
+        assert_eq!(r.remove(a, 41), Ok(()));
+        let too_few = Limits {
+            max_objects: 1,
+            ..Limits::default()
+        };
+        assert!(State::restore(too_few, WaitMode::Spin, &back).is_err());
+    }
+
+    /// Many objects registered and most removed: the survivors may sit in
+    /// high journal slots, and the file must still load.
+    #[test]
+    fn a_store_that_shrank_restores() {
+        let mut s = state();
+        let ids: Vec<u64> = (0..3000).map(|_| register_box(&mut s, 1)).collect();
+        for &id in &ids[..2990] {
+            s.remove(id, 1).expect("owner");
+        }
+        let snap = s.snapshot();
+        assert!(snap.objects.iter().any(|o| o.slot > 2000));
+        let bytes = snap.encode().expect("encodes");
+        let back = crate::persist::Snapshot::decode(&bytes).expect("a valid file");
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("restores");
+        assert_eq!(r.len(), 10);
+        // Freed slots are reused before new ones.
+        let fresh = register_box(&mut r, 1);
+        assert!(r.object(fresh).expect("there").slot < 2990);
+    }
+
+    /// The input `fuzz/` found (`gjk/tests/fuzz_regressions.rs`), through
+    /// the server: a warm query across poses with 1e108 and 1e100
+    /// coordinates. It used to panic inside gjk (answered `Internal` by the
+    /// serving loop's catch_unwind); now it is answered with ordered bounds.
+    #[test]
+    fn the_fuzz_found_warm_start_is_answered() {
+        let mut s = state();
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 4;
+        req.pieces[0].radius = 6.4000000000000006e100;
+        let v = |x: f64, y: f64, z: f64| Vertex { x, y, z };
+        let a = s.handle_admin(
+            1,
+            &req,
+            &[
+                v(9.9e100, 9.900000000000002e108, 9.9e100),
+                v(9.9e100, 9.9e100, 9.9e100),
+                v(9.9e100, 9.9e100, 9.9e100),
+                v(6.1875, 9.9e100, 9.9e100),
+            ],
+        );
+        req.pieces[0].radius = 0.0;
+        let b = s.handle_admin(
+            1,
+            &req,
+            &[
+                v(9.9e100, 9.9e100, -6.25),
+                v(-6.25, -6.25, -6.25),
+                v(-6.25, -6.25, -6.25),
+                v(-6.25, -6.25, -6.25),
+            ],
+        );
+        let (a, b) = (ObjectId::from_raw(a.id), ObjectId::from_raw(b.id));
+        let pose = |w: f64, i: f64, j: f64, k: f64| {
+            Isometry3::from_parts(
+                Translation3::new(-6.25, -6.25, -6.25),
+                UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
+            )
+        };
+        let o = QueryOptions {
+            tolerance: 2.220446049250313e-14,
+            max_iterations: 55,
+            ..QueryOptions::default()
+        };
+        let p = pose(-0.5, -0.5, -0.5, -0.5);
+        let turned = pose(
+            -0.51231551957856,
+            -0.51231551957856,
+            -0.51231551957856,
+            0.46108396762070397,
+        );
+        for (pa, pb) in [(p, p), (p, turned)] {
+            let item = Item::distance(a, b, &o).with_pose_a(&pa).with_pose_b(&pb);
+            let got = one(&mut s, 9, item).answer().expect("answered");
+            assert!(
+                got.lower <= got.distance && got.distance <= got.upper,
+                "{got:?}"
+            );
+            assert!(got.distance > 7e100 && got.distance < 8e100, "{got:?}");
+        }
+    }
+
+    #[test]
+    fn a_failed_write_undoes_the_change_and_says_internal() {
+        let dir = std::env::temp_dir().join(format!("gjkd-state-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(crate::persist::Store::open(&path).expect("store"))
+            .expect("journal");
+        let kept = register_box(&mut s, 1);
+        assert!(path.exists());
+        // A directory where the file should be: every rename onto it fails.
+        std::fs::remove_file(&path).expect("rm");
+        std::fs::create_dir(&path).expect("block the path");
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        assert!(req.set_name("ghost"));
+        let reply = s.handle_admin(1, &req, &[Vertex::default()]);
+        assert_eq!(reply.error_code(), ErrorCode::Internal);
+        assert_eq!(s.len(), 1, "the unwritten object is not kept");
+        assert_eq!(s.lookup("ghost"), None);
+        assert_eq!(s.remove(kept, 1), Err(ErrorCode::Internal));
+        assert!(s.object(kept).is_some(), "the unwritten removal is undone");
+        assert_eq!(s.stats().persist_errors, 2);
+        std::fs::remove_dir(&path).expect("unblock");
+        assert_eq!(s.remove(kept, 1), Ok(()));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// Arbitrary bytes reinterpreted as items never panic the handler.

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use gjkd_client::{Client, ClientError};
+use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 
 /// The `gjkd` binary of this build profile: `$GJKD_BIN` if set, else
@@ -64,11 +65,16 @@ pub fn unique_service(tag: &str) -> String {
 
 /// A running `gjkd serve`, stopped (SIGTERM, then SIGKILL) when dropped, so
 /// that a failing test leaves no server behind.
+///
+/// Unless its arguments say `--no-persist` or `--state-file`, it keeps its
+/// objects in a state file in a fresh temporary directory (removed on drop),
+/// never in the user's `~/.local/state`; [`Server::restart`] reuses it.
 pub struct Server {
     child: Option<Child>,
     /// Its service name.
     pub service: String,
     args: Vec<String>,
+    state_dir: Option<PathBuf>,
 }
 
 impl Server {
@@ -80,13 +86,35 @@ impl Server {
 
     /// Starts `gjkd serve --service SERVICE` with `args`.
     pub fn start_on(service: &str, args: &[&str]) -> Self {
+        let mut args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+        let mut state_dir = None;
+        if !args
+            .iter()
+            .any(|a| a == "--no-persist" || a == "--state-file")
+        {
+            // One directory per Server value: a second server started on the
+            // same service must not share (or wipe) the first one's file.
+            static DIRS: AtomicU32 = AtomicU32::new(0);
+            let n = DIRS.fetch_add(1, Ordering::Relaxed);
+            let dir = std::env::temp_dir().join(format!("{service}.{n}.state"));
+            let _ = std::fs::remove_dir_all(&dir);
+            args.push("--state-file".into());
+            args.push(dir.join("objects").to_string_lossy().into_owned());
+            state_dir = Some(dir);
+        }
         let mut server = Server {
             child: None,
             service: service.to_owned(),
-            args: args.iter().map(|s| s.to_string()).collect(),
+            args,
+            state_dir,
         };
         server.spawn();
         server
+    }
+
+    /// The state file, when the helper chose it.
+    pub fn state_file(&self) -> Option<PathBuf> {
+        self.state_dir.as_ref().map(|d| d.join("objects"))
     }
 
     fn spawn(&mut self) {
@@ -183,6 +211,9 @@ impl Server {
 impl Drop for Server {
     fn drop(&mut self) {
         self.terminate();
+        if let Some(dir) = &self.state_dir {
+            let _ = std::fs::remove_dir_all(dir);
+        }
     }
 }
 
@@ -217,6 +248,158 @@ pub fn services_exist(service: &str) -> bool {
         let name = ServiceName::new(name).expect("valid service name");
         ipc::Service::does_exist(&name, config, *pattern).unwrap_or(true)
     })
+}
+
+/// Whether an iceoryx2 node of process `pid`, alive or dead (its resources
+/// not yet cleaned up), is still registered on this host.
+pub fn node_of_pid_exists(pid: u32) -> bool {
+    let mut found = false;
+    let _ = Node::<ipc::Service>::list(Config::global_config(), |state| {
+        let id = match &state {
+            NodeState::Alive(v) => Some(*v.id()),
+            NodeState::Dead(v) => Some(*v.id()),
+            NodeState::Inaccessible(id) | NodeState::Undefined(id) => Some(*id),
+        };
+        if let Some(id) = id
+            && id
+                .pid::<ipc::Service>()
+                .is_ok_and(|p| i64::from(p.value()) == i64::from(pid))
+        {
+            found = true;
+            return CallbackProgression::Stop;
+        }
+        CallbackProgression::Continue
+    });
+    found
+}
+
+/// Resident set size of process `pid` in KiB, from `/proc/<pid>/status`.
+pub fn rss_kib(pid: u32) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+}
+
+/// The `gjkd-load` client process of this package (see its source).
+pub fn load_binary() -> PathBuf {
+    let bin = gjkd_binary().with_file_name("gjkd-load");
+    if !bin.exists() {
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let mut build = Command::new(cargo);
+        build
+            .args(["build", "--quiet", "-p", "gjkd-e2e", "--bin", "gjkd-load"])
+            .current_dir(env!("CARGO_MANIFEST_DIR"));
+        if bin
+            .parent()
+            .and_then(|d| d.file_name())
+            .is_some_and(|n| n == "release")
+        {
+            build.arg("--release");
+        }
+        let status = build.status().expect("run cargo build for gjkd-load");
+        assert!(status.success(), "cargo build gjkd-load failed: {status}");
+    }
+    bin
+}
+
+/// A running `gjkd-load` process whose stdout lines are collected by a
+/// thread; killed (SIGKILL) when dropped.
+pub struct LoadProcess {
+    child: Child,
+    lines: std::sync::mpsc::Receiver<String>,
+    /// Every line read so far.
+    pub seen: Vec<String>,
+}
+
+impl LoadProcess {
+    /// Starts `gjkd-load SERVICE MODE SEED [COUNT]`.
+    pub fn spawn(service: &str, mode: &str, seed: u64, count: Option<u64>) -> Self {
+        let mut cmd = Command::new(load_binary());
+        cmd.arg(service).arg(mode).arg(seed.to_string());
+        if let Some(c) = count {
+            cmd.arg(c.to_string());
+        }
+        let mut child = cmd
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("spawn gjkd-load");
+        let stdout = child.stdout.take().expect("piped");
+        let (tx, lines) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            use std::io::BufRead;
+            for line in std::io::BufReader::new(stdout).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        LoadProcess {
+            child,
+            lines,
+            seen: Vec::new(),
+        }
+    }
+
+    /// Process id.
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Waits up to `within` for a line starting with `prefix`; returns it.
+    pub fn wait_for(&mut self, prefix: &str, within: Duration) -> Option<String> {
+        let deadline = Instant::now() + within;
+        if let Some(l) = self.seen.iter().find(|l| l.starts_with(prefix)) {
+            return Some(l.clone());
+        }
+        loop {
+            let left = deadline.checked_duration_since(Instant::now())?;
+            match self.lines.recv_timeout(left) {
+                Ok(line) => {
+                    self.seen.push(line.clone());
+                    if line.starts_with(prefix) {
+                        return Some(line);
+                    }
+                }
+                Err(_) => return None,
+            }
+        }
+    }
+
+    /// Waits up to `within` for the process to exit; its status and every
+    /// line it printed.
+    pub fn finish(&mut self, within: Duration) -> Option<(ExitStatus, Vec<String>)> {
+        let deadline = Instant::now() + within;
+        let status = loop {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                break status;
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        // The reader thread ends at end of file.
+        while let Ok(line) = self.lines.recv_timeout(Duration::from_secs(2)) {
+            self.seen.push(line);
+        }
+        Some((status, self.seen.clone()))
+    }
+
+    /// SIGKILL and reap.
+    pub fn kill9(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Drop for LoadProcess {
+    fn drop(&mut self) {
+        self.kill9();
+    }
 }
 
 /// Whether `e` says the server is gone.

@@ -56,6 +56,38 @@ fn a_killed_server_is_reported_and_a_restarted_one_serves() {
             Err(e) => panic!("restarted server not reached: {e}"),
         }
     };
+    assert_eq!(
+        stats.objects, 2,
+        "the restarted server reloaded both objects"
+    );
+    // Same ids, same answers; and this client still owns what it registered
+    // (its identity is its node, which outlived the server).
+    check(&mut client, a, b);
+    client.remove(b).expect("still the owner after the restart");
+    let (a2, b2) = spheres(&mut client);
+    assert!(
+        a2 != a && b2 != b && a2 != b && b2 != a,
+        "ids are never reused"
+    );
+}
+
+#[test]
+fn without_persistence_a_restarted_server_starts_empty() {
+    let mut server = Server::start("nopersist", &["--no-persist"]);
+    let mut client = server.client(Duration::from_millis(800));
+    let (a, b) = spheres(&mut client);
+    server.kill9();
+    server.restart();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let stats = loop {
+        match client.stats() {
+            Ok(s) => break s,
+            Err(e) if is_gone(&e) && Instant::now() < deadline => {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => panic!("restarted server not reached: {e}"),
+        }
+    };
     assert_eq!(stats.objects, 0, "a new server starts empty");
     // Ids of the dead server are unknown to the new one, never aliases.
     assert_eq!(
@@ -239,4 +271,29 @@ offset = { translation = [0.05, 0.0, 0.0] }
     );
     assert!(client.lookup("table").is_ok());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A hung server (SIGSTOP) is reported within the call's timeout, as a
+/// timeout: it is still there, it just does not answer. Once it resumes,
+/// it serves the same objects.
+#[test]
+fn a_hung_server_times_out_and_serves_again_when_resumed() {
+    let server = Server::start("hung", &["--wait", "block"]);
+    let timeout = Duration::from_millis(500);
+    let mut client = server.client(timeout);
+    let (a, b) = spheres(&mut client);
+    let pid = libc::pid_t::try_from(server.pid().expect("running")).expect("pid");
+    // SAFETY: kill(2) on the server we spawned.
+    unsafe { libc::kill(pid, libc::SIGSTOP) };
+    let start = Instant::now();
+    let err = client
+        .distance(a, b, &QueryOptions::default())
+        .expect_err("stopped");
+    let took = start.elapsed();
+    // SAFETY: as above.
+    unsafe { libc::kill(pid, libc::SIGCONT) };
+    eprintln!("hung server reported after {took:?}: {err}");
+    assert_eq!(err, ClientError::Timeout(timeout));
+    assert!(took < timeout + Duration::from_millis(500), "{took:?}");
+    check(&mut client, a, b);
 }

@@ -1,0 +1,196 @@
+//! Access: what a server and its clients put on the file system is
+//! owner-only, a client removes only what it registered (before and after a
+//! server restart), and scene objects are read-only.
+
+use std::collections::HashSet;
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use gjkd_client::{ClientError, ErrorCode, Geometry, QueryOptions};
+use gjkd_e2e::{Server, is_gone, unique_service};
+use nalgebra::Isometry3;
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            walk(&p, out);
+        }
+        out.push(p);
+    }
+}
+
+/// iceoryx2's files: its shared memory in /dev/shm and its root directory.
+fn iceoryx2_files() -> HashSet<PathBuf> {
+    let mut all = Vec::new();
+    walk(Path::new("/tmp/iceoryx2"), &mut all);
+    if let Ok(entries) = std::fs::read_dir("/dev/shm") {
+        all.extend(entries.flatten().map(|e| e.path()).filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("iox2_"))
+        }));
+    }
+    all.into_iter().collect()
+}
+
+fn mode(p: &Path) -> Option<u32> {
+    std::fs::symlink_metadata(p)
+        .ok()
+        .map(|m| m.permissions().mode())
+}
+
+#[test]
+fn files_are_owner_only() {
+    let before = iceoryx2_files();
+    let server = Server::start("perm", &["--wait", "block"]);
+    let mut client = server.client(Duration::from_secs(5));
+    let id = client.register_sphere(1.0).expect("registered");
+    client
+        .distance(id, id, &QueryOptions::default())
+        .expect("answer");
+    let created: Vec<PathBuf> = iceoryx2_files().difference(&before).cloned().collect();
+    assert!(
+        created.iter().any(|p| p.starts_with("/dev/shm")),
+        "no shared memory found: {created:?}"
+    );
+    let mut checked = 0;
+    for p in &created {
+        // Files of tests running beside this one may come and go meanwhile.
+        let Some(m) = mode(p) else { continue };
+        if p.is_dir() {
+            // Directories: listable by the group at most (iceoryx2 makes
+            // its node directories 0750), never writable by anyone else.
+            assert_eq!(m & 0o022, 0, "{} is {:o}", p.display(), m & 0o777);
+            assert_eq!(m & 0o007, 0, "{} is {:o}", p.display(), m & 0o777);
+        } else {
+            assert_eq!(m & 0o077, 0, "{} is {:o}", p.display(), m & 0o777);
+        }
+        checked += 1;
+    }
+    assert!(checked >= 5, "only {checked} files checked");
+
+    let state = server.state_file().expect("state file");
+    assert_eq!(mode(&state).expect("state file") & 0o777, 0o600);
+    let journal = PathBuf::from(format!("{}.poses", state.display()));
+    assert_eq!(mode(&journal).expect("journal") & 0o777, 0o600);
+    eprintln!("{checked} iceoryx2 files and 2 state files checked");
+}
+
+/// The default state file lives under `$XDG_STATE_HOME/gjkd/`, created
+/// 0700, the file 0600.
+#[test]
+fn the_default_state_directory_is_owner_only() {
+    let home = std::env::temp_dir().join(unique_service("xdg"));
+    let _ = std::fs::remove_dir_all(&home);
+    let service = unique_service("xdg");
+    let mut child = std::process::Command::new(gjkd_e2e::gjkd_binary())
+        .args(["serve", "--service", &service, "--wait", "block"])
+        .env("XDG_STATE_HOME", &home)
+        .env("RUST_LOG", "warn")
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("spawn");
+    let file = home.join("gjkd").join(format!("{service}.objects"));
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !file.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let file_mode = mode(&file);
+    let dir_mode = mode(&home.join("gjkd"));
+    // SAFETY: kill(2) on our own child.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGTERM);
+    }
+    let _ = child.wait();
+    let _ = std::fs::remove_dir_all(&home);
+    assert_eq!(
+        file_mode.expect("state file written at start") & 0o777,
+        0o600
+    );
+    assert_eq!(dir_mode.expect("directory") & 0o777, 0o700);
+}
+
+fn rejected<T: std::fmt::Debug>(r: Result<T, ClientError>) -> ErrorCode {
+    match r {
+        Err(ClientError::Rejected(code)) => code,
+        other => panic!("expected a rejection, got {other:?}"),
+    }
+}
+
+#[test]
+fn owners_stay_owners_across_a_server_restart() {
+    let mut server = Server::start("owners-restart", &[]);
+    let mut alice = server.client(Duration::from_secs(2));
+    let mut bob = server.client(Duration::from_secs(2));
+    let hers = alice.register_sphere(1.0).expect("hers");
+    let his = bob.register_sphere(1.0).expect("his");
+    assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
+
+    server.kill9();
+    server.restart();
+    // Both notice and reconnect with the same identity.
+    for c in [&mut alice, &mut bob] {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            match c.stats() {
+                Ok(_) => break,
+                Err(e) if is_gone(&e) && Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                Err(e) => panic!("restarted server not reached: {e}"),
+            }
+        }
+    }
+    assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
+    assert_eq!(rejected(alice.remove(his)), ErrorCode::NotOwner);
+    // A client that never registered anything owns nothing either.
+    let mut carol = server.client(Duration::from_secs(2));
+    assert_eq!(rejected(carol.remove(hers)), ErrorCode::NotOwner);
+    // Anyone may query and move anyone's objects; only removal is owned.
+    carol
+        .set_pose(hers, &Isometry3::translation(5.0, 0.0, 0.0))
+        .expect("move");
+    let d = carol
+        .distance(hers, his, &QueryOptions::default())
+        .expect("query")
+        .distance;
+    assert!((d - 3.0).abs() < 1e-12, "{d}");
+    alice.remove(hers).expect("owner removes");
+    bob.remove(his).expect("owner removes");
+    assert_eq!(carol.stats().expect("stats").objects, 0);
+}
+
+#[test]
+fn scene_objects_stay_read_only_and_keep_their_ids_across_a_restart() {
+    let dir = std::env::temp_dir().join(unique_service("scene-ro"));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("scene.toml");
+    std::fs::write(
+        &path,
+        "[[object]]\nname = \"wall\"\ntype = \"box\"\nhalf_extents = [1.0, 1.0, 1.0]\n",
+    )
+    .expect("scene");
+    let mut server = Server::start("scene-ro", &["--scene", path.to_str().expect("utf-8")]);
+    let mut client = server.client(Duration::from_secs(2));
+    let wall = client.lookup("wall").expect("wall");
+    assert_eq!(rejected(client.remove(wall)), ErrorCode::ReadOnly);
+    assert_eq!(
+        rejected(client.register_named(
+            "wall",
+            &Geometry::Sphere { radius: 1.0 },
+            &Isometry3::identity()
+        )),
+        ErrorCode::NameTaken
+    );
+    server.kill9();
+    server.restart();
+    let mut client = server.client(Duration::from_secs(2));
+    assert_eq!(client.lookup("wall").expect("wall"), wall, "same id");
+    assert_eq!(rejected(client.remove(wall)), ErrorCode::ReadOnly);
+    assert_eq!(client.stats().expect("stats").objects, 1);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -69,6 +69,15 @@ fn latency_quick_writes_table_csv_and_plots() {
         let svg = std::fs::read_to_string(dir.join(f)).expect(f);
         assert!(svg.starts_with("<svg"), "{f}");
     }
+    // The socket server ran as a child process (`gjkd bench uds-server`)
+    // with its socket in the output directory: the bench removed it.
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .expect("read the output directory")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".sock"))
+        .map(|e| e.path())
+        .collect();
+    assert!(leftovers.is_empty(), "socket files left: {leftovers:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -5,8 +5,9 @@
 //!
 //! - `spin`, `block`, `adaptive`: a real `gjkd serve --wait MODE` child
 //!   process (this executable) and a [`gjkd_client::Client`];
-//! - `uds`: a Unix-stream-socket server thread with blocking reads
-//!   ([`super::uds`]);
+//! - `uds`: a Unix-stream-socket server with blocking reads, also a child
+//!   process of its own (`gjkd bench uds-server`, [`super::uds`]), pinned
+//!   like the others;
 //! - `in-process`: [`State::handle`] called directly, the floor.
 //!
 //! Each is asked a single pair (`Client::distance`, the pair at its stored
@@ -103,7 +104,7 @@ fn unpin() {
 pub enum Transport {
     /// The handler called directly.
     InProcess,
-    /// A Unix-socket server.
+    /// A Unix-socket server process.
     Uds,
     /// iceoryx2, server busy-polling.
     Spin,
@@ -280,8 +281,9 @@ impl Target {
 }
 
 /// A state with the bench's objects, registered through the admin handler
-/// exactly as a client's requests would be.
-fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<ObjectId>) {
+/// exactly as a client's requests would be. Deterministic: the socket server
+/// child builds the same one, so these ids name its objects too.
+pub(crate) fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<ObjectId>) {
     let mut state = State::new(Limits::default(), WaitMode::Block, 0x5eed);
     let mut reg = AdminRequest::new(AdminOp::Register);
     reg.shape = shape_kind::CONVEX;
@@ -347,15 +349,25 @@ fn start(
     if t == Transport::Uds {
         let path = dir.join(format!("gjkd-bench-{}.sock", std::process::id()));
         let server = io(
-            "bind the unix socket",
-            UdsServer::start(&path, state, server_cpu),
+            "start gjkd bench uds-server",
+            UdsServer::spawn(&path, max_batch, server_cpu),
         )?;
         let client = io("connect the unix socket", UdsClient::connect(server.path()))?;
-        return Ok(Target::Uds {
+        let mut target = Target::Uds {
             client,
             req,
             _server: server,
-        });
+        };
+        // The child registered its own objects: check that our ids name them.
+        target.call(Workload::Single)?;
+        if let Target::Uds { req, .. } = &target
+            && let Err(e) = req.results[0].answer()
+        {
+            return Err(BenchError::Other(format!(
+                "the socket server does not know the bench's objects: {e:?}"
+            )));
+        }
+        return Ok(target);
     }
     Ok(Target::Local {
         state: Box::new(state),
@@ -775,22 +787,17 @@ mod tests {
     }
 
     #[test]
-    fn in_process_and_socket_answers_agree() {
-        // The baselines answer the very requests the servers get.
+    fn in_process_answers_and_measures() {
+        // The socket server is a child `gjkd` process: the e2e smoke test of
+        // `gjkd bench latency` covers it.
         let dir = std::env::temp_dir();
         let mut local = start(Transport::InProcess, 8, &dir, None).expect("local");
-        let mut uds = start(Transport::Uds, 8, &dir, None).expect("uds");
-        for t in [&mut local, &mut uds] {
-            t.call(Workload::Batch(8)).expect("batch");
-            t.call(Workload::Single).expect("single");
-        }
-        let results = |t: &Target| match t {
-            Target::Local { req, .. } | Target::Uds { req, .. } => req.results.clone(),
-            Target::Ipc { .. } => unreachable!(),
+        local.call(Workload::Batch(8)).expect("batch");
+        local.call(Workload::Single).expect("single");
+        let Target::Local { req, .. } = &local else {
+            unreachable!()
         };
-        let (l, u) = (results(&local), results(&uds));
-        assert_eq!(l[0].distance, u[0].distance);
-        assert!(l[0].answer().expect("ok").distance > 0.0);
+        assert!(req.results[0].answer().expect("ok").distance > 0.0);
         let hist = measure(&mut local, Workload::Batch(8), None, 10).expect("measure");
         assert_eq!(hist.len(), 10);
     }

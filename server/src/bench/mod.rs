@@ -2,7 +2,7 @@
 //! `docs/speed-accuracy.md`, one command each.
 //!
 //! - [`latency`]: round trips through real `gjkd serve` processes in each
-//!   wait mode, beside a Unix-socket server and a plain function call, with
+//!   wait mode, beside a Unix-socket server process and a plain function call, with
 //!   HdrHistogram percentiles.
 //! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
 //!   and cold starts and early-exit margins, judged by an exact reference
@@ -43,6 +43,9 @@ enum BenchCommand {
     Tradeoff(tradeoff::TradeoffArgs),
     /// The paper's Section 7: time per query and per vertex against M.
     Paper(paper::PaperArgs),
+    /// The socket server `latency` starts as a child process.
+    #[command(hide = true)]
+    UdsServer(uds::UdsServerArgs),
 }
 
 /// Flags every bench command has.
@@ -87,6 +90,11 @@ pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T,
 /// # Errors
 /// What stopped it.
 pub fn run(args: BenchArgs) -> Result<(), BenchError> {
+    if let BenchCommand::UdsServer(a) = &args.command {
+        // A child of `latency`: it serves until killed and prints nothing
+        // but its ready line.
+        return uds::run_server(a);
+    }
     let start = std::time::Instant::now();
     let what = match args.command {
         BenchCommand::Latency(a) => {
@@ -101,6 +109,7 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
             paper::run(&a)?;
             "paper"
         }
+        BenchCommand::UdsServer(_) => unreachable!("handled above"),
     };
     println!(
         "\ngjkd bench {what}: finished in {:.1} s (wall time of the whole command)",

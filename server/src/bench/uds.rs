@@ -4,19 +4,27 @@
 //!
 //! A request is an 8-byte header (item count, zero) followed by the items as
 //! they lie in memory; a reply is a [`ReplyHeader`] followed by the results.
-//! The server is a thread doing blocking reads on a stream socket, one
-//! connection at a time; the client writes a request with one `write` and
-//! reads the reply with blocking reads. No polling, no artificial delays.
+//! The server is a separate process, like the iceoryx2 servers it is
+//! compared with: `gjkd bench latency` starts this executable as
+//! `gjkd bench uds-server --socket PATH [--cpu N]` ([`UdsServer`]), pinned
+//! as the others are, and kills it and removes the socket file when done.
+//! It does blocking reads on a stream socket, one connection at a time; the
+//! client writes a request with one `write` and reads the reply with
+//! blocking reads. No polling, no artificial delays.
+//!
+//! The child registers the bench's objects itself, through the same admin
+//! handler and in the same order as the in-process baseline
+//! (`latency::local_state`), so the ids the client sends name the same
+//! objects on both sides; `gjkd bench latency` checks the first answer.
 
 use std::io::{Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::thread::JoinHandle;
+use std::process::{Child, ChildStdout, Command, Stdio};
 
 use gjkd_proto::{ErrorCode, Item, ItemResult, ReplyHeader};
 
+use super::{BenchError, io};
 use crate::state::State;
 
 // The byte views below rely on these types having no padding (every byte is
@@ -50,45 +58,116 @@ fn results_bytes_mut(results: &mut [ItemResult]) -> &mut [u8] {
     }
 }
 
-/// A Unix-socket gjkd server on its own thread.
+/// Flags of the hidden `gjkd bench uds-server`: the socket server that
+/// `gjkd bench latency` starts as a child process.
+#[derive(clap::Args, Debug, Clone)]
+pub struct UdsServerArgs {
+    /// Socket file to bind (a stale one is removed first).
+    #[arg(long)]
+    socket: PathBuf,
+    /// Pin the process to this CPU before serving.
+    #[arg(long)]
+    cpu: Option<usize>,
+    /// The largest batch the client will send: the server registers the
+    /// bench's objects for it (`latency::local_state`).
+    #[arg(long, default_value_t = 512)]
+    max_batch: usize,
+}
+
+/// The line the child prints on stdout once the socket is bound.
+const READY: &str = "gjkd-uds listening";
+
+/// Runs `gjkd bench uds-server`: pins itself if asked, builds the bench's
+/// state, binds the socket, says so on stdout, and serves connections one
+/// at a time, with blocking reads, until killed.
+///
+/// # Errors
+/// When the socket cannot be bound or the ready line cannot be written.
+pub fn run_server(args: &UdsServerArgs) -> Result<(), BenchError> {
+    // End with the bench if it dies without stopping us.
+    // SAFETY: prctl(PR_SET_PDEATHSIG) takes a signal number and no pointers.
+    unsafe {
+        libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
+    }
+    if let Some(cpu) = args.cpu {
+        super::latency::pin(0, cpu);
+    }
+    let (state, ..) = super::latency::local_state(args.max_batch.max(1));
+    let _ = std::fs::remove_file(&args.socket);
+    let listener = io(
+        format!("bind {}", args.socket.display()),
+        UnixListener::bind(&args.socket),
+    )?;
+    let mut stdout = std::io::stdout().lock();
+    io(
+        "write the ready line",
+        writeln!(stdout, "{READY}").and_then(|()| stdout.flush()),
+    )?;
+    drop(stdout);
+    serve(&listener, state);
+    Ok(())
+}
+
+/// Serves the connections of `listener` one at a time, each until its client
+/// hangs up; returns when accepting fails.
+fn serve(listener: &UnixListener, mut state: State) {
+    for conn in listener.incoming() {
+        match conn {
+            // A connection ends when the client hangs up.
+            Ok(conn) => {
+                let _ = serve_connection(conn, &mut state);
+            }
+            Err(_) => return,
+        }
+    }
+}
+
+/// A `gjkd bench uds-server` child process (this executable), killed and its
+/// socket file removed when dropped.
 pub struct UdsServer {
     path: PathBuf,
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    child: Child,
+    stdout: ChildStdout,
 }
 
 impl UdsServer {
-    /// Binds `path` (removing a stale socket file first) and serves `state`
-    /// on a new thread, pinned to `cpu` if given, until dropped.
+    /// Starts `gjkd bench uds-server` on `path`, for batches of up to
+    /// `max_batch`, pinned to `cpu` if given, and waits until it listens.
     ///
     /// # Errors
-    /// When the socket cannot be bound.
-    pub fn start(path: &Path, mut state: State, cpu: Option<usize>) -> std::io::Result<Self> {
-        let _ = std::fs::remove_file(path);
-        let listener = UnixListener::bind(path)?;
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::Builder::new()
-            .name("gjkd-uds".into())
-            .spawn(move || {
-                if let Some(cpu) = cpu {
-                    super::latency::pin(0, cpu);
-                }
-                for conn in listener.incoming() {
-                    if flag.load(Ordering::Relaxed) {
-                        break;
-                    }
-                    if let Ok(conn) = conn {
-                        // A connection ends when the client hangs up.
-                        let _ = serve_connection(conn, &mut state);
-                    }
-                }
-            })?;
-        Ok(UdsServer {
+    /// When the process cannot be spawned or exits before listening.
+    pub fn spawn(path: &Path, max_batch: usize, cpu: Option<usize>) -> std::io::Result<Self> {
+        let mut cmd = Command::new(std::env::current_exe()?);
+        cmd.args(["bench", "uds-server", "--socket"])
+            .arg(path)
+            .args(["--max-batch", &max_batch.to_string()])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped());
+        if let Some(cpu) = cpu {
+            cmd.args(["--cpu", &cpu.to_string()]);
+        }
+        let mut child = cmd.spawn()?;
+        let mut server = UdsServer {
             path: path.to_owned(),
-            stop,
-            thread: Some(thread),
-        })
+            stdout: child
+                .stdout
+                .take()
+                .ok_or_else(|| std::io::Error::other("no stdout pipe"))?,
+            child,
+        };
+        let mut line = String::new();
+        // The child writes nothing else, so an unbuffered read of this one
+        // line leaves nothing behind in the pipe.
+        let mut byte = [0u8; 1];
+        while server.stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
+            line.push(char::from(byte[0]));
+        }
+        if line != READY {
+            return Err(std::io::Error::other(format!(
+                "gjkd bench uds-server did not start (said {line:?})"
+            )));
+        }
+        Ok(server)
     }
 
     /// The socket's path.
@@ -99,12 +178,9 @@ impl UdsServer {
 
 impl Drop for UdsServer {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        // Wake the blocking accept so the thread sees the flag.
-        let _ = UnixStream::connect(&self.path);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
+        // The server holds no state worth a clean exit: kill and reap it.
+        let _ = self.child.kill();
+        let _ = self.child.wait();
         let _ = std::fs::remove_file(&self.path);
     }
 }
@@ -245,8 +321,12 @@ mod tests {
             ),
         ];
         let path = std::env::temp_dir().join(format!("gjkd-uds-test-{}.sock", std::process::id()));
-        let server = UdsServer::start(&path, state, None).expect("bind");
-        let mut client = UdsClient::connect(server.path()).expect("connect");
+        let _ = std::fs::remove_file(&path);
+        // The server loop of the child process, on a thread here: a unit
+        // test's executable is not `gjkd` (the e2e tests run the child).
+        let listener = UnixListener::bind(&path).expect("bind");
+        let server = std::thread::spawn(move || serve(&listener, state));
+        let mut client = UdsClient::connect(&path).expect("connect");
         let mut out = [ItemResult::default(); 2];
         for _ in 0..3 {
             client.query(&items, &mut out).expect("round trip");
@@ -254,7 +334,9 @@ mod tests {
             assert_eq!(out[1].error_code(), ErrorCode::UnknownObject);
         }
         drop(client);
+        std::fs::remove_file(&path).expect("remove the socket");
+        // The serving thread stays blocked in `accept`; it ends with the
+        // test process.
         drop(server);
-        assert!(!path.exists());
     }
 }

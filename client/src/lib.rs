@@ -410,7 +410,7 @@ const YIELD_FOR: Duration = Duration::from_millis(2);
 /// While busy-polling, give the core away this often: a server the kernel
 /// woke onto this core cannot answer while the client holds it (on a busy
 /// 2-core machine that made a client spin out its whole 100 µs).
-const POLITE_EVERY: Duration = Duration::from_micros(10);
+const POLITE_EVERY: Duration = Duration::from_micros(5);
 
 impl Client {
     /// A builder for a client of the deployment named `service` (the server's
@@ -967,10 +967,12 @@ impl Client {
                 .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
             if conn.notify_queries {
                 let _ = conn.wake.notify();
-                // The kernel often wakes the server onto this very core: let
-                // it run now rather than after a spell of polling.
-                std::thread::yield_now();
             }
+            // If the server is waiting for this core (woken onto it, or
+            // preempted by us), let it run now rather than after a spell of
+            // polling; with a core of its own, this returns at once while it
+            // works on the answer.
+            std::thread::yield_now();
             Self::await_reply(&self.node, conn, deadline, self.timeout, || {
                 let Some(response) = pending.receive().map_err(ipc_err("query receive"))? else {
                     return Ok(None);

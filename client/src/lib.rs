@@ -410,7 +410,7 @@ const YIELD_FOR: Duration = Duration::from_millis(2);
 /// While busy-polling, give the core away this often: a server the kernel
 /// woke onto this core cannot answer while the client holds it (on a busy
 /// 2-core machine that made a client spin out its whole 100 µs).
-const POLITE_EVERY: Duration = Duration::from_micros(5);
+const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {
     /// A builder for a client of the deployment named `service` (the server's

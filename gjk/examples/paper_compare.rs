@@ -588,7 +588,7 @@ fn main() {
         }
     }
     println!(
-        "\n(compound: 5 queries of K_A = K6 u K7 per step, gjk warm-starts the nearest piece pair;"
+        "\n(compound: 5 queries of K_A = K6 u K7 per step, gjk warm-starts the nearest and runner-up piece pairs;"
     );
     println!(
         " pieces: the paper's setup, 10 convex queries d_6i, d_7i per step, each warm-started)"

@@ -195,6 +195,30 @@ pub struct Answer {
     pub warm_start: WarmStart,
 }
 
+/// Scratch memory of a query (the simplex with its dot products and
+/// cofactors), kept by a caller that makes many queries so that each one
+/// skips setting it up: see [`distance_in`]. Holds no result; any workspace
+/// serves any query.
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    simplex: Simplex,
+}
+
+impl Workspace {
+    /// A fresh workspace.
+    pub fn new() -> Self {
+        Workspace {
+            simplex: Simplex::empty(),
+        }
+    }
+}
+
+impl Default for Workspace {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// The distance between `a` at `pose_a` and `b` at `pose_b`, with nearest points,
 /// certified bounds and the simplex for a warm start.
 ///
@@ -204,6 +228,39 @@ pub struct Answer {
 /// [`Error::WarmStartOutOfRange`] for a warm start that names a piece or vertex
 /// the shapes do not have.
 pub fn distance(
+    a: &Shape,
+    pose_a: &Isometry3<f64>,
+    b: &Shape,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
+    distance_in(&mut Workspace::new(), a, pose_a, b, pose_b, options, warm)
+}
+
+/// [`distance`] in a caller's [`Workspace`]: the same answer, bit for bit,
+/// a little sooner when queries come one after another (a server's loop).
+///
+/// ```
+/// use gjk::{Convex, Options, Shape, Workspace, distance_in};
+/// use nalgebra::Isometry3;
+///
+/// let ball: Shape = Convex::sphere(1.0)?.into();
+/// let mut ws = Workspace::new();
+/// for x in [3.0, 4.0, 5.0] {
+///     let pose = Isometry3::translation(x, 0.0, 0.0);
+///     let answer = distance_in(
+///         &mut ws, &ball, &Isometry3::identity(), &ball, &pose, &Options::default(), None,
+///     )?;
+///     assert!((answer.distance - (x - 2.0)).abs() < 1e-12);
+/// }
+/// # Ok::<(), gjk::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`distance`].
+pub fn distance_in(
+    workspace: &mut Workspace,
     a: &Shape,
     pose_a: &Isometry3<f64>,
     b: &Shape,
@@ -240,16 +297,16 @@ pub fn distance(
     let mut answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)));
-            let mut simplex = Simplex::empty();
+            let simplex = &mut workspace.simplex;
             let run = pair.solve(
-                &mut simplex,
+                simplex,
                 options,
                 warm.and_then(|w| w.for_pieces([0, 0])),
                 f64::INFINITY,
             );
             pair.answer(
                 &run,
-                &simplex,
+                simplex,
                 Place {
                     pose: pose_a,
                     offset: None,
@@ -261,7 +318,16 @@ pub fn distance(
                 [0, 0],
             )
         }
-        _ => compound(a, pose_a, b, pose_b, &rel, options, warm),
+        _ => compound(
+            &mut workspace.simplex,
+            a,
+            pose_a,
+            b,
+            pose_b,
+            &rel,
+            options,
+            warm,
+        ),
     };
     if answer.lower > answer.upper {
         // The bounds contradict each other: round-off beyond the slack. The
@@ -271,7 +337,7 @@ pub fn distance(
         // bound is given up (0) rather than returning an interval that
         // cannot hold.
         if warm.is_some() {
-            return distance(a, pose_a, b, pose_b, options, None);
+            return distance_in(workspace, a, pose_a, b, pose_b, options, None);
         }
         answer.lower = 0.0;
         answer.distance = answer.distance.min(answer.upper);
@@ -723,7 +789,9 @@ impl<'s> Pair<'s> {
 /// (2.3), (2.8): the minimum over piece pairs. Pairs are visited warm pair
 /// first, then by a bounding-sphere lower bound; each runs with the best upper
 /// bound so far as its cutoff, so a pair that cannot win stops early.
+#[allow(clippy::too_many_arguments)]
 fn compound(
+    simplex: &mut Simplex,
     a: &Shape,
     pose_a: &Isometry3<f64>,
     b: &Shape,
@@ -772,7 +840,6 @@ fn compound(
         }
     }
 
-    let mut simplex = Simplex::empty();
     let mut best: Option<Answer> = None;
     let mut lower = f64::INFINITY;
     let mut iterations = 0u32;
@@ -792,10 +859,10 @@ fn compound(
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel, None);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
-        let run = pair.solve(&mut simplex, options, warm_pairs, cutoff);
+        let run = pair.solve(simplex, options, warm_pairs, cutoff);
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
         if pair_upper < kept[1].0 {
-            let entry = (pair_upper, PieceSimplex::of(&simplex, run.sol.mask, [i, j]));
+            let entry = (pair_upper, PieceSimplex::of(simplex, run.sol.mask, [i, j]));
             if pair_upper < kept[0].0 {
                 kept = [entry, kept[0]];
             } else {
@@ -823,7 +890,7 @@ fn compound(
         if better || status == Status::Closer {
             best = Some(pair.answer(
                 &run,
-                &simplex,
+                simplex,
                 Place {
                     pose: pose_a,
                     offset: Some(&oa),

@@ -8,6 +8,10 @@
 //! prints p50 / p90 / p99, since the target is stated as a median of single
 //! round trips.
 //!
+//! As in `gjkd bench latency`, the client is pinned to CPU 0 and the server to
+//! CPU 1, so that the scheduler cannot put the two spinning threads on one
+//! core (set `GJKD_BENCH_NO_PIN` to leave placement to it).
+//!
 //! `cargo bench -p gjkd --bench roundtrip` (set `GJKD_BENCH_PERCENTILES_ONLY`
 //! to stop after the percentiles).
 
@@ -40,7 +44,14 @@ impl Fixture {
         let shutdown = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&shutdown);
         let name = service.clone();
+        let pinned = std::env::var_os("GJKD_BENCH_NO_PIN").is_none();
+        if pinned {
+            gjkd::bench::latency::pin(0, 0);
+        }
         let server = std::thread::spawn(move || {
+            if pinned {
+                gjkd::bench::latency::pin(0, 1);
+            }
             let state = State::new(Limits::default(), WaitMode::Spin, 1);
             let options = ServeOptions {
                 service: name,

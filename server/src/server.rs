@@ -45,7 +45,7 @@ fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError 
 /// control cycle, short enough that an idle server costs no CPU.
 pub const ADAPTIVE_SPIN: Duration = Duration::from_micros(50);
 /// While spinning idle, yield the core this often.
-const POLITE_EVERY: Duration = Duration::from_micros(5);
+const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 /// Longest sleep in `block` mode: the loop wakes this often to look at the
 /// shutdown flag (signal handlers cannot wake an iceoryx2 wait) and do

@@ -110,6 +110,8 @@ pub struct State {
     next_slot: u32,
     /// Writes of the state file that failed.
     persist_errors: u64,
+    /// Scratch memory of gjk queries, reused from one query to the next.
+    workspace: gjk::Workspace,
     /// Query clients connected, as last seen by the serving loop.
     clients: u64,
 }
@@ -145,6 +147,7 @@ impl State {
             next_slot: 0,
             persist_errors: 0,
             clients: 0,
+            workspace: gjk::Workspace::new(),
         }
     }
 
@@ -571,7 +574,8 @@ impl State {
             b: item.b,
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
-        let answer = match gjk::distance(
+        let answer = match gjk::distance_in(
+            &mut self.workspace,
             &a.shape,
             &pose_a,
             &b.shape,
@@ -582,10 +586,16 @@ impl State {
             Ok(answer) => answer,
             // The cache is keyed by ids that are never reused, so this cannot
             // happen; if it does, the cold answer is still right.
-            Err(gjk::Error::WarmStartOutOfRange) => {
-                gjk::distance(&a.shape, &pose_a, &b.shape, &pose_b, &options, None)
-                    .map_err(map_gjk_error)?
-            }
+            Err(gjk::Error::WarmStartOutOfRange) => gjk::distance_in(
+                &mut self.workspace,
+                &a.shape,
+                &pose_a,
+                &b.shape,
+                &pose_b,
+                &options,
+                None,
+            )
+            .map_err(map_gjk_error)?,
             Err(e) => return Err(map_gjk_error(e)),
         };
         if warm_on {

@@ -13,7 +13,8 @@
 //! (the drawn gap, or 0) and against parry.
 //!
 //! Section 8: the collision sweep of `gjk::paper::section8()` for T = 10, 100,
-//! 1000, cold start against warm start, beside the paper's Table 1.
+//! 1000, cold start against warm start, beside the paper's Table 1; then warm
+//! against cold along a 1000-step motion of family pairs from M = 16 to 200.
 
 #[path = "../benches/common/mod.rs"]
 mod common;
@@ -641,4 +642,64 @@ fn main() {
     println!(
         "(times: median batch per whole sweep; ratio = cold/warm of the medians, ratio min = of the\n fastest batches; paper = Table 1; it/q = subalgorithm runs per query)"
     );
+    larger_motions(&options);
+}
+
+/// Warm against cold along a 1000-step motion of two members of the Section
+/// 7 family, small to large: the fixed cost of a query (poses, set-up, the
+/// answer in world coordinates) is the same either way, so the ratio grows
+/// with the support scans that a warm start saves.
+fn larger_motions(options: &Options) {
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+    let family: Vec<Shape> = paper::family().into_iter().map(Into::into).collect();
+    println!("\nWarm vs cold along a 1000-step motion of family pairs (B slides 4 units and turns 1.5 rad past A turning 0.6 rad):");
+    println!(
+        "{:>4} {:>8} {:>10} {:>10} {:>7} {:>10} {:>10}",
+        "M", "pair", "cold ns/q", "warm ns/q", "ratio", "cold it/q", "warm it/q"
+    );
+    let steps = 1000;
+    let poses: Vec<(Isometry3<f64>, Isometry3<f64>)> = (0..=steps)
+        .map(|t| {
+            let s = t as f64 / steps as f64;
+            let pa = Isometry3::from_parts(
+                Translation3::new(0.0, 0.0, 0.0),
+                UnitQuaternion::from_scaled_axis(Vector3::new(0.3, 0.1, 0.2) * (3.0 * s)),
+            );
+            let pb = Isometry3::from_parts(
+                Translation3::new(9.0 - 4.0 * s, s, 0.5),
+                UnitQuaternion::from_scaled_axis(Vector3::new(-0.2, 0.4, 0.1) * (5.0 * s)),
+            );
+            (pa, pb)
+        })
+        .collect();
+    for (a, b) in [(2usize, 2usize), (4, 5), (7, 9), (10, 11), (11, 11)] {
+        let run = |warm: bool| {
+            let mut last: Option<gjk::WarmStart> = None;
+            let mut iterations = 0u64;
+            for (pa, pb) in &poses {
+                let w = if warm { last.as_ref() } else { None };
+                let ans = gjk::distance(black_box(&family[a]), pa, &family[b], pb, options, w)
+                    .expect("valid input");
+                iterations += u64::from(ans.iterations);
+                last = Some(ans.warm_start);
+            }
+            iterations as f64
+        };
+        let queries = (steps + 1) as f64;
+        let (ic, iw) = (run(false) / queries, run(true) / queries);
+        let t = time_pair(1, || run(false), || run(true));
+        let m = match (&family[a], &family[b]) {
+            (Shape::Convex(x), Shape::Convex(y)) => x.len() + y.len(),
+            _ => 0,
+        };
+        println!(
+            "{m:>4} {:>8} {:>10.0} {:>10.0} {:>7.2} {:>10.2} {:>10.2}",
+            format!("({},{})", a + 1, b + 1),
+            t.f_median / queries,
+            t.g_median / queries,
+            t.f_median / t.g_median,
+            ic,
+            iw
+        );
+    }
 }

@@ -968,11 +968,6 @@ impl Client {
             if conn.notify_queries {
                 let _ = conn.wake.notify();
             }
-            // If the server is waiting for this core (woken onto it, or
-            // preempted by us), let it run now rather than after a spell of
-            // polling; with a core of its own, this returns at once while it
-            // works on the answer.
-            std::thread::yield_now();
             Self::await_reply(&self.node, conn, deadline, self.timeout, || {
                 let Some(response) = pending.receive().map_err(ipc_err("query receive"))? else {
                     return Ok(None);

@@ -101,9 +101,13 @@ impl WarmCache {
     /// `u32::MAX` are kept).
     pub fn new(capacity: usize) -> Self {
         let capacity = capacity.min(u32::MAX as usize);
+        // Start small and grow with the pairs actually queried: a table sized
+        // for the cap spreads a few dozen live entries over megabytes, one
+        // page (and TLB miss) each, which cost a batch of 64 pairs several µs.
+        let start = capacity.min(256);
         WarmCache {
-            index: HashMap::with_capacity_and_hasher(capacity.min(1 << 16), FxBuild::default()),
-            slots: Vec::with_capacity(capacity.min(1 << 16)),
+            index: HashMap::with_capacity_and_hasher(start, FxBuild::default()),
+            slots: Vec::with_capacity(start),
             hand: 0,
             capacity,
             stats: CacheStats::default(),

@@ -231,6 +231,9 @@ pub fn run(
         let now = Instant::now();
         if served > 0 {
             last_request = now;
+            // Yield only after POLITE_EVERY of idleness, not at the first
+            // idle turn after each reply.
+            last_yield = now;
         }
         let since = now.duration_since(last_housekeeping);
         if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING

@@ -652,7 +652,9 @@ fn main() {
 fn larger_motions(options: &Options) {
     use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
     let family: Vec<Shape> = paper::family().into_iter().map(Into::into).collect();
-    println!("\nWarm vs cold along a 1000-step motion of family pairs (B slides 4 units and turns 1.5 rad past A turning 0.6 rad):");
+    println!(
+        "\nWarm vs cold along a 1000-step motion of family pairs (B slides 4 units and turns 1.5 rad past A turning 0.6 rad):"
+    );
     println!(
         "{:>4} {:>8} {:>10} {:>10} {:>7} {:>10} {:>10}",
         "M", "pair", "cold ns/q", "warm ns/q", "ratio", "cold it/q", "warm it/q"

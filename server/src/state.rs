@@ -574,28 +574,17 @@ impl State {
             b: item.b,
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
-        let answer = match gjk::distance_in(
-            &mut self.workspace,
-            &a.shape,
-            &pose_a,
-            &b.shape,
-            &pose_b,
-            &options,
-            warm.as_ref(),
-        ) {
+        let workspace = &mut self.workspace;
+        let mut query = |warm: Option<&gjk::WarmStart>| {
+            gjk::distance_in(
+                workspace, &a.shape, &pose_a, &b.shape, &pose_b, &options, warm,
+            )
+        };
+        let answer = match query(warm.as_ref()) {
             Ok(answer) => answer,
             // The cache is keyed by ids that are never reused, so this cannot
             // happen; if it does, the cold answer is still right.
-            Err(gjk::Error::WarmStartOutOfRange) => gjk::distance_in(
-                &mut self.workspace,
-                &a.shape,
-                &pose_a,
-                &b.shape,
-                &pose_b,
-                &options,
-                None,
-            )
-            .map_err(map_gjk_error)?,
+            Err(gjk::Error::WarmStartOutOfRange) => query(None).map_err(map_gjk_error)?,
             Err(e) => return Err(map_gjk_error(e)),
         };
         if warm_on {

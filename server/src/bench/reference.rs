@@ -22,6 +22,14 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
+/// The exact closest-point primitives (segment, segment pair, triangle) of
+/// gjk's own brute-force test reference, shared rather than copied: both
+/// references must owe nothing to GJK, and one implementation of them is
+/// enough.
+#[path = "../../../gjk/tests/common/mod.rs"]
+mod common;
+pub use common::{closest_on_segment, closest_on_triangle, closest_segment_segment};
+
 type P = Point3<f64>;
 type V = Vector3<f64>;
 
@@ -202,85 +210,6 @@ pub struct Reference {
     pub distance: f64,
     /// Whether a separating axis with a positive gap proved the cores apart.
     pub separated: bool,
-}
-
-/// Nearest point of segment `[a, b]` to `p`.
-pub fn closest_on_segment(p: &P, a: &P, b: &P) -> P {
-    let d = b - a;
-    let dd = d.norm_squared();
-    if dd == 0.0 {
-        return *a;
-    }
-    let t = ((p - a).dot(&d) / dd).clamp(0.0, 1.0);
-    a + d * t
-}
-
-/// Nearest points of two segments (Ericson 5.1.9), backed by the four
-/// endpoint–segment candidates so that parallel and degenerate segments are
-/// exact too: every candidate is a pair of points on the segments, so the
-/// nearest of them is never worse than the closed form.
-pub fn closest_segment_segment(p1: &P, q1: &P, p2: &P, q2: &P) -> (P, P) {
-    let mut best = (*p1, *p2);
-    let mut best_d2 = f64::INFINITY;
-    let mut consider = |x: P, y: P| {
-        let d2 = (y - x).norm_squared();
-        if d2 < best_d2 {
-            best_d2 = d2;
-            best = (x, y);
-        }
-    };
-    let d1 = q1 - p1;
-    let d2 = q2 - p2;
-    let r = p1 - p2;
-    let a = d1.norm_squared();
-    let e = d2.norm_squared();
-    if a > 0.0 && e > 0.0 {
-        let b = d1.dot(&d2);
-        let c = d1.dot(&r);
-        let f = d2.dot(&r);
-        let denom = a * e - b * b;
-        let mut s = if denom > 1e-14 * a * e {
-            ((b * f - c * e) / denom).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let mut t = (b * s + f) / e;
-        if t < 0.0 {
-            t = 0.0;
-            s = (-c / a).clamp(0.0, 1.0);
-        } else if t > 1.0 {
-            t = 1.0;
-            s = ((b - c) / a).clamp(0.0, 1.0);
-        }
-        consider(p1 + d1 * s, p2 + d2 * t);
-    }
-    consider(*p1, closest_on_segment(p1, p2, q2));
-    consider(*q1, closest_on_segment(q1, p2, q2));
-    consider(closest_on_segment(p2, p1, q1), *p2);
-    consider(closest_on_segment(q2, p1, q1), *q2);
-    best
-}
-
-/// Nearest point of triangle `abc` to `p`: the projection on the plane when
-/// it falls inside, else the nearest of the edges.
-pub fn closest_on_triangle(p: &P, a: &P, b: &P, c: &P) -> P {
-    let n = (b - a).cross(&(c - a));
-    let nn = n.norm_squared();
-    if nn > 0.0 {
-        let inside = n.dot(&(b - a).cross(&(p - a))) >= 0.0
-            && n.dot(&(c - b).cross(&(p - b))) >= 0.0
-            && n.dot(&(a - c).cross(&(p - c))) >= 0.0;
-        if inside {
-            return p - n * (n.dot(&(p - a)) / nn);
-        }
-    }
-    let mut best = closest_on_segment(p, a, b);
-    for q in [closest_on_segment(p, b, c), closest_on_segment(p, c, a)] {
-        if (q - p).norm_squared() < (best - p).norm_squared() {
-            best = q;
-        }
-    }
-    best
 }
 
 /// Gap between the sets along unit axis `a`, measured from `origin` to keep

@@ -4,7 +4,7 @@
 //! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
 //! ([`scene`]), the state file that keeps objects across crashes
 //! ([`persist`]), the iceoryx2 serving loop ([`server`]), the built-in demo
-//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`](crate::bench)). The `gjkd`
+//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`](mod@bench)). The `gjkd`
 //! binary is a thin command line over these.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the

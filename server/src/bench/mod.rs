@@ -6,7 +6,7 @@
 //!   HdrHistogram percentiles.
 //! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
 //!   and cold starts and early-exit margins, judged by an exact reference
-//!   ([`reference`](crate::bench::reference)) that owes nothing to GJK.
+//!   ([`reference`](mod@reference)) that owes nothing to GJK.
 //! - [`paper`]: the paper's Section 7, time per query against the number of
 //!   vertices `M`.
 //!

@@ -301,7 +301,7 @@ fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(),
     let _ = writeln!(
         out,
         "Time of a sweep of T steps (5(T+1) queries, median of {repeats}), cold start against the\n\
-         server's per-pair warm start, beside the paper's Table 1 (a VAX 11/785 in 1986):\n"
+         server's per-pair warm start, beside the paper's Table 1 (a Harris 800 in 1986):\n"
     );
     let _ = writeln!(
         out,

@@ -226,7 +226,7 @@ fn candidate_distance(p: &[P], q: &[P]) -> (f64, P, P) {
 
 /// Gap between the sets along the unit axis `a`: `min_q a·q - max_p a·p`,
 /// measured from `origin` to keep the products small.
-fn gap_along(p: &[P], q: &[P], a: &V, origin: &P) -> f64 {
+pub fn gap_along(p: &[P], q: &[P], a: &V, origin: &P) -> f64 {
     let max_p = p
         .iter()
         .map(|x| a.dot(&(x - origin)))

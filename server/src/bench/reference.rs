@@ -22,12 +22,13 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-/// The exact closest-point primitives (segment, segment pair, triangle) of
-/// gjk's own brute-force test reference, shared rather than copied: both
-/// references must owe nothing to GJK, and one implementation of them is
-/// enough.
+/// The exact closest-point primitives (segment, segment pair, triangle) and
+/// the gap along an axis, from gjk's own brute-force test reference: shared
+/// rather than copied, since both references must owe nothing to GJK and one
+/// implementation of them is enough.
 #[path = "../../../gjk/tests/common/mod.rs"]
 mod common;
+use common::gap_along;
 pub use common::{closest_on_segment, closest_on_triangle, closest_segment_segment};
 
 type P = Point3<f64>;
@@ -210,20 +211,6 @@ pub struct Reference {
     pub distance: f64,
     /// Whether a separating axis with a positive gap proved the cores apart.
     pub separated: bool,
-}
-
-/// Gap between the sets along unit axis `a`, measured from `origin` to keep
-/// the products small: `min_q a·q - max_p a·p`.
-fn gap_along(p: &[P], q: &[P], a: &V, origin: &P) -> f64 {
-    let max_p = p
-        .iter()
-        .map(|x| a.dot(&(x - origin)))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let min_q = q
-        .iter()
-        .map(|y| a.dot(&(y - origin)))
-        .fold(f64::INFINITY, f64::min);
-    min_q - max_p
 }
 
 /// Centre and (padded) radius of a ball holding `pts`.

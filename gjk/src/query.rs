@@ -311,23 +311,10 @@ pub fn distance_in(
                     pose: pose_a,
                     offset: None,
                 },
-                Place {
-                    pose: pose_b,
-                    offset: None,
-                },
                 [0, 0],
             )
         }
-        _ => compound(
-            &mut workspace.simplex,
-            a,
-            pose_a,
-            b,
-            pose_b,
-            &rel,
-            options,
-            warm,
-        ),
+        _ => compound(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
     };
     if answer.lower > answer.upper {
         // The bounds contradict each other: round-off beyond the slack. The
@@ -714,41 +701,36 @@ impl<'s> Pair<'s> {
 
     /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
     /// pieces' offsets in their shapes' body frames.
-    fn answer(
-        &self,
-        run: &Run,
-        simplex: &Simplex,
-        place_a: Place<'_>,
-        place_b: Place<'_>,
-        pieces: [u32; 2],
-    ) -> Answer {
+    fn answer(&self, run: &Run, simplex: &Simplex, place_a: Place<'_>, pieces: [u32; 2]) -> Answer {
         let (pose_a, off_a) = (place_a.pose, place_a.offset);
-        let place = |pose: &Isometry3<f64>, off: Option<&Isometry3<f64>>, p: Point3<f64>| match off
-        {
-            Some(o) => pose * (o * p),
-            None => pose * p,
-        };
         let mut wa = Vector3::zeros();
-        let mut wb = Vector3::zeros();
         let mut pairs = [[0u32; 2]; 4];
         let mut len = 0;
         for i in 0..4 {
             if run.sol.mask & (1 << i) != 0 {
                 let vx = &simplex.vertices[i];
-                let l = run.sol.lambda[i];
-                wa += self.a.local(vx.ia as usize) * l;
-                wb += self.b.local(vx.ib as usize) * l;
-                pairs[len] = [vx.ia, vx.ib];
+                wa += self.a.local(vx.ia as usize) * run.sol.lambda[i];
+                pairs[len & 3] = [vx.ia, vx.ib];
                 len += 1;
             }
         }
-        let core_a = place(pose_a, off_a, self.a.centroid() + wa);
-        let core_b = place(place_b.pose, place_b.offset, self.b.centroid() + wb);
+        // Both nearest points in A's piece frame: B's is A's minus v, since
+        // v = Σλ(a_i - b_i) with the same weights. One placement serves both,
+        // and their gap is v itself, not the difference of two placements.
+        let (rot, shift) = match off_a {
+            Some(o) => (
+                pose_a.rotation * o.rotation,
+                pose_a.rotation * o.translation.vector + pose_a.translation.vector,
+            ),
+            None => (pose_a.rotation, pose_a.translation.vector),
+        };
+        let core_a = Point3::from(rot * (self.a.centroid().coords + wa) + shift);
+        // b - a = -v, in world coordinates.
+        let gap = rot * -run.sol.v;
+        let core_b = core_a + gap;
         let separated = run.norm > self.slack;
         let normal = if separated {
-            // b - a = -v in A's piece frame.
-            let n = -run.sol.v / run.norm;
-            pose_a.rotation * off_a.map_or(n, |o| o.rotation * n)
+            gap * (1.0 / run.norm)
         } else {
             Vector3::zeros()
         };
@@ -795,7 +777,6 @@ fn compound(
     a: &Shape,
     pose_a: &Isometry3<f64>,
     b: &Shape,
-    pose_b: &Isometry3<f64>,
     rel: &Isometry3<f64>,
     options: &Options,
     warm: Option<&WarmStart>,
@@ -894,10 +875,6 @@ fn compound(
                 Place {
                     pose: pose_a,
                     offset: Some(&oa),
-                },
-                Place {
-                    pose: pose_b,
-                    offset: Some(&ob),
                 },
                 [i, j],
             ));

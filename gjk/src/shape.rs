@@ -45,6 +45,22 @@ pub struct Convex {
     xs: Vec<f64>,
     ys: Vec<f64>,
     zs: Vec<f64>,
+    /// How the support point is found: a scan in general, a closed form for
+    /// the shapes whose support function is one.
+    kind: Kind,
+}
+
+/// The support function's form, decided once from the vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    /// One vertex: a sphere's core.
+    Point,
+    /// Eight vertices `(±h.x, ±h.y, ±h.z)` about the centroid, vertex `i`
+    /// taking `+` on axis `k` when bit `k` of `i` is set ([`Convex::cuboid`]'s
+    /// order): the support index is the sign bits of the direction.
+    Box,
+    /// Anything else: the linear scan.
+    Scan,
 }
 
 impl Convex {
@@ -111,6 +127,13 @@ impl Convex {
                 coord.resize(padded, coord[0]);
             }
         }
+        let kind = if len == 1 {
+            Kind::Point
+        } else if is_box(&xs, &ys, &zs) {
+            Kind::Box
+        } else {
+            Kind::Scan
+        };
         Ok(Self {
             vertices,
             radius,
@@ -120,6 +143,7 @@ impl Convex {
             xs,
             ys,
             zs,
+            kind,
         })
     }
 
@@ -207,9 +231,18 @@ impl Convex {
     /// is a valid support point), but always the same way on one machine.
     #[inline]
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
-        if self.xs.len() == 1 {
+        match self.kind {
             // A sphere's core: nothing to scan.
-            return 0;
+            Kind::Point => return 0,
+            // A box's support is its direction's sign pattern. A zero
+            // component is a tie between the two faces, given to the lower
+            // index as the scan would.
+            Kind::Box => {
+                return usize::from(d.x > 0.0)
+                    | usize::from(d.y > 0.0) << 1
+                    | usize::from(d.z > 0.0) << 2;
+            }
+            Kind::Scan => {}
         }
         #[cfg(target_arch = "x86_64")]
         {
@@ -320,6 +353,24 @@ impl From<Compound> for Shape {
     fn from(c: Compound) -> Self {
         Shape::Compound(c)
     }
+}
+
+/// Whether the centroid-relative vertices are exactly a box in
+/// [`Convex::cuboid`]'s order: vertex `i` is `(±h.x, ±h.y, ±h.z)`, with `+` on
+/// axis `k` when bit `k` of `i` is set. Exact comparison: a set that is a box
+/// only up to round-off keeps the scan, which is never wrong.
+fn is_box(xs: &[f64], ys: &[f64], zs: &[f64]) -> bool {
+    if xs.len() != 8 {
+        return false;
+    }
+    let h = [xs[7], ys[7], zs[7]];
+    if h.iter().any(|&c| c.is_sign_negative()) {
+        return false;
+    }
+    (0..8).all(|i| {
+        let want = |bit: usize, c: f64| if i & bit != 0 { c } else { -c };
+        xs[i] == want(1, h[0]) && ys[i] == want(2, h[1]) && zs[i] == want(4, h[2])
+    })
 }
 
 pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {
@@ -472,4 +523,79 @@ unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usi
         }
     }
     idx
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The support index by brute force: the first vertex of largest `v·d`.
+    fn brute(c: &Convex, d: &Vector3<f64>) -> usize {
+        let mut best = 0;
+        for i in 1..c.len() {
+            if c.local(i).dot(d) > c.local(best).dot(d) {
+                best = i;
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn box_support_is_the_scan_including_ties() {
+        let comps = [-1.5, -1e-300, -0.0, 0.0, 1e-300, 0.7];
+        for half in [
+            Vector3::new(0.5, 2.0, 0.25),
+            Vector3::new(0.5, 2.0, 1e-200),
+            Vector3::new(0.5, 2.0, 0.0),
+        ] {
+            let b = Convex::cuboid(half, 0.1).unwrap();
+            assert_eq!(b.kind, Kind::Box);
+            for &x in &comps {
+                for &y in &comps {
+                    for &z in &comps {
+                        let d = Vector3::new(x, y, z);
+                        let (i, j) = (b.support_index(&d), brute(&b, &d));
+                        assert_eq!(b.local(i).dot(&d), b.local(j).dot(&d), "{d:?}");
+                        // A flat axis, or a component lost in the sum,
+                        // ties the two faces: either is a support point.
+                        let lost = [x, y, z].iter().any(|c| c.abs() == 1e-300);
+                        if half.z > 1e-100 && !lost {
+                            assert_eq!(i, j, "direction {d:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn only_exact_boxes_in_cuboid_order_take_the_closed_form() {
+        let b = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.0).unwrap();
+        let mut swapped = b.vertices().to_vec();
+        swapped.swap(0, 7);
+        let shifted: Vec<_> = b
+            .vertices()
+            .iter()
+            .map(|v| v + Vector3::new(1e3, 0.0, 0.0))
+            .collect();
+        let mut skew = b.vertices().to_vec();
+        skew[3].x += 1e-9;
+        for (verts, kind) in [
+            (swapped, Kind::Scan),
+            (skew, Kind::Scan),
+            (shifted, Kind::Box),
+            (b.vertices()[..1].to_vec(), Kind::Point),
+            (b.vertices()[..2].to_vec(), Kind::Scan),
+        ] {
+            let c = Convex::new(verts, 0.0).unwrap();
+            assert_eq!(c.kind, kind);
+            for d in [
+                Vector3::new(0.3, -0.2, 0.9),
+                Vector3::new(-1.0, 0.0, 0.0),
+                Vector3::new(0.0, 0.0, 0.0),
+            ] {
+                assert_eq!(c.support_index(&d), brute(&c, &d), "{kind:?} {d:?}");
+            }
+        }
+    }
 }

@@ -40,7 +40,8 @@ impl Default for Options {
 
 impl Options {
     fn validate(&self) -> Result<(), Error> {
-        if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
+        // One pair of comparisons: NaN fails both, infinity the second.
+        if !(self.tolerance >= 0.0 && self.tolerance <= f64::MAX) {
             return Err(Error::InvalidOption("tolerance must be finite and >= 0"));
         }
         if self.max_iterations == 0 {
@@ -362,9 +363,8 @@ pub fn distance_in(
 struct Pair<'s> {
     a: &'s Convex,
     b: &'s Convex,
-    /// Rotation of B's piece into A's piece frame, and its transpose.
+    /// Rotation of B's piece into A's piece frame.
     r: Matrix3<f64>,
-    rt: Matrix3<f64>,
     /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`.
     t: Vector3<f64>,
     /// `D(K)` bounded by (6.4).
@@ -446,7 +446,6 @@ impl<'s> Pair<'s> {
             a,
             b,
             r,
-            rt: r.transpose(),
             t,
             d,
             slack: 64.0 * f64::EPSILON * scale,
@@ -471,7 +470,7 @@ impl<'s> Pair<'s> {
     #[inline]
     fn support(&self, eta: &Vector3<f64>) -> Vertex {
         let ia = self.a.support_index(eta);
-        let ib = self.b.support_index(&(self.rt * -eta));
+        let ib = self.b.support_index(&-self.r.tr_mul(eta));
         self.vertex(ia, ib)
     }
 

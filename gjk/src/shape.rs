@@ -229,7 +229,7 @@ impl Convex {
     /// vector lanes. Exact ties go to the lowest index; a near-tie within the
     /// last bit may go either way between the AVX2 and portable paths (each
     /// is a valid support point), but always the same way on one machine.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
         match self.kind {
             // A sphere's core: nothing to scan.
@@ -242,8 +242,14 @@ impl Convex {
                     | usize::from(d.y > 0.0) << 1
                     | usize::from(d.z > 0.0) << 2;
             }
-            Kind::Scan => {}
+            Kind::Scan => self.scan_index(d),
         }
+    }
+
+    /// [`support_index`](Self::support_index) by the scan, out of line: the
+    /// closed forms are inlined into the query, the scan is not.
+    #[inline(never)]
+    fn scan_index(&self, d: &Vector3<f64>) -> usize {
         #[cfg(target_arch = "x86_64")]
         {
             if self.xs.len() >= 8

@@ -86,6 +86,28 @@ impl PieceSimplex {
         &self.pairs[..(self.len as usize).min(4)]
     }
 
+    /// Whether every index names a piece and vertex that `a` and `b` have
+    /// (an empty entry always fits). Branch-free over the pairs: one
+    /// comparison each, folded into one flag.
+    fn fits(&self, a: &Shape, b: &Shape) -> bool {
+        if self.len == 0 {
+            return true;
+        }
+        let (Some(ca), Some(cb)) = (
+            a.convex_piece(self.pieces[0] as usize),
+            b.convex_piece(self.pieces[1] as usize),
+        ) else {
+            return false;
+        };
+        let (na, nb) = (ca.len(), cb.len());
+        let mut ok = self.len <= 4;
+        for &[i, j] in self.pairs() {
+            ok &= (i as usize) < na;
+            ok &= (j as usize) < nb;
+        }
+        ok
+    }
+
     /// The index pairs of `mask`'s vertices in `simplex`.
     fn of(simplex: &Simplex, mask: u8, pieces: [u32; 2]) -> Self {
         let mut out = PieceSimplex {
@@ -270,19 +292,10 @@ pub fn distance_in(
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
     options.validate()?;
-    if let Some(w) = warm {
-        for e in w.entries() {
-            let (pa, pb) = (e.pieces[0] as usize, e.pieces[1] as usize);
-            let (Some((_, ca)), Some((_, cb))) = (a.piece(pa), b.piece(pb)) else {
-                return Err(Error::WarmStartOutOfRange);
-            };
-            if e.pairs()
-                .iter()
-                .any(|&[i, j]| i as usize >= ca.len() || j as usize >= cb.len())
-            {
-                return Err(Error::WarmStartOutOfRange);
-            }
-        }
+    if let Some(w) = warm
+        && !(w.first.fits(a, b) && w.second.fits(a, b))
+    {
+        return Err(Error::WarmStartOutOfRange);
     }
     let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
     // a⁻¹·b: the translations are subtracted before rotating, so poses far from

@@ -339,6 +339,15 @@ impl Shape {
         }
     }
 
+    /// Piece `i` without its offset.
+    #[inline]
+    pub(crate) fn convex_piece(&self, i: usize) -> Option<&Convex> {
+        match self {
+            Shape::Convex(c) => (i == 0).then_some(c),
+            Shape::Compound(c) => c.pieces.get(i).map(|(_, p)| p),
+        }
+    }
+
     /// Piece `i` with its offset in the shape's body frame.
     pub(crate) fn piece(&self, i: usize) -> Option<(Isometry3<f64>, &Convex)> {
         match self {

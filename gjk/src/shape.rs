@@ -233,14 +233,12 @@ impl Convex {
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
         match self.kind {
             // A sphere's core: nothing to scan.
-            Kind::Point => return 0,
+            Kind::Point => 0,
             // A box's support is its direction's sign pattern. A zero
             // component is a tie between the two faces, given to the lower
             // index as the scan would.
             Kind::Box => {
-                return usize::from(d.x > 0.0)
-                    | usize::from(d.y > 0.0) << 1
-                    | usize::from(d.z > 0.0) << 2;
+                usize::from(d.x > 0.0) | usize::from(d.y > 0.0) << 1 | usize::from(d.z > 0.0) << 2
             }
             Kind::Scan => self.scan_index(d),
         }

@@ -87,6 +87,56 @@ pub fn pin(pid: libc::pid_t, cpu: usize) -> bool {
     }
 }
 
+/// The median time, in ns, for one cache line to go from CPU `a` to CPU `b`
+/// and back (two threads pinned there bouncing an atomic counter), or `None`
+/// when the threads cannot be pinned. Every round trip through shared memory
+/// is a handful of such transfers, and on a VM their cost is the host's
+/// business: this machine has shown about 65 ns at some times and about
+/// 340 ns at others, which doubles a single round trip. Printed with each
+/// run so that its figures can be read against the state it ran in.
+pub fn core_round_trip_ns(a: usize, b: usize) -> Option<f64> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    #[repr(align(128))]
+    struct Line(AtomicU64);
+    const BATCH: u64 = 2_000;
+    const BATCHES: u64 = 15;
+    let line = Line(AtomicU64::new(0));
+    let line = &line;
+    // Two threads of their own, so the caller's affinity is left alone.
+    std::thread::scope(|scope| {
+        let echo = scope.spawn(move || {
+            let ok = pin(0, b);
+            // An odd value is a ping; answer with the next even one. A
+            // failed pin still answers, so the other side never hangs.
+            for i in 0..BATCH * BATCHES {
+                while line.0.load(Ordering::Acquire) != 2 * i + 1 {
+                    std::hint::spin_loop();
+                }
+                line.0.store(2 * i + 2, Ordering::Release);
+            }
+            ok
+        });
+        let ping = scope.spawn(move || {
+            let ok = pin(0, a);
+            let mut times = Vec::with_capacity(BATCHES as usize);
+            for k in 0..BATCHES {
+                let start = Instant::now();
+                for i in k * BATCH..(k + 1) * BATCH {
+                    line.0.store(2 * i + 1, Ordering::Release);
+                    while line.0.load(Ordering::Acquire) != 2 * i + 2 {
+                        std::hint::spin_loop();
+                    }
+                }
+                times.push(start.elapsed().as_nanos() as f64 / BATCH as f64);
+            }
+            times.sort_by(f64::total_cmp);
+            ok.then(|| times[times.len() / 2])
+        });
+        let echoed = echo.join().unwrap_or(false);
+        ping.join().ok().flatten().filter(|_| echoed)
+    })
+}
+
 /// Lets the calling thread run on every CPU again.
 fn unpin() {
     // SAFETY: as in `pin`, with every CPU the set can name.
@@ -494,7 +544,12 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
     }
     let mut planned: Vec<u64> = vec![0; configs.len()];
     let mut hists: Vec<Option<Histogram<u64>>> = vec![None; configs.len()];
+    // The host's cross-core latency, before each round and after the last.
+    let mut probes: Vec<f64> = Vec::new();
     for round in 0..rounds {
+        if let Some(ns) = core_round_trip_ns(0, 1) {
+            probes.push(ns);
+        }
         for &t in &transports {
             progress.step(format!(
                 "round {}/{rounds}, {}: starting",
@@ -552,14 +607,23 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
             })
         })
         .collect();
+    if let Some(ns) = core_round_trip_ns(0, 1) {
+        probes.push(ns);
+    }
     progress.finish();
     if pinned {
         unpin();
     }
-    report(&rows, &dir, &args, pinned)
+    report(&rows, &dir, &args, pinned, &probes)
 }
 
-fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<(), BenchError> {
+fn report(
+    rows: &[Row],
+    dir: &Path,
+    args: &LatencyArgs,
+    pinned: bool,
+    probes: &[f64],
+) -> Result<(), BenchError> {
     let mut csv = Csv::new(&[
         "transport",
         "request",
@@ -618,6 +682,13 @@ fn report(rows: &[Row], dir: &Path, args: &LatencyArgs, pinned: bool) -> Result<
             p50(Transport::Uds, Workload::Single, gapped),
             p50(Transport::Uds, Workload::Single, gapped) / spin,
             p50(Transport::InProcess, Workload::Single, gapped),
+        ));
+    }
+    if !probes.is_empty() {
+        let list: Vec<String> = probes.iter().map(|ns| format!("{ns:.0}")).collect();
+        summary.push_str(&format!(
+            "\nCache-line round trip CPU 0 <-> CPU 1 before each round and after the last: {} ns (the host's state: this VM has shown ~65 ns and ~340 ns at different times, and the slow state doubles a single round trip)\n",
+            list.join(", ")
         ));
     }
     println!("\n{md}{summary}");

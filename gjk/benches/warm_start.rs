@@ -6,7 +6,8 @@
 //! and 1000.
 //!
 //! `cold`/`warm` hand the two-piece object to `gjk::distance` as one compound
-//! (5 queries per step; gjk warm-starts only the piece pair that was nearest);
+//! (5 queries per step; gjk warm-starts the nearest and the runner-up piece
+//! pairs);
 //! `pieces_cold`/`pieces_warm` query each piece against each obstacle with its
 //! own warm start (10 convex queries per step), as the paper does.
 //!

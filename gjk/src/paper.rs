@@ -561,7 +561,7 @@ impl Motion {
     /// per step, `d_6i` and `d_7i` for the pieces `K6`, `K7` and each obstacle
     /// `Ki`, each with its own warm start when `warm`; `d_i = min(d_6i, d_7i)`
     /// (2.3). Same distances as [`Motion::sweep`], which hands the union to
-    /// [`distance`] and so warm-starts only the piece pair that was nearest.
+    /// [`distance`] and so warm-starts only the nearest and runner-up piece pairs.
     ///
     /// # Errors
     /// As [`distance`].

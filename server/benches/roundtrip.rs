@@ -39,6 +39,10 @@ struct Fixture {
     a: ObjectId,
     b: ObjectId,
     batch: Vec<Item>,
+    /// The same 64 items naming objects that do not exist: the server only
+    /// looks the ids up, so the round trip is the transport of a batch of
+    /// this size, to set the batch's time against.
+    unknown: Vec<Item>,
     results: Vec<ItemResult>,
     shutdown: Arc<AtomicBool>,
     server: Option<std::thread::JoinHandle<()>>,
@@ -96,8 +100,18 @@ impl Fixture {
                 Item::distance(boxes[0], boxes[k + 1], &QueryOptions::default()).with_pose_b(&pose)
             })
             .collect();
+        let unknown = batch
+            .iter()
+            .enumerate()
+            .map(|(k, it)| Item {
+                a: u64::MAX - 2 * k as u64,
+                b: u64::MAX - 2 * k as u64 - 1,
+                ..*it
+            })
+            .collect();
         Fixture {
             client,
+            unknown,
             a,
             b,
             results: vec![ItemResult::default(); batch.len()],
@@ -118,6 +132,16 @@ impl Fixture {
         self.client
             .query_batch(&self.batch, &mut self.results)
             .expect("batch");
+    }
+
+    fn transport_only(&mut self) {
+        self.client
+            .query_batch(&self.unknown, &mut self.results)
+            .expect("batch");
+        assert!(
+            self.results.iter().all(|r| r.error != 0),
+            "ids must be unknown"
+        );
     }
 }
 
@@ -162,6 +186,7 @@ fn benches(c: &mut Criterion) {
         black_box(fx.single());
     });
     percentiles("roundtrip/batch_64_box_pairs", || fx.batch());
+    percentiles("roundtrip/batch_64_transport_only", || fx.transport_only());
     if std::env::var_os("GJKD_BENCH_PERCENTILES_ONLY").is_some() {
         // Probed with the spinning server stopped: it holds CPU 1.
         drop(fx);

@@ -901,8 +901,10 @@ pub struct ServerStats {
     /// (every few seconds): a client that died drops out once its death
     /// is detected.
     pub clients: u64,
-    /// Writes of the state file that failed (each failed registration or
-    /// removal was refused with [`ErrorCode::Internal`] and undone).
+    /// Writes of the state file, change log or pose journal that failed. A
+    /// registration or removal that could be written nowhere was refused
+    /// with [`ErrorCode::Internal`] and undone; one whose compaction failed
+    /// but whose log record was written was acknowledged.
     pub persist_errors: u64,
 }
 

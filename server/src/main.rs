@@ -6,12 +6,12 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use gjkd::persist::{Loaded, Store};
+use gjkd::persist::{Loaded, LogError, Replay, Store};
 use gjkd::scene::Scene;
 use gjkd::server::{ServeOptions, run};
 use gjkd::state::{Limits, State};
 use gjkd_proto::{DEFAULT_SERVICE, MAX_PIECES, WaitMode};
-use tracing::{error, info};
+use tracing::{error, info, warn};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -203,14 +203,16 @@ fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
         .clone()
         .or_else(|| gjkd::persist::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file or --no-persist")?;
-    let store = Store::open(&path).map_err(|e| e.to_string())?;
+    let mut store = Store::open(&path).map_err(|e| e.to_string())?;
     let wait = args.wait.into();
     let mut state = match store.load_or_quarantine().map_err(|e| e.to_string())? {
-        Loaded::Missing => {
+        Loaded::Missing { log } => {
             info!(file = %path.display(), "no state file yet: starting empty");
+            report_log(store.log_path(), &log);
             State::new(limits, wait, epoch())
         }
-        Loaded::Snapshot(snapshot) => {
+        Loaded::Snapshot { snapshot, log } => {
+            report_log(store.log_path(), &log);
             let state = State::restore(limits, wait, &snapshot).map_err(|e| {
                 format!(
                     "cannot restore {} ({e}); raise the limits or move the file away",
@@ -220,17 +222,58 @@ fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
             info!(file = %path.display(), objects = state.len(), "objects restored");
             state
         }
-        Loaded::Corrupt { reason, moved_to } => {
+        Loaded::Corrupt {
+            reason,
+            moved_to,
+            log,
+        } => {
             error!(
                 file = %path.display(),
                 moved_to = %moved_to.display(),
                 "state file is corrupt ({reason}): set aside, starting with no objects"
             );
+            report_log(store.log_path(), &log);
             State::new(limits, wait, epoch())
         }
     };
     state.set_store(store).map_err(|e| e.to_string())?;
     Ok(state)
+}
+
+/// Says what loading the change log did: quietly when it was whole, loudly
+/// when something of it was cut off or set aside.
+fn report_log(path: &std::path::Path, log: &Replay) {
+    if log.applied + log.skipped > 0 {
+        info!(
+            file = %path.display(),
+            applied = log.applied,
+            skipped = log.skipped,
+            "change log replayed"
+        );
+    }
+    if log.torn > 0 {
+        warn!(
+            file = %path.display(),
+            bytes = log.torn,
+            "change log ended in a torn record (an append cut short by a crash, never acknowledged): cut off"
+        );
+    }
+    if let Some(e) = &log.error {
+        let kept = match e {
+            LogError::Corrupt { .. } | LogError::Invalid { .. } => {
+                "the records before it are kept (written into the state file)"
+            }
+            LogError::Header(_) | LogError::Inconsistent(_) => {
+                "none of its records are kept, the state file alone is loaded"
+            }
+            LogError::Orphan | LogError::StateCorrupt => "none of its records are kept",
+        };
+        error!(
+            file = %path.display(),
+            moved_to = %log.moved_to.as_deref().unwrap_or(path).display(),
+            "change log is corrupt ({e}): set aside; {kept}"
+        );
+    }
 }
 
 /// Upper half of every object id of this run: differs between runs so that a

@@ -16,7 +16,7 @@ use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use crate::cache::{FxBuild, PairKey, WarmCache};
 use crate::journal::Journal;
-use crate::persist::{Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
+use crate::persist::{Change, Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
 
 /// Limits the server enforces, also used to size the iceoryx2 services.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,7 +60,8 @@ impl Default for Limits {
 /// reconnections and across server restarts (the id is stored in the state
 /// file). A client *process* that restarts has a new node, so objects
 /// registered by its previous life can no longer be removed by anyone; they
-/// stay until the state file is removed (see `docs/reliability.md`).
+/// stay until the state file and its log are removed (see
+/// `docs/reliability.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Owner {
     /// Loaded from the scene file at start: read-only.
@@ -108,7 +109,7 @@ pub struct State {
     free_slots: Vec<u32>,
     /// Lowest slot never used.
     next_slot: u32,
-    /// Writes of the state file that failed.
+    /// Writes of the state file or change log that failed.
     persist_errors: u64,
     /// Scratch memory of gjk queries, reused from one query to the next.
     workspace: gjk::Workspace,
@@ -201,18 +202,8 @@ impl State {
     pub fn snapshot(&self) -> Snapshot {
         let mut objects: Vec<StoredObject> = self
             .objects
-            .iter()
-            .map(|(&id, o)| StoredObject {
-                id,
-                owner: match o.owner {
-                    Owner::Scene => StoredOwner::Scene,
-                    Owner::Client(c) => StoredOwner::Client(c),
-                },
-                name: o.name.clone(),
-                pose: StoredPose::from_isometry(&o.pose),
-                shape: StoredShape::from_shape(&o.shape),
-                slot: o.slot,
-            })
+            .keys()
+            .filter_map(|&id| self.stored(id))
             .collect();
         objects.sort_unstable_by_key(|o| o.id);
         Snapshot {
@@ -222,11 +213,27 @@ impl State {
         }
     }
 
+    /// The stored form of object `id`.
+    fn stored(&self, id: u64) -> Option<StoredObject> {
+        let o = self.objects.get(&id)?;
+        Some(StoredObject {
+            id,
+            owner: match o.owner {
+                Owner::Scene => StoredOwner::Scene,
+                Owner::Client(c) => StoredOwner::Client(c),
+            },
+            name: o.name.clone(),
+            pose: StoredPose::from_isometry(&o.pose),
+            shape: StoredShape::from_shape(&o.shape),
+            slot: o.slot,
+        })
+    }
+
     /// Turns persistence on: from now on every registration and removal is
-    /// written to `store` before it is acknowledged, and every pose update
-    /// goes to the pose journal next to it. Poses the journal holds for the
-    /// objects already here (restored from the state file) replace theirs:
-    /// they are the latest ones before a crash.
+    /// written to `store` (its change log) before it is acknowledged, and
+    /// every pose update goes to the pose journal next to it. Poses the
+    /// journal holds for the objects already here (restored from the state
+    /// file) replace theirs: they are the latest ones before a crash.
     ///
     /// # Errors
     /// When the journal cannot be opened; persistence stays off then.
@@ -275,20 +282,38 @@ impl State {
         self.store.as_ref()
     }
 
-    /// Writes the state file now (when persistence is on).
+    /// Writes the state file now (when persistence is on): a full snapshot,
+    /// which also empties the change log (compaction).
     ///
     /// # Errors
-    /// The write error; the previous file is then intact.
+    /// The write error; the previous file and log are then intact.
     pub fn persist(&mut self) -> Result<(), crate::persist::StoreError> {
-        let Some(store) = &self.store else {
+        if self.store.is_none() {
+            return Ok(());
+        }
+        let snapshot = self.snapshot();
+        let Some(store) = &mut self.store else {
             return Ok(());
         };
-        match store.write(&self.snapshot()) {
+        match store.write(&snapshot) {
             Ok(()) => Ok(()),
             Err(e) => {
                 self.persist_errors += 1;
                 Err(e)
             }
+        }
+    }
+
+    /// Folds the change log into the state file if it holds any change:
+    /// done at clean shutdown, so that the next start reads one file.
+    ///
+    /// # Errors
+    /// As [`State::persist`]; the log still holds every change then.
+    pub fn compact(&mut self) -> Result<(), crate::persist::StoreError> {
+        if self.store.as_ref().is_some_and(Store::has_changes) {
+            self.persist()
+        } else {
+            Ok(())
         }
     }
 
@@ -455,8 +480,8 @@ impl State {
         Ok(id)
     }
 
-    /// Removes object `id` on behalf of `requester`, and writes the state
-    /// file (when persistence is on) before returning.
+    /// Removes object `id` on behalf of `requester`, and writes the removal
+    /// to disk (when persistence is on) before returning.
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
@@ -616,9 +641,10 @@ impl State {
     /// Answers one admin request from client `requester` (the id of its
     /// iceoryx2 node, see [`Owner`]), with the request's slice payload
     /// `vertices`. With persistence on, a registration or removal is written
-    /// to the state file before this returns; if the write fails the change
-    /// is undone and the reply is [`ErrorCode::Internal`], so an
-    /// acknowledged change is always on disk.
+    /// to the change log (or the state file, see [`crate::persist`]) before
+    /// this returns; if the write fails the change is undone and the reply
+    /// is [`ErrorCode::Internal`], so an acknowledged change is always on
+    /// disk.
     pub fn handle_admin(
         &mut self,
         requester: u128,
@@ -649,7 +675,9 @@ impl State {
             Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
                 .and_then(|new| self.insert(new, Owner::Client(requester)))
                 .and_then(|id| {
-                    self.commit().map(|()| id).inspect_err(|_| {
+                    // Just inserted, so always there.
+                    let change = Change::Register(self.stored(id).ok_or(ErrorCode::Internal)?);
+                    self.commit(change).map(|()| id).inspect_err(|_| {
                         self.drop_object(id);
                     })
                 }),
@@ -669,10 +697,36 @@ impl State {
 }
 
 impl State {
-    /// Writes the state file after a registration or removal; the error is
-    /// what the client is told if that fails.
-    fn commit(&mut self) -> Result<(), ErrorCode> {
-        self.persist().map_err(|e| {
+    /// Makes a registration or removal durable before it is acknowledged:
+    /// appended to the change log, or, when the log is due for compaction
+    /// (or there is none), written as a full snapshot, which holds the
+    /// change as well. The error is what the client is told if neither
+    /// works; the caller then undoes the change.
+    fn commit(&mut self, change: Change) -> Result<(), ErrorCode> {
+        let Some(store) = &self.store else {
+            return Ok(());
+        };
+        if store.wants_compaction() {
+            match self.persist() {
+                Ok(()) => return Ok(()),
+                // The snapshot is still the old one and the log intact, so
+                // the change can still go to the log: a compaction that
+                // fails (a full disk has room for a record, not a copy of
+                // the store) does not cost the client its request.
+                Err(e) if self.store.as_ref().is_some_and(Store::can_append) => {
+                    tracing::error!("{e}; compaction postponed, the change is appended");
+                }
+                Err(e) => {
+                    tracing::error!("{e}; the change is undone");
+                    return Err(ErrorCode::Internal);
+                }
+            }
+        }
+        let Some(store) = &mut self.store else {
+            return Ok(());
+        };
+        store.append(&change).map_err(|e| {
+            self.persist_errors += 1;
             tracing::error!("{e}; the change is undone");
             ErrorCode::Internal
         })
@@ -688,7 +742,7 @@ impl State {
         let Some(object) = self.drop_object(id) else {
             return Err(ErrorCode::UnknownObject);
         };
-        if let Err(e) = self.commit() {
+        if let Err(e) = self.commit(Change::Remove(id)) {
             if self.free_slots.last() == Some(&object.slot) {
                 self.free_slots.pop();
             }
@@ -1337,18 +1391,50 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_failed_write_undoes_the_change_and_says_internal() {
-        let dir = std::env::temp_dir().join(format!("gjkd-state-{}", std::process::id()));
+    /// A scratch directory of the test's own.
+    fn scratch(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("gjkd-state-{}-{tag}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("dir");
+        dir
+    }
+
+    /// The store as a restarted server would load it.
+    fn reload(path: &std::path::Path) -> (Snapshot, crate::persist::Replay) {
+        let mut store = Store::open(path).expect("store");
+        match store.load_or_quarantine().expect("load") {
+            crate::persist::Loaded::Snapshot { snapshot, log } => (snapshot, log),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    fn register_named(s: &mut State, owner: u128, name: &str) -> u64 {
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        req.pieces[0].radius = 0.5;
+        assert!(req.set_name(name));
+        let reply = s.handle_admin(owner, &req, &[Vertex::default()]);
+        assert_eq!(reply.error_code(), ErrorCode::Ok);
+        reply.id
+    }
+
+    #[test]
+    fn a_failed_write_undoes_the_change_and_says_internal() {
+        let dir = scratch("failed-write");
         let path = dir.join("objects");
         let mut s = state();
-        s.set_store(crate::persist::Store::open(&path).expect("store"))
+        s.set_store(Store::open(&path).expect("store"))
             .expect("journal");
+        // No log yet: the first change is written as a snapshot.
         let kept = register_box(&mut s, 1);
         assert!(path.exists());
-        // A directory where the file should be: every rename onto it fails.
+        let store = s.store().expect("store");
+        assert!(store.can_append() && !store.has_changes());
+        // The disk fills up under the log (a real ENOSPC), and a directory
+        // where the state file should be makes every rename onto it fail.
+        store.fill_disk_under_log();
         std::fs::remove_file(&path).expect("rm");
         std::fs::create_dir(&path).expect("block the path");
         let mut req = AdminRequest::new(AdminOp::Register);
@@ -1360,11 +1446,129 @@ mod tests {
         assert_eq!(reply.error_code(), ErrorCode::Internal);
         assert_eq!(s.len(), 1, "the unwritten object is not kept");
         assert_eq!(s.lookup("ghost"), None);
+        assert!(!s.store().expect("store").can_append(), "log closed");
+        // No log to append to, no snapshot can be written.
         assert_eq!(s.remove(kept, 1), Err(ErrorCode::Internal));
         assert!(s.object(kept).is_some(), "the unwritten removal is undone");
         assert_eq!(s.stats().persist_errors, 2);
         std::fs::remove_dir(&path).expect("unblock");
+        // Written as a snapshot, which starts a fresh log...
         assert_eq!(s.remove(kept, 1), Ok(()));
+        assert!(s.store().expect("store").can_append());
+        // ...that the next change goes to.
+        let last = register_box(&mut s, 1);
+        assert!(s.store().expect("store").has_changes());
+        drop(s);
+        let (snapshot, log) = reload(&path);
+        assert_eq!((log.applied, log.error), (1, None));
+        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
+        assert_eq!(ids, [last], "neither the ghost nor the removed object");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Registrations go to the log until it outgrows the snapshot (or
+    /// 64 KiB), which is then rewritten and the log emptied: the log never
+    /// gets much longer than the snapshot, so each registration writes a
+    /// bounded amount on average. A compaction that fails leaves the change
+    /// in the log instead.
+    #[test]
+    fn the_log_is_compacted_when_it_outgrows_the_snapshot() {
+        use crate::persist::{COMPACT_MIN, LOG_HEADER_LEN};
+        let dir = scratch("compaction");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        let (mut compactions, mut last_len, mut appended) = (0, 0, 0u64);
+        for _ in 0..700 {
+            register_box(&mut s, 1);
+            let store = s.store().expect("store");
+            let len = store.log_len();
+            if len < last_len {
+                compactions += 1;
+                assert_eq!(len, LOG_HEADER_LEN as u64, "emptied");
+            } else {
+                appended += len - last_len;
+            }
+            let snapshot = std::fs::metadata(&path).expect("state file").len();
+            assert!(
+                len <= snapshot.max(COMPACT_MIN) + 512,
+                "a log of {len} bytes beside a snapshot of {snapshot}"
+            );
+            last_len = len;
+        }
+        // A box's record is about 300 bytes: the first compaction comes
+        // after about 220 registrations, the next when the log outgrows the
+        // snapshot, so a handful in 700, and all other changes appended.
+        assert!((2..=5).contains(&compactions), "{compactions} compactions");
+        assert!(appended > 2 * COMPACT_MIN, "{appended} bytes appended");
+        let want = s.snapshot();
+
+        // Fill the log up to its threshold, then block the state file.
+        while !s.store().expect("store").wants_compaction() {
+            register_box(&mut s, 1);
+        }
+        std::fs::rename(&path, dir.join("aside")).expect("move");
+        std::fs::create_dir(&path).expect("block the path");
+        let before = s.store().expect("store").log_len();
+        let late = register_box(&mut s, 1);
+        assert!(s.store().expect("store").log_len() > before, "appended");
+        assert_eq!(s.stats().persist_errors, 1, "the failed compaction");
+        std::fs::remove_dir(&path).expect("unblock");
+        std::fs::rename(dir.join("aside"), &path).expect("back");
+        register_box(&mut s, 1);
+        assert_eq!(
+            s.store().expect("store").log_len(),
+            LOG_HEADER_LEN as u64,
+            "compacted at the next change"
+        );
+        let all = s.snapshot();
+        assert!(all.objects.iter().any(|o| o.id == late));
+        assert!(all.objects.len() > want.objects.len());
+        drop(s);
+        let (snapshot, log) = reload(&path);
+        assert_eq!(snapshot, all);
+        assert_eq!(log.applied + log.skipped, 0);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A removal and a registration taking over the removed object's name
+    /// and journal slot, both only in the log: a restart gets exactly
+    /// that, and the counter goes on past both ids.
+    #[test]
+    fn a_removal_then_a_registration_replays_from_the_log() {
+        let dir = scratch("remove-register");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        s.persist().expect("first snapshot");
+        let other = register_box(&mut s, 2);
+        let a = register_named(&mut s, 1, "n");
+        let slot = s.object(a).expect("there").slot;
+        s.remove(a, 1).expect("owner");
+        let b = register_named(&mut s, 1, "n");
+        assert_eq!(s.object(b).expect("there").slot, slot, "slot reused");
+        let want = s.snapshot();
+        drop(s);
+        assert_eq!(
+            Snapshot::decode(&std::fs::read(&path).expect("state file"))
+                .expect("valid")
+                .objects
+                .len(),
+            0,
+            "everything is in the log"
+        );
+        let (snapshot, log) = reload(&path);
+        assert_eq!((log.applied, log.skipped, log.error), (4, 0, None));
+        assert_eq!(snapshot, want);
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &snapshot).expect("valid");
+        assert_eq!(r.lookup("n"), Some(b));
+        assert!(r.object(a).is_none());
+        assert!(r.object(other).is_some());
+        assert_eq!(r.object(b).expect("there").slot, slot);
+        let c = register_box(&mut r, 1);
+        assert!(c > b && c > a, "ids are not reused");
         let _ = std::fs::remove_dir_all(&dir);
     }
 

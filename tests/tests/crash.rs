@@ -269,3 +269,65 @@ fn a_state_file_in_use_is_not_shared() {
     let snap = gjkd::persist::Snapshot::decode(&bytes).expect("intact");
     assert!(snap.objects.is_empty());
 }
+
+/// Registrations and removals enough for several compactions of the change
+/// log, then `kill -9` with the latest changes only in the log: every
+/// acknowledged change is back after the restart, each object with its own
+/// geometry, and no removed one.
+#[test]
+fn a_server_killed_after_many_changes_keeps_every_acknowledged_one() {
+    let mut server = Server::start("crash-log", &["--wait", "block"]);
+    let path = server.state_file().expect("helper-chosen state file");
+    let mut log_path = path.clone().into_os_string();
+    log_path.push(".log");
+    let mut client = server.client(Duration::from_secs(5));
+    // Box i has half-extent 0.5 + i/1000 along x: its distance to the probe
+    // tells which object answered.
+    let mut live: Vec<(ObjectId, usize)> = Vec::new();
+    let mut removed = Vec::new();
+    let mut log_shrank = false;
+    let mut last_log = 0;
+    for i in 0..700 {
+        let half = nalgebra::Vector3::new(0.5 + i as f64 * 1e-3, 0.4, 0.3);
+        let id = client.register_cuboid(half, 0.0).expect("registered");
+        live.push((id, i));
+        if i % 7 == 6 {
+            let (gone, _) = live.remove(live.len() / 2);
+            client.remove(gone).expect("removed");
+            removed.push(gone);
+        }
+        let log = std::fs::metadata(&log_path).map(|m| m.len()).unwrap_or(0);
+        log_shrank |= log < last_log;
+        last_log = log;
+    }
+    assert!(log_shrank, "the log was compacted at least once");
+    assert!(last_log > 16, "the last changes are only in the log");
+    drop(client);
+    server.kill9();
+    server.restart();
+    let mut client = server.client(Duration::from_secs(5));
+    assert_eq!(client.stats().expect("stats").objects, live.len() as u64);
+    let probe = client.register_sphere(0.25).expect("probe");
+    let at = Isometry3::translation(3.0, 0.0, 0.0);
+    let options = QueryOptions::cold();
+    for &(id, i) in &live {
+        let got = client
+            .distance_at(id, &Isometry3::identity(), probe, &at, &options)
+            .unwrap_or_else(|e| panic!("object {i} lost: {e}"));
+        let want = 3.0 - 0.25 - (0.5 + i as f64 * 1e-3);
+        assert!((got.distance - want).abs() < 1e-9, "object {i}: {got:?}");
+    }
+    for &id in &removed {
+        assert!(
+            client
+                .distance_at(id, &Isometry3::identity(), probe, &at, &options)
+                .is_err(),
+            "removed object {id:?} is back"
+        );
+    }
+    eprintln!(
+        "{} objects back, {} removals kept, log of {last_log} bytes at the kill",
+        live.len(),
+        removed.len()
+    );
+}

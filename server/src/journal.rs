@@ -8,7 +8,8 @@
 //! abort) the restarted server finds every pose that was acknowledged. Only
 //! a crash of the whole machine can lose poses written since the last
 //! `msync` (done at housekeeping, every few seconds while poses change); the
-//! objects themselves are in the fsynced state file regardless.
+//! objects themselves are on disk regardless (the fsynced change log and state
+//! file, see `crate::persist`).
 //!
 //! # Layout (version 1)
 //!

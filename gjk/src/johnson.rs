@@ -347,6 +347,7 @@ impl Simplex {
 
     /// `Y = V̂ ∪ {p}`: keep `keep`, put `p` in a free slot, and compute the dot
     /// products and cofactors that involve it.
+    #[inline(always)]
     pub fn push(&mut self, keep: u8, p: Vertex) {
         debug_assert!(keep.count_ones() <= 3);
         self.all = keep;

@@ -422,6 +422,7 @@ impl<'s> Pair<'s> {
     /// The pair at relative pose `rel = A⁻¹·B`. `world`, when given, holds the
     /// two poses themselves, for the exact centroid offset of a body frame far
     /// from its vertices.
+    #[inline(always)]
     fn new(
         a: &'s Convex,
         b: &'s Convex,
@@ -480,7 +481,7 @@ impl<'s> Pair<'s> {
     }
 
     /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one scan of each vertex set.
-    #[inline]
+    #[inline(always)]
     fn support(&self, eta: &Vector3<f64>) -> Vertex {
         let ia = self.a.support_index(eta);
         let ib = self.b.support_index(&-self.r.tr_mul(eta));
@@ -713,6 +714,7 @@ impl<'s> Pair<'s> {
 
     /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
     /// pieces' offsets in their shapes' body frames.
+    #[inline(always)]
     fn answer(&self, run: &Run, simplex: &Simplex, place_a: Place<'_>, pieces: [u32; 2]) -> Answer {
         let (pose_a, off_a) = (place_a.pose, place_a.offset);
         let mut wa = Vector3::zeros();

@@ -27,6 +27,8 @@
 //! # Ok::<(), gjk::Error>(())
 //! ```
 
+#![warn(missing_docs)]
+
 mod dd;
 mod johnson;
 pub mod paper;

@@ -712,8 +712,9 @@ impl<'s> Pair<'s> {
         (lower, upper, distance)
     }
 
-    /// Turn a run into an answer in world coordinates. `off_a`, `off_b` are the
-    /// pieces' offsets in their shapes' body frames.
+    /// Turn a run into an answer in world coordinates. `place_a` places A's
+    /// piece (its shape's pose and, for a compound, the piece's offset); B's
+    /// nearest point is placed with it, as A's point minus `v`.
     #[inline(always)]
     fn answer(&self, run: &Run, simplex: &Simplex, place_a: Place<'_>, pieces: [u32; 2]) -> Answer {
         let (pose_a, off_a) = (place_a.pose, place_a.offset);

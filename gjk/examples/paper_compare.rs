@@ -298,6 +298,7 @@ fn main() {
         max_iterations: 1000,
         margin: None,
         warm_start: false,
+        ..Options::default()
     };
 
     let gjk_q = |c: &FamilyCase, o: &Options| {

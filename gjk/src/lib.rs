@@ -35,7 +35,7 @@ pub mod paper;
 mod query;
 mod shape;
 
-pub use query::{Answer, Options, Status, WarmStart, Workspace, distance, distance_in};
+pub use query::{Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_in};
 pub use shape::{Compound, Convex, Shape};
 
 /// What can be wrong with the input. Every query and constructor reports bad

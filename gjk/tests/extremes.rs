@@ -11,7 +11,7 @@
 mod common;
 
 use common::{P, V, aabb_distance, p, v};
-use gjk::{Answer, Convex, Options, Shape, Status, distance};
+use gjk::{Answer, Convex, Options, Precision, Shape, Status, distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 struct Case {
@@ -51,13 +51,14 @@ impl Case {
     }
 }
 
-/// Check one case; `None` when it passes.
-fn failure(c: &Case, options: &Options) -> Option<String> {
+/// Check one case; `None` when it passes. `extra` widens the allowed error
+/// (absolute), for [`Precision::Single`].
+fn failure(c: &Case, options: &Options, extra: f64) -> Option<String> {
     let ans: Answer = match distance(&c.a, &c.pa, &c.b, &c.pb, options, None) {
         Ok(a) => a,
         Err(e) => return Some(format!("{}: error {e:?}", c.name)),
     };
-    let allowed = (1e-6 * c.truth).max(1e-9 * c.size);
+    let allowed = (1e-6 * c.truth).max(1e-9 * c.size) + extra;
     // Round-off of the truth itself (computed from rounded inputs).
     let eps = 1e-15 * c.size;
     let mut why = Vec::new();
@@ -109,9 +110,27 @@ fn failure(c: &Case, options: &Options) -> Option<String> {
 
 #[track_caller]
 fn run(cases: &[Case]) {
+    run_with(cases, Precision::Double);
+}
+
+/// `Precision::Single` may miss the support value by 2⁻²⁰ of each shape's
+/// size; the distance may then be off by twice that, which the test allows
+/// on top of the usual requirement (the bounds must still hold exactly).
+#[track_caller]
+fn run_with(cases: &[Case], precision: Precision) {
+    let options = Options {
+        precision,
+        ..Options::default()
+    };
     let failures: Vec<String> = cases
         .iter()
-        .filter_map(|c| failure(c, &Options::default()))
+        .filter_map(|c| {
+            let extra = match precision {
+                Precision::Double => 0.0,
+                Precision::Single => 2f64.powi(-18) * c.size,
+            };
+            failure(c, &options, extra)
+        })
         .collect();
     assert!(
         failures.is_empty(),
@@ -764,5 +783,60 @@ fn hundred_thousand_vertices() {
             ));
         }
     }
+    run(&cases);
+    run_with(&cases, Precision::Single);
+}
+
+/// A box given as the 26 surface points of its 3×3×3 grid (corners, edge
+/// midpoints, face centres), so that the f32 scan of `Precision::Single`
+/// takes it and no closed form does.
+fn dotted_box(h: V) -> Shape {
+    let mut pts = Vec::new();
+    for i in [-1.0, 0.0, 1.0] {
+        for j in [-1.0, 0.0, 1.0] {
+            for k in [-1.0, 0.0, 1.0] {
+                if (i, j, k) != (0.0, 0.0, 0.0) {
+                    pts.push(p(i * h.x, j * h.y, k * h.z));
+                }
+            }
+        }
+    }
+    Convex::new(pts, 0.0).unwrap().into()
+}
+
+/// `Precision::Single` at the extremes: boxes as many-point sets (so the f32
+/// scan runs) at scales 1e-9 to 1e6, 1e9 from the origin, rotated, with gaps
+/// down to 1e-12 of their size and touching. The bounds must hold exactly;
+/// the distance within the f32 allowance.
+#[test]
+fn single_precision_at_scales_offsets_and_gaps() {
+    let mut cases = Vec::new();
+    for s in [1e-9, 1e-3, 1.0, 1e6] {
+        for off in [0.0, 1e9] {
+            for rot in rotations() {
+                for g in GAPS {
+                    let ha = v(1.0, 0.5, 2.0) * s;
+                    let hb = v(0.75, 1.5, 0.25) * s;
+                    let size = 2.0 * ha.norm();
+                    let ta = v(off + 0.3 * s, -0.7 * s, off);
+                    let rel = v(ha.x + hb.x + g * size, 0.2 * s, -0.1 * s);
+                    let tb = ta + rot * rel;
+                    let rel_actual = rot.inverse_transform_vector(&(tb - ta));
+                    let truth = aabb_distance(&V::zeros(), &ha, &rel_actual, &hb);
+                    cases.push(Case::new(
+                        format!("dotted boxes scale {s:e}, offset {off:e}, rot {rot:?}, gap {g:e}"),
+                        dotted_box(ha),
+                        posed(ta, rot),
+                        dotted_box(hb),
+                        posed(tb, rot),
+                        truth,
+                        size,
+                    ));
+                }
+            }
+        }
+    }
+    run_with(&cases, Precision::Single);
+    // The same cases in f64 meet the tighter requirement.
     run(&cases);
 }

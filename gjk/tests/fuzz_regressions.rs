@@ -83,6 +83,7 @@ fn mixed_magnitudes_1e108_and_1() {
         max_iterations: 55,
         margin: None,
         warm_start: true,
+        ..Options::default()
     };
     let first = check(&a, &pose, &b, &pose, &o);
     // The crash: warm from that answer's simplex, B turned a little.

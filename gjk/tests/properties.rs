@@ -7,7 +7,7 @@ mod common;
 use common::{
     P, RefShape, Tolerance, V, hull_distance, shape_distance, verify, verify_penetration,
 };
-use gjk::{Compound, Convex, Options, Shape, Status, WarmStart, distance};
+use gjk::{Compound, Convex, Options, Precision, Shape, Status, WarmStart, distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -360,5 +360,109 @@ fn verify_rejects_perturbed_answers() {
                 || verify_penetration(&x, &r, tol).is_err();
             assert!(caught, "perturbed {what} not caught, pb {pb:?}");
         }
+    }
+}
+
+/// `Precision::Single` on the paper's family (polytopes of 1 to 100
+/// vertices, separated, touching and intersecting): every answer's bounds
+/// contain the f64 answer (itself checked against brute force above), and
+/// the two distances differ by at most the f32 slack.
+#[test]
+fn single_precision_agrees_with_double_on_the_paper_family() {
+    let convex = gjk::paper::family();
+    let family: Vec<Shape> = convex.iter().cloned().map(Into::into).collect();
+    let single = Options {
+        precision: Precision::Single,
+        ..Options::default()
+    };
+    let mut checked = 0;
+    for case in gjk::paper::Case::ALL {
+        for c in gjk::paper::cases(case, 10, 3) {
+            let (a, b) = (&family[c.a], &family[c.b]);
+            let d = distance(a, &c.pose_a, b, &c.pose_b, &Options::default(), None).unwrap();
+            let s = distance(a, &c.pose_a, b, &c.pose_b, &single, None).unwrap();
+            let size = convex[c.a].size() + convex[c.b].size();
+            assert!(
+                s.lower <= d.distance + 1e-12 && d.distance <= s.upper + 1e-12,
+                "{case:?} {c:?}: {s:?} against {d:?}"
+            );
+            // Twice 2⁻²⁰ of the sizes, with room for the f64 tolerance.
+            assert!(
+                (s.distance - d.distance).abs() <= 2f64.powi(-18) * size,
+                "{case:?}: {s:?} against {d:?}"
+            );
+            assert_eq!(s.status, Status::Converged);
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 600);
+}
+
+/// A box of half extents `h` given as its 8 corners and `extra` random points
+/// inside it, shuffled in: its hull is the box, so distances have a closed
+/// form, and at 16 points or more `Precision::Single` scans it in f32.
+fn cloud_box() -> impl Strategy<Value = (V, Vec<P>)> {
+    (
+        (0.05..2.0f64, 0.05..2.0f64, 0.05..2.0f64),
+        prop::collection::vec((coord(), coord(), coord()), 8..=40),
+        any::<u64>(),
+    )
+        .prop_map(|((hx, hy, hz), inner, seed)| {
+            let h = V::new(hx, hy, hz);
+            let mut pts: Vec<P> = inner
+                .iter()
+                .map(|&(x, y, z)| P::new(x * hx, y * hy, z * hz))
+                .collect();
+            let corners = Convex::cuboid(h, 0.0).unwrap();
+            for (k, c) in corners.vertices().iter().enumerate() {
+                let at = (seed.rotate_left(8 * k as u32) as usize) % (pts.len() + 1);
+                pts.insert(at, *c);
+            }
+            (h, pts)
+        })
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// `Precision::Single` against the closed form: two boxes given as
+    /// clouds (corners plus interior points), rounded, in one common
+    /// rotation and 1e3 from the origin, at gaps from overlapping through
+    /// touching to far. The bounds hold to round-off, the distance within
+    /// the f32 slack, and the f64 answer on the same input within 1e-9.
+    #[test]
+    fn single_precision_matches_closed_form_boxes(
+        (ha, pa_pts) in cloud_box(), (hb, pb_pts) in cloud_box(),
+        ra in radius(), rb in radius(),
+        dir in vec3(), gap in prop_oneof![Just(0.0), -0.5..0.0f64, 0.0..1e-6f64, 0.0..3.0f64],
+        w in vec3(),
+    ) {
+        let a: Shape = Convex::new(pa_pts, ra).unwrap().into();
+        let b: Shape = Convex::new(pb_pts, rb).unwrap().into();
+        let rot = UnitQuaternion::from_scaled_axis(w * std::f64::consts::PI);
+        // B's centre: A's half extents plus B's along a random direction,
+        // pushed out (or in) by `gap` on the axis where the direction is
+        // largest, so that touching (gap 0) really occurs.
+        let k = dir.iamax();
+        let mut rel = dir.component_mul(&(ha + hb));
+        rel[k] = (ha[k] + hb[k] + gap).copysign(dir[k] + 0.0);
+        let pa = Isometry3::from_parts(Translation3::new(1e3, -1e3, 5e2), rot);
+        let pb = Isometry3::from_parts(Translation3::from(pa.translation.vector + rot * rel), rot);
+        let rel_actual = rot.inverse_transform_vector(&(pb.translation.vector - pa.translation.vector));
+        let core = common::aabb_distance(&V::zeros(), &ha, &rel_actual, &hb);
+        let truth = (core - ra - rb).max(0.0);
+        let size = ha.norm() + hb.norm() + ra + rb;
+        // Round-off of the 1e3 offset and of the truth itself.
+        let eps = 1e-12 * (size + 1e3 * f64::EPSILON / 1e-12);
+        let single = Options { precision: Precision::Single, ..Options::default() };
+        let ans = distance(&a, &pa, &b, &pb, &single, None).unwrap();
+        prop_assert!(ans.lower <= truth + eps && truth <= ans.upper + eps,
+            "bounds [{}, {}] miss {truth}: {ans:?}", ans.lower, ans.upper);
+        prop_assert_eq!(ans.status, Status::Converged);
+        prop_assert!((ans.distance - truth).abs() <= 1e-9 * size + 2f64.powi(-18) * size,
+            "single {} against {truth}", ans.distance);
+        let double = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        prop_assert!((double.distance - truth).abs() <= 1e-9 * size,
+            "double {} against {truth}", double.distance);
     }
 }

@@ -114,7 +114,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 pub use gjkd_proto::{
     AdminOp, Answer, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemResult, MAX_NAME_LEN,
-    MAX_PIECES, ObjectId, QueryOptions, ServerInfo, ServerStats, Status, WaitMode,
+    MAX_PIECES, ObjectId, Precision, QueryOptions, ServerInfo, ServerStats, Status, WaitMode,
 };
 use gjkd_proto::{
     AdminReply, AdminRequest, PieceDesc, Pose, ReplyHeader, Vertex, admin_service_name,

@@ -302,8 +302,12 @@ pub mod item_flags {
     pub const MARGIN: u32 = 1 << 2;
     /// Start from the server's cached simplex of this pair (for this client).
     pub const WARM_START: u32 = 1 << 3;
+    /// Search support points in f32 ([`Precision::Single`]). Added within
+    /// v1 (the layout is unchanged): a server older than this bit refuses it
+    /// as malformed rather than silently answering in f64.
+    pub const SINGLE_PRECISION: u32 = 1 << 4;
     /// Every bit this version knows; others are rejected as malformed.
-    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START;
+    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION;
 }
 
 /// Bits of [`ItemResult::flags`].
@@ -383,6 +387,22 @@ pub struct QueryOptions {
     /// client's previous query of it (default on). Changes only the time,
     /// never the answer beyond the tolerance.
     pub warm_start: bool,
+    /// Arithmetic of the support search (default [`Precision::Double`]).
+    pub precision: Precision,
+}
+
+/// Arithmetic of the support search, the step whose cost grows with the
+/// number of vertices; the rest of a query is f64 whatever is chosen. The
+/// wire form of `gjk::Precision`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// f64: the distance is exact to the tolerance.
+    #[default]
+    Double,
+    /// f32 for objects of 16 vertices or more: faster on large vertex sets
+    /// (about 1.5× at 1 000 vertices), the distance exact to the tolerance
+    /// plus about 1e-6 of the two objects' sizes, bounds still certified.
+    Single,
 }
 
 impl Default for QueryOptions {
@@ -392,6 +412,7 @@ impl Default for QueryOptions {
             max_iterations: DEFAULT_MAX_ITERATIONS,
             margin: None,
             warm_start: true,
+            precision: Precision::Double,
         }
     }
 }
@@ -465,6 +486,9 @@ impl Item {
         if options.margin.is_some() {
             flags |= item_flags::MARGIN;
         }
+        if options.precision == Precision::Single {
+            flags |= item_flags::SINGLE_PRECISION;
+        }
         Item {
             kind: ItemKind::Distance as u32,
             flags,
@@ -529,6 +553,11 @@ impl Item {
             max_iterations: self.max_iterations,
             margin: (self.flags & item_flags::MARGIN != 0).then_some(self.margin),
             warm_start: self.flags & item_flags::WARM_START != 0,
+            precision: if self.flags & item_flags::SINGLE_PRECISION != 0 {
+                Precision::Single
+            } else {
+                Precision::Double
+            },
         }
     }
 }
@@ -978,11 +1007,23 @@ mod tests {
             max_iterations: 7,
             margin: Some(0.5),
             warm_start: false,
+            precision: Precision::Single,
         };
         let it = Item::distance(ObjectId::from_raw(3), ObjectId::from_raw(4), &o);
         assert_eq!(it.options(), o);
         assert_eq!(it.item_kind(), Some(ItemKind::Distance));
         assert_eq!(it.flags & item_flags::WARM_START, 0);
+        assert_eq!(
+            it.flags & item_flags::SINGLE_PRECISION,
+            item_flags::SINGLE_PRECISION
+        );
+        let d = Item::distance(
+            ObjectId::from_raw(3),
+            ObjectId::from_raw(4),
+            &QueryOptions::default(),
+        );
+        assert_eq!(d.flags & item_flags::SINGLE_PRECISION, 0);
+        assert_eq!(d.options().precision, Precision::Double);
     }
 
     #[test]

@@ -574,6 +574,11 @@ impl State {
             max_iterations: item.max_iterations,
             margin: (item.flags & item_flags::MARGIN != 0).then_some(item.margin),
             warm_start: warm_on,
+            precision: if item.flags & item_flags::SINGLE_PRECISION != 0 {
+                gjk::Precision::Single
+            } else {
+                gjk::Precision::Double
+            },
         };
         if !(options.tolerance.is_finite() && options.tolerance >= 0.0)
             || options.max_iterations == 0
@@ -1591,7 +1596,8 @@ mod tests {
                 &QueryOptions::default(),
             );
             item.kind = (next() % 4) as u32;
-            item.flags = (next() % 32) as u32;
+            // Every known bit and the first unknown one.
+            item.flags = (next() % 64) as u32;
             item.tolerance = f64::from_bits(next());
             item.margin = f64::from_bits(next());
             item.max_iterations = (next() % 300) as u32;

@@ -498,6 +498,10 @@ pub fn gjk_options(o: &gjkd_client::QueryOptions) -> gjk::Options {
         max_iterations: o.max_iterations,
         margin: o.margin,
         warm_start: o.warm_start,
+        precision: match o.precision {
+            gjkd_client::Precision::Double => gjk::Precision::Double,
+            gjkd_client::Precision::Single => gjk::Precision::Single,
+        },
     }
 }
 

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use gjk::paper::{self, Case};
-use gjk::{Options, Shape, Status, WarmStart};
+use gjk::{Options, Precision, Shape, Status, WarmStart};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::extremes;
@@ -79,6 +79,7 @@ enum Group {
     TolWarm,
     Cap,
     Margin,
+    Precision,
 }
 
 impl Group {
@@ -88,6 +89,7 @@ impl Group {
             Group::TolWarm => "tolerance, warm",
             Group::Cap => "iteration cap, cold",
             Group::Margin => "early-exit margin",
+            Group::Precision => "f32 support search",
         }
     }
 }
@@ -141,6 +143,18 @@ fn settings() -> Vec<Setting> {
             options: Options {
                 max_iterations: cap,
                 warm_start: false,
+                ..Options::default()
+            },
+            margin: None,
+        });
+    }
+    for warm in [false, true] {
+        out.push(Setting {
+            name: format!("f32 support {}", if warm { "warm" } else { "cold" }),
+            group: Group::Precision,
+            options: Options {
+                precision: Precision::Single,
+                warm_start: warm,
                 ..Options::default()
             },
             margin: None,
@@ -701,8 +715,14 @@ fn report(
         args.reps,
         args.passes
     );
+    let by_size = precision_by_size(args)?;
+    io(
+        "write tradeoff-precision.csv",
+        by_size.csv.write(&dir.join("tradeoff-precision.csv")),
+    )?;
     let text = format!(
-        "{header}## All settings\n\n{md}\n## What does going faster cost?\n\n{rec}\n## Fastest setting within an error budget\n\n{budget}"
+        "{header}## All settings\n\n{md}\n## What does going faster cost?\n\n{rec}\n## Fastest setting within an error budget\n\n{budget}\n## The f32 support search by vertex count\n\n{}",
+        by_size.md
     );
     println!("\n{text}");
     io("write tradeoff.csv", csv.write(&dir.join("tradeoff.csv")))?;
@@ -739,15 +759,171 @@ fn report(
     io("write tradeoff-queries.csv", detail.write(&detail_path))?;
     pareto_plot(dir, settings, &sums)?;
     println!(
-        "wrote {0}/tradeoff.csv, {0}/tradeoff.md, {0}/tradeoff-pareto.svg, {1}",
+        "wrote {0}/tradeoff.csv, {0}/tradeoff.md, {0}/tradeoff-precision.csv, {0}/tradeoff-pareto.svg, {1}",
         dir.display(),
         detail_path.display()
     );
     Ok(())
 }
 
+/// The precision knob where it matters: the paper's polytopes have at most
+/// 100 vertices, too few for the scan to dominate. Box clouds (8 corners and
+/// `n - 8` points inside, so the hull is the box and the truth a closed form)
+/// of 16 to 16 384 points, in a common random rotation with random gaps,
+/// timed in f64 and f32, cold and warm.
+struct BySize {
+    md: String,
+    csv: Csv,
+}
+
+fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
+    let sizes: &[usize] = if args.common.quick {
+        &[16, 1024]
+    } else {
+        &[16, 64, 256, 1024, 4096, 16384]
+    };
+    let poses = if args.common.quick { 4 } else { 40 };
+    let (ha, hb) = (Vector3::new(1.0, 0.6, 0.8), Vector3::new(0.7, 0.9, 0.5));
+    let size = ha.norm() + hb.norm();
+    let mut seed = 0x0dd_ba11_u64;
+    let mut rnd = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut csv = Csv::new(&[
+        "vertices",
+        "setting",
+        "mean_ns",
+        "speedup_vs_f64_same_start",
+        "max_err_rel_size",
+        "bounds_missed",
+        "queries",
+    ]);
+    let mut md = format!(
+        "Box clouds of n points each (corners plus points inside), {poses} poses per n, gaps uniform in [0, 0.5) of the size and touching; {} calls per timed block, fastest of {} passes. Errors against the closed-form box distance, divided by the size ({size:.2}).\n\n| vertices per shape | f64 cold ns | f32 cold ns | f32 speed-up, cold | f64 warm ns | f32 warm ns | f32 speed-up, warm | max error / size, f64 | max error / size, f32 | bounds missed |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        args.reps, args.passes
+    );
+    let cloud =
+        |h: Vector3<f64>, n: usize, rnd: &mut dyn FnMut() -> f64| -> Result<Shape, BenchError> {
+            let mut pts: Vec<Point3<f64>> = (0..n - 8)
+                .map(|_| {
+                    Point3::new(
+                        (2.0 * rnd() - 1.0) * h.x,
+                        (2.0 * rnd() - 1.0) * h.y,
+                        (2.0 * rnd() - 1.0) * h.z,
+                    )
+                })
+                .collect();
+            pts.extend(gjk::Convex::cuboid(h, 0.0)?.vertices().iter().copied());
+            Ok(gjk::Convex::new(pts, 0.0)?.into())
+        };
+    let mut cases = Vec::new();
+    for &n in sizes {
+        let (a, b) = (cloud(ha, n, &mut rnd)?, cloud(hb, n, &mut rnd)?);
+        let mut qs = Vec::new();
+        for k in 0..poses {
+            let rot = UnitQuaternion::from_scaled_axis(
+                Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 6.0,
+            );
+            let dir = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            let axis = dir.iamax();
+            let gap = if k % 8 == 0 { 0.0 } else { 0.5 * size * rnd() };
+            let mut rel = dir.component_mul(&(ha + hb));
+            rel[axis] = (ha[axis] + hb[axis] + gap).copysign(dir[axis]);
+            let pa = Isometry3::from_parts(Translation3::new(3.0, -2.0, 1.0), rot);
+            let pb =
+                Isometry3::from_parts(Translation3::from(pa.translation.vector + rot * rel), rot);
+            let local =
+                rot.inverse_transform_vector(&(pb.translation.vector - pa.translation.vector));
+            let mut s2 = 0.0;
+            for i in 0..3 {
+                let g = local[i].abs() - ha[i] - hb[i];
+                if g > 0.0 {
+                    s2 += g * g;
+                }
+            }
+            let before = step_back(&pb, size);
+            let warm = gjk::distance(&a, &pa, &b, &before, &Options::default(), None)?.warm_start;
+            qs.push((pa, pb, s2.sqrt(), warm));
+        }
+        cases.push((n, a, b, qs));
+    }
+    let modes = [
+        ("f64 cold", Precision::Double, false),
+        ("f32 cold", Precision::Single, false),
+        ("f64 warm", Precision::Double, true),
+        ("f32 warm", Precision::Single, true),
+    ];
+    for (n, a, b, qs) in &cases {
+        let mut ns = [0.0f64; 4];
+        let mut err = [0.0f64; 4];
+        let mut missed = [0usize; 4];
+        for (mi, &(_, precision, warm_on)) in modes.iter().enumerate() {
+            let options = Options {
+                precision,
+                warm_start: warm_on,
+                ..Options::default()
+            };
+            let mut total = 0.0;
+            for (pa, pb, truth, warm) in qs {
+                let warm = warm_on.then_some(warm);
+                let ans = gjk::distance(a, pa, b, pb, &options, warm)?;
+                err[mi] = err[mi].max((ans.distance - truth).abs() / size);
+                let slack = BOUND_SLACK * size;
+                if *truth < ans.lower - slack || *truth > ans.upper + slack {
+                    missed[mi] += 1;
+                }
+                let mut best = f64::INFINITY;
+                for _ in 0..args.passes {
+                    let t0 = Instant::now();
+                    for _ in 0..args.reps {
+                        black_box(gjk::distance(black_box(a), pa, b, pb, &options, warm)?);
+                    }
+                    best = best.min(t0.elapsed().as_nanos() as f64 / f64::from(args.reps));
+                }
+                total += best;
+            }
+            ns[mi] = total / qs.len() as f64;
+        }
+        for (mi, (name, _, _)) in modes.iter().enumerate() {
+            // f64 of the same start (cold or warm) is the baseline.
+            let speed = ns[mi & 2] / ns[mi];
+            csv.row(&[
+                n.to_string(),
+                (*name).to_owned(),
+                format!("{:.1}", ns[mi]),
+                format!("{speed:.3}"),
+                format!("{:.3e}", err[mi]),
+                missed[mi].to_string(),
+                qs.len().to_string(),
+            ]);
+        }
+        md.push_str(&format!(
+            "| {n} | {:.0} | {:.0} | {:.2}× | {:.0} | {:.0} | {:.2}× | {:.1e} | {:.1e} | {} |\n",
+            ns[0],
+            ns[1],
+            ns[0] / ns[1],
+            ns[2],
+            ns[3],
+            ns[2] / ns[3],
+            err[0].max(err[2]),
+            err[1].max(err[3]),
+            missed.iter().sum::<usize>()
+        ));
+    }
+    Ok(BySize { md, csv })
+}
+
 fn pareto_plot(dir: &Path, settings: &[Setting], sums: &[Summary]) -> Result<(), BenchError> {
-    let groups = [Group::TolCold, Group::TolWarm, Group::Cap, Group::Margin];
+    let groups = [
+        Group::TolCold,
+        Group::TolWarm,
+        Group::Cap,
+        Group::Margin,
+        Group::Precision,
+    ];
     let mut charts = Vec::new();
     for (title, err) in [
         (
@@ -856,5 +1032,6 @@ mod tests {
         assert!(s.iter().any(|s| s.group == Group::TolWarm));
         assert!(s.iter().any(|s| s.margin.is_some()));
         assert!(s.iter().any(|s| s.options.max_iterations < 4));
+        assert!(s.iter().any(|s| s.options.precision == Precision::Single));
     }
 }

@@ -798,11 +798,12 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
         "mean_ns",
         "speedup_vs_f64_same_start",
         "max_err_rel_size",
+        "widest_interval_rel_size",
         "bounds_missed",
         "queries",
     ]);
     let mut md = format!(
-        "Box clouds of n points each (corners plus points inside), {poses} poses per n, gaps uniform in [0, 0.5) of the size and touching; {} calls per timed block, fastest of {} passes. Errors against the closed-form box distance, divided by the size ({size:.2}).\n\n| vertices per shape | f64 cold ns | f32 cold ns | f32 speed-up, cold | f64 warm ns | f32 warm ns | f32 speed-up, warm | max error / size, f64 | max error / size, f32 | bounds missed |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "Box clouds of n points each (corners plus points inside), {poses} poses per n, gaps uniform in [0, 0.5) of the size and touching; {} calls per timed block, fastest of {} passes. Errors against the closed-form box distance, and the widest certified interval (upper - lower), divided by the size ({size:.2}).\n\n| vertices per shape | f64 cold ns | f32 cold ns | f32 speed-up, cold | f64 warm ns | f32 warm ns | f32 speed-up, warm | max error / size, f64 | max error / size, f32 | widest interval / size, f64 | widest interval / size, f32 | bounds missed |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         args.reps, args.passes
     );
     let cloud =
@@ -860,6 +861,7 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
         let mut ns = [0.0f64; 4];
         let mut err = [0.0f64; 4];
         let mut missed = [0usize; 4];
+        let mut width = [0.0f64; 4];
         for (mi, &(_, precision, warm_on)) in modes.iter().enumerate() {
             let options = Options {
                 precision,
@@ -871,6 +873,7 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
                 let warm = warm_on.then_some(warm);
                 let ans = gjk::distance(a, pa, b, pb, &options, warm)?;
                 err[mi] = err[mi].max((ans.distance - truth).abs() / size);
+                width[mi] = width[mi].max((ans.upper - ans.lower) / size);
                 let slack = BOUND_SLACK * size;
                 if *truth < ans.lower - slack || *truth > ans.upper + slack {
                     missed[mi] += 1;
@@ -896,12 +899,13 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
                 format!("{:.1}", ns[mi]),
                 format!("{speed:.3}"),
                 format!("{:.3e}", err[mi]),
+                format!("{:.3e}", width[mi]),
                 missed[mi].to_string(),
                 qs.len().to_string(),
             ]);
         }
         md.push_str(&format!(
-            "| {n} | {:.0} | {:.0} | {:.2}× | {:.0} | {:.0} | {:.2}× | {:.1e} | {:.1e} | {} |\n",
+            "| {n} | {:.0} | {:.0} | {:.2}× | {:.0} | {:.0} | {:.2}× | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {} |\n",
             ns[0],
             ns[1],
             ns[0] / ns[1],
@@ -910,6 +914,8 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
             ns[2] / ns[3],
             err[0].max(err[2]),
             err[1].max(err[3]),
+            width[0].max(width[2]),
+            width[1].max(width[3]),
             missed.iter().sum::<usize>()
         ));
     }

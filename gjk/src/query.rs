@@ -403,19 +403,25 @@ pub fn distance_in(
 struct Pair<'s> {
     a: &'s Convex,
     b: &'s Convex,
-    /// Rotation of B's piece into A's piece frame.
+    /// Rotation of B's piece into A's piece frame, times `k`.
     r: Matrix3<f64>,
-    /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`.
+    /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`,
+    /// times `k`.
     t: Vector3<f64>,
-    /// `D(K)` bounded by (6.4).
+    /// `D(K)` bounded by (6.4), times `k`.
     d: f64,
-    /// Allowance for floating-point error in the bounds.
+    /// Allowance for floating-point error in the bounds, times `k`.
     slack: f64,
+    /// `slack` in the world's units.
+    slack_world: f64,
     radii: f64,
+    /// The power of two by which the run's frame is scaled, and its inverse.
+    k: f64,
+    inv_k: f64,
     /// Support search in f32 ([`Precision::Single`]).
     single: bool,
     /// How far below the true support value the f32 search may land, as a
-    /// distance: 0 in f64.
+    /// distance times `k`: 0 in f64.
     single_slack: f64,
 }
 
@@ -478,15 +484,27 @@ impl<'s> Pair<'s> {
             ),
             _ => (rb + rel.translation.vector - ca.coords, false),
         };
-        let t_norm = t.norm();
-        let d = a.size() + b.size() + t_norm;
+        // The run works in a frame scaled by a power of two that brings the
+        // pair's sizes near 1: exact (every result is the unscaled one times
+        // k, bit for bit), and the cofactors, products of up to three
+        // squared lengths, then neither overflow nor underflow for shapes
+        // anywhere from 1e-300 to 1e300 in size.
+        // Sizes within 2^±64 need no scaling: cofactors stay within 2^±400.
+        let m = a.size().max(b.size()).max(t.amax());
+        let (k, inv_k) = if m > 5.4e-20 && m < 1.8e19 {
+            (1.0, 1.0)
+        } else {
+            crate::shape::pow2_scale(m)
+        };
+        let t = t * k;
+        let d = (a.size() + b.size()) * k + t.norm();
         let single = precision == Precision::Single;
         // The f32 search lands within SINGLE_SLACK·size·|η| of each shape's
         // support value; every direction it is given has |η| = |v|, so the
         // support value of K = A - B may be missed by this times |v|.
         let single_slack = if single {
             let of = |c: &Convex| if c.has_single() { c.size() } else { 0.0 };
-            crate::shape::SINGLE_SLACK * (of(a) + of(b))
+            crate::shape::SINGLE_SLACK * (of(a) + of(b)) * k
         } else {
             0.0
         };
@@ -497,16 +515,20 @@ impl<'s> Pair<'s> {
             d
         } else {
             // |rb| = |z̄2|: a rotation keeps lengths.
-            d + na + nb + rel.translation.vector.norm()
+            d + na * k + nb * k + crate::shape::robust_norm(&rel.translation.vector) * k
         };
+        let slack = 64.0 * f64::EPSILON * scale;
         Pair {
             a,
             b,
-            r,
+            r: if k != 1.0 { r * k } else { r },
             t,
             d,
-            slack: 64.0 * f64::EPSILON * scale,
+            slack,
+            slack_world: slack * inv_k,
             radii: a.radius() + b.radius(),
+            k,
+            inv_k,
             single,
             single_slack,
         }
@@ -517,7 +539,10 @@ impl<'s> Pair<'s> {
     /// terms are small vectors relative to their centroids.
     #[inline(always)]
     fn vertex(&self, ia: usize, ib: usize) -> Vertex {
-        let y = self.a.local(ia) - (self.r * self.b.local(ib) + self.t);
+        let za = self.a.local(ia);
+        // k is 1 but for shapes beyond 2^±64 in size: skip the product then.
+        let za = if self.k != 1.0 { za * self.k } else { za };
+        let y = za - (self.r * self.b.local(ib) + self.t);
         Vertex {
             y,
             ia: ia as u32,
@@ -541,7 +566,29 @@ impl<'s> Pair<'s> {
     }
 
     /// The Numerical Algorithm, steps (1) to (6).
+    /// One run of the Numerical Algorithm, its lengths in the world's units
+    /// (the simplex's points stay in the scaled frame).
     fn solve(
+        &self,
+        simplex: &mut Simplex,
+        options: &Options,
+        warm: Option<&[[u32; 2]]>,
+        cutoff: f64,
+    ) -> Run {
+        let mut run = self.solve_scaled(simplex, options, warm, cutoff);
+        if self.inv_k != 1.0 {
+            run.norm *= self.inv_k;
+            run.lower *= self.inv_k;
+            run.inner *= self.inv_k;
+            run.sol.v *= self.inv_k;
+        }
+        run
+    }
+
+    /// [`solve`](Self::solve) in the scaled frame: every length in the
+    /// returned run is `k` times the world's.
+    #[inline(always)]
+    fn solve_scaled(
         &self,
         simplex: &mut Simplex,
         options: &Options,
@@ -584,8 +631,9 @@ impl<'s> Pair<'s> {
                 let v2 = sol.v.norm_squared();
                 let norm = v2.sqrt();
                 if !norm.is_finite() {
-                    // The subalgorithm overflowed: the cofactors of points
-                    // ~1e108 from each other exceed f64 (found by fuzzing,
+                    // The subalgorithm overflowed. Fuzzing found points
+                    // ~1e108 apart whose cofactors exceeded f64 (before the
+                    // run was scaled to sizes near 1; kept as a guard, see
                     // gjk/tests/fuzz_regressions.rs), and NaN weights would
                     // make every bound below meaningless. Keep the last
                     // finite iterate, or else a single vertex: each is a
@@ -652,7 +700,8 @@ impl<'s> Pair<'s> {
                 if g <= stop_d * norm || norm <= eps_d || simplex.has_pair(sol.mask, s.ia, s.ib) {
                     return finish(Status::Converged, sol, lower);
                 }
-                let lower_cert = lower - self.slack - self.radii;
+                // Cutoff and margin are the world's: compared there.
+                let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
                 if lower_cert > cutoff {
                     let mut run = finish(Status::Converged, sol, lower);
                     run.exit = Exit::Pruned;
@@ -662,7 +711,7 @@ impl<'s> Pair<'s> {
                     if lower_cert.max(0.0) > m {
                         return finish(Status::Farther, sol, lower);
                     }
-                    if (norm + self.slack - self.radii).max(0.0) <= m {
+                    if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
                         return finish(Status::Closer, sol, lower);
                     }
                 }
@@ -759,8 +808,8 @@ impl<'s> Pair<'s> {
     /// distance reported between them.
     #[inline]
     fn bounds(&self, run: &Run) -> (f64, f64, f64) {
-        let upper = (run.norm + self.slack - self.radii).max(0.0);
-        let lower = (run.lower - self.slack - self.radii).max(0.0);
+        let upper = (run.norm + self.slack_world - self.radii).max(0.0);
+        let lower = (run.lower - self.slack_world - self.radii).max(0.0);
         // Not `clamp`: it panics when round-off beyond the slack has put
         // `lower` above `upper`; `distance` repairs that case.
         let distance = (run.norm - self.radii).max(0.0).max(lower).min(upper);
@@ -798,7 +847,7 @@ impl<'s> Pair<'s> {
         // b - a = -v, in world coordinates.
         let gap = rot * -run.sol.v;
         let core_b = core_a + gap;
-        let separated = run.norm > self.slack;
+        let separated = run.norm > self.slack_world;
         let normal = if separated {
             gap * (1.0 / run.norm)
         } else {
@@ -870,7 +919,7 @@ fn compound(
         for j in 0..nb {
             let (ob, cb) = b.piece(j).expect("index below piece_count");
             let centre_b = rel * (ob * cb.centroid());
-            let gap = (centre_b - centre_a).norm()
+            let gap = crate::shape::robust_norm(&(centre_b - centre_a))
                 - (ca.size() + ca.radius())
                 - (cb.size() + cb.radius());
             if let Some(o) = slot.next() {

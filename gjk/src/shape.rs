@@ -132,15 +132,25 @@ impl Convex {
             Vec::with_capacity(len),
             Vec::with_capacity(len),
         );
-        let mut size2: f64 = 0.0;
+        let mut widest: f64 = 0.0;
         for v in &vertices {
             let d = v - centroid;
-            size2 = size2.max(d.norm_squared());
+            widest = widest.max(d.amax());
             xs.push(d.x);
             ys.push(d.y);
             zs.push(d.z);
         }
-        let size = size2.sqrt();
+        if !widest.is_finite() {
+            return Err(Error::NonFiniteVertex(0));
+        }
+        // Squared lengths scaled by a power of two (exact), so that sets near
+        // 1e-300 or 1e300 neither underflow to a size of 0 nor overflow.
+        let (k, inv_k) = pow2_scale(widest);
+        let mut size2: f64 = 0.0;
+        for i in 0..len {
+            size2 = size2.max(Vector3::new(xs[i] * k, ys[i] * k, zs[i] * k).norm_squared());
+        }
+        let size = size2.sqrt() * inv_k;
         if !size.is_finite() {
             return Err(Error::NonFiniteVertex(0));
         }
@@ -165,6 +175,7 @@ impl Convex {
             && len >= SINGLE_MIN_VERTICES
             && i32::try_from(xs.len()).is_ok()
             && size > 0.0
+            && (1.0 / size).is_finite()
         {
             let inv = 1.0 / size;
             let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
@@ -180,7 +191,7 @@ impl Convex {
             vertices,
             radius,
             centroid,
-            centroid_norm: centroid.coords.norm(),
+            centroid_norm: robust_norm(&centroid.coords),
             size,
             xs,
             ys,
@@ -474,6 +485,35 @@ fn is_box(xs: &[f64], ys: &[f64], zs: &[f64]) -> bool {
         let want = |bit: usize, c: f64| if i & bit != 0 { c } else { -c };
         xs[i] == want(1, h[0]) && ys[i] == want(2, h[1]) && zs[i] == want(4, h[2])
     })
+}
+
+/// A power of two `k` and its inverse such that `m·k` lies in [1, 2) for a
+/// normal `m` (and is at least 2^-52 for a subnormal one): scaling by `k` is
+/// exact, and brings lengths near 1 where their squares, and the cofactors'
+/// products of squares, can neither overflow nor underflow. `(1, 1)` for 0,
+/// infinity and NaN.
+#[inline]
+pub(crate) fn pow2_scale(m: f64) -> (f64, f64) {
+    if !(m > 0.0 && m <= f64::MAX) {
+        return (1.0, 1.0);
+    }
+    let biased = ((m.to_bits() >> 52) & 0x7ff) as i32;
+    // Subnormals count as 2^-1022; the clamp keeps both factors normal.
+    let e = (biased.max(1) - 1023).clamp(-1020, 1020);
+    let pow = |x: i32| f64::from_bits(((1023 + x) as u64) << 52);
+    (pow(-e), pow(e))
+}
+
+/// `|v|` without overflow or underflow of the squares: the plain norm where
+/// that is safe, else the norm of `v` scaled by a power of two.
+#[inline]
+pub(crate) fn robust_norm(v: &Vector3<f64>) -> f64 {
+    let n = v.norm();
+    if n > 1e-140 && n < 1e140 {
+        return n;
+    }
+    let (k, inv_k) = pow2_scale(v.amax());
+    (v * k).norm() * inv_k
 }
 
 pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {

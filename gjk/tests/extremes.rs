@@ -434,6 +434,73 @@ fn scales_and_gaps() {
     run(&cases);
 }
 
+/// The whole f64 range: objects of size 2^-1000 (1e-301) to 2^1000 (1e301),
+/// rotated, with gaps from their size down to touching. The cofactors are
+/// products of up to three squared lengths, so without the run's scaling
+/// they leave f64 beyond about 1e±50 (at 1e-300 they used to vanish and
+/// certify [0, 0] around a true distance of 1e-300). The scales are powers
+/// of two, so the closed forms are evaluated exactly at scale 1 and scaled.
+#[test]
+fn the_whole_range_of_scales() {
+    let mut cases = Vec::new();
+    for e in [-1000, -600, -300, -150, 150, 300, 600, 1000] {
+        let s = 2f64.powi(e);
+        for rot in rotations() {
+            for g in [1.0, 1e-6, 0.0] {
+                let (ha, hb) = (v(1.0, 0.5, 2.0), v(0.75, 1.5, 0.25));
+                let size = 2.0 * ha.norm() * s;
+                let rel = v(ha.x + hb.x + g * 2.0 * ha.norm(), 0.2, -0.1);
+                let ta = v(0.3, -0.7, 0.2) * s;
+                let tb = ta + rot * (rel * s);
+                let rel_actual = rot.inverse_transform_vector(&(tb - ta));
+                let truth = aabb_distance(&V::zeros(), &ha, &(rel_actual / s), &hb) * s;
+                cases.push(Case::new(
+                    format!("boxes at scale 2^{e}, rot {rot:?}, gap {g:e}"),
+                    cuboid(ha * s, 0.0),
+                    posed(ta, rot),
+                    cuboid(hb * s, 0.0),
+                    posed(tb, rot),
+                    truth,
+                    size,
+                ));
+                cases.push(Case::new(
+                    format!("dotted boxes at scale 2^{e}, rot {rot:?}, gap {g:e}"),
+                    dotted_box(ha * s),
+                    posed(ta, rot),
+                    dotted_box(hb * s),
+                    posed(tb, rot),
+                    truth,
+                    size,
+                ));
+                // A rounded tetrahedron face against a sphere.
+                let tet: Shape = Convex::new(
+                    vec![p(0., 0., 0.), p(s, 0., 0.), p(0., s, 0.), p(0., 0., s)],
+                    0.25 * s,
+                )
+                .unwrap()
+                .into();
+                let n = v(1., 1., 1.) / 3f64.sqrt();
+                let q = v(s, s, s) / 3.0 + n * ((0.5 + g) * s);
+                let pa = posed(V::zeros(), rot);
+                let pb = at(rot * q);
+                let local = rot.inverse_transform_vector(&pb.translation.vector);
+                let core = (local.x + local.y + local.z - s) / 3f64.sqrt();
+                cases.push(Case::new(
+                    format!("rounded tetra/sphere at scale 2^{e}, rot {rot:?}, gap {g:e}"),
+                    tet,
+                    pa,
+                    sphere(0.25 * s),
+                    pb,
+                    (core - 0.5 * s).max(0.0),
+                    s,
+                ));
+            }
+        }
+    }
+    run(&cases);
+    run_with(&cases, Precision::Single);
+}
+
 // ---------------------------------------------------------------------------
 
 /// Duplicate, collinear, coplanar and single-point vertex sets.

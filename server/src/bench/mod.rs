@@ -38,8 +38,9 @@ enum BenchCommand {
     /// server and an in-process call, single pairs and batches, back to back
     /// and with gaps.
     Latency(latency::LatencyArgs),
-    /// Speed against accuracy: tolerance, iteration caps, warm/cold starts and
-    /// margins on the paper's family and an extremes family.
+    /// Speed against accuracy: tolerance, iteration caps, warm/cold starts,
+    /// margins and f32 support search on the paper's family and an extremes
+    /// family, and the f32 search on box clouds of 16 to 16 384 points.
     Tradeoff(tradeoff::TradeoffArgs),
     /// The paper's Section 7: time per query and per vertex against M.
     Paper(paper::PaperArgs),

@@ -403,7 +403,7 @@ pub fn distance_in(
 struct Pair<'s> {
     a: &'s Convex,
     b: &'s Convex,
-    /// Rotation of B's piece into A's piece frame, times `k`.
+    /// Rotation of B's piece into A's piece frame.
     r: Matrix3<f64>,
     /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`,
     /// times `k`.
@@ -521,7 +521,7 @@ impl<'s> Pair<'s> {
         Pair {
             a,
             b,
-            r: if k != 1.0 { r * k } else { r },
+            r,
             t,
             d,
             slack,
@@ -539,10 +539,15 @@ impl<'s> Pair<'s> {
     /// terms are small vectors relative to their centroids.
     #[inline(always)]
     fn vertex(&self, ia: usize, ib: usize) -> Vertex {
-        let za = self.a.local(ia);
-        // k is 1 but for shapes beyond 2^±64 in size: skip the product then.
-        let za = if self.k != 1.0 { za * self.k } else { za };
-        let y = za - (self.r * self.b.local(ib) + self.t);
+        let (za, zb) = (self.a.local(ia), self.r * self.b.local(ib));
+        // k is 1 but for shapes beyond 2^±64 in size: skip the products
+        // then. Each point is scaled after the rotation, not through a
+        // scaled matrix, whose entries could be subnormal.
+        let y = if self.k != 1.0 {
+            za * self.k - (zb * self.k + self.t)
+        } else {
+            za - (zb + self.t)
+        };
         Vertex {
             y,
             ia: ia as u32,

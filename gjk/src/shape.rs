@@ -322,15 +322,17 @@ impl Convex {
     #[inline(never)]
     fn scan_single(&self, d: &Vector3<f64>) -> usize {
         let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
-        if m == 0.0 || !m.is_finite() {
+        let inv = 1.0 / m;
+        if !(m.is_finite() && inv.is_finite()) {
             // A zero direction makes every vertex a support point, and one
-            // that is not finite cannot be scaled: the f64 scan decides.
+            // that is not finite, or so small that 1/m overflows, cannot be
+            // scaled: the f64 scan decides.
             return self.scan_index(d);
         }
         // Largest component 1 (a scaling keeps the support point), so the
         // f32 direction neither overflows nor loses more than its relative
         // round-off, and |u| <= √3 |d| / m keeps the error bound in |d|.
-        let u = d * (1.0 / m);
+        let u = d * inv;
         let d32 = [u.x as f32, u.y as f32, u.z as f32];
         let s = &self.single;
         #[cfg(target_arch = "x86_64")]
@@ -918,9 +920,11 @@ mod tests {
                         if flat {
                             d = Vector3::new(1.0, d.y * 1e-9, d.z * 1e-9);
                         }
-                        match k % 4 {
+                        match k % 5 {
                             1 => d.y *= 1e-300,
                             2 => d = Vector3::new(0.0, -0.0, d.z),
+                            // Subnormal: 1/max overflows, the f64 scan takes over.
+                            4 => d *= 1e-310,
                             // Large, but not so large that the reference overflows.
                             3 => d *= 1e120 / scale.max(1.0),
                             _ => {}
@@ -933,12 +937,14 @@ mod tests {
                             let u = d * (1.0 / m);
                             [u.x as f32, u.y as f32, u.z as f32]
                         };
-                        let mut picks = vec![
-                            c.support_index_single(&d),
-                            scan_single(&s.xs, &s.ys, &s.zs, d32),
-                        ];
+                        let mut picks = vec![c.support_index_single(&d)];
+                        let scalable = d32.iter().all(|x| x.is_finite());
+                        if scalable {
+                            picks.push(scan_single(&s.xs, &s.ys, &s.zs, d32));
+                        }
                         #[cfg(target_arch = "x86_64")]
-                        if std::arch::is_x86_feature_detected!("avx2")
+                        if scalable
+                            && std::arch::is_x86_feature_detected!("avx2")
                             && std::arch::is_x86_feature_detected!("fma")
                         {
                             // SAFETY: the features were checked just above.

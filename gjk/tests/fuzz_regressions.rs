@@ -160,3 +160,74 @@ fn points_whose_squared_gap_underflows() {
         assert!((ans.distance - truth).abs() <= 1e-14 * truth, "{ans:?}");
     }
 }
+
+/// A segment grown by 1.17e302 against a 22-point set spanning 1e-315 to
+/// 2e307, with the f32 support search. The scaled run had folded its scale
+/// (2^-1020) into the rotation, so search directions came out subnormal;
+/// the f32 search could not normalise them and picked vertex 0, and the
+/// lower bound (3.8e301) exceeded a plain vertex-pair distance (3.4e299).
+/// Now the rotation stays unscaled, and a direction the f32 search cannot
+/// normalise goes to the f64 scan.
+#[test]
+fn subnormal_search_directions_at_1e307() {
+    let p = Point3::new;
+    let h = 1.1700000000000001e302;
+    let a = Convex::new(vec![p(2.13033543e-314, h, h), p(h, h, h)], h).unwrap();
+    let mut bv = vec![p(h, h, h); 5];
+    bv.extend([
+        p(h, h, 1e300),
+        p(0.0625, 0.0625, 0.125),
+        p(33.686018, 33.686018, 33.620225999999995),
+        p(1.65780921e-315, 0.0, -2.177169412394963e307),
+        p(0.125, -7.125, 2.75),
+        p(0.0625, 0.0625, 0.0625),
+        p(7.74860418665603e-304, 7.3125, h),
+    ]);
+    bv.extend([p(h, h, h); 8]);
+    bv.extend([p(h, 1e300, 0.0625), p(0.0625, 0.125, 33.686018)]);
+    let b = Convex::new(bv.clone(), 0.0).unwrap();
+    let pa = Isometry3::from_parts(
+        Translation3::new(33.686018, 0.131329, 6.475817e-318),
+        UnitQuaternion::identity(),
+    );
+    let pb = Isometry3::from_parts(
+        Translation3::new(0.1, 0.0625, 0.0625),
+        UnitQuaternion::new_unchecked(Quaternion::new(
+            0.5773502691896258,
+            0.5773502691896258,
+            0.5773502691896258,
+            8.932311110520153e-309,
+        )),
+    );
+    // An upper bound on the truth independent of GJK: the nearest pair of
+    // vertices, less the radius (norms scaled against overflow).
+    let mut vertex_bound = f64::INFINITY;
+    for x in a.vertices().iter().map(|v| pa * v) {
+        for y in bv.iter().map(|v| pb * v) {
+            let d = x - y;
+            let m = d.amax();
+            vertex_bound = vertex_bound.min(m * (d / m).norm() - h);
+        }
+    }
+    assert!(vertex_bound < 4e299, "{vertex_bound:e}");
+    let (a, b): (Shape, Shape) = (a.into(), b.into());
+    for precision in [gjk::Precision::Double, gjk::Precision::Single] {
+        for margin in [None, Some(0.0625)] {
+            let o = Options {
+                max_iterations: 10,
+                margin,
+                precision,
+                ..Options::default()
+            };
+            let ans = check(&a, &pa, &b, &pb, &o);
+            assert!(
+                ans.lower <= vertex_bound,
+                "{precision:?} {margin:?}: {ans:?}"
+            );
+            assert!(
+                ans.distance <= vertex_bound,
+                "{precision:?} {margin:?}: {ans:?}"
+            );
+        }
+    }
+}

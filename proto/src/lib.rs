@@ -302,7 +302,7 @@ pub mod item_flags {
     pub const MARGIN: u32 = 1 << 2;
     /// Start from the server's cached simplex of this pair (for this client).
     pub const WARM_START: u32 = 1 << 3;
-    /// Search support points in f32 ([`Precision::Single`]). Added within
+    /// Search support points in f32 ([`Precision::Single`](crate::Precision::Single)). Added within
     /// v1 (the layout is unchanged): a server older than this bit refuses it
     /// as malformed rather than silently answering in f64.
     pub const SINGLE_PRECISION: u32 = 1 << 4;

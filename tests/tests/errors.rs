@@ -319,3 +319,44 @@ fn only_owners_remove() {
     alice.remove(hers).expect("owner removes");
     probe.check(&mut bob);
 }
+
+/// The object of a client that is gone (here: dropped, which ends its
+/// iceoryx2 node, as a process exit does) may be removed by anyone, so that
+/// a restarted process can clear what its earlier life registered. While
+/// its owner runs it may not, and the server's other objects stay.
+#[test]
+fn objects_of_departed_clients_can_be_removed() {
+    let server = Server::start("orphans", &[]);
+    let mut bob = server.client(TIMEOUT);
+    let probe = Probe::new(&mut bob);
+    let mut carol = server.client(TIMEOUT);
+    let (orphan, named) = {
+        let mut alice = server.client(TIMEOUT);
+        let orphan = alice.register_sphere(1.0).expect("registered");
+        let named = alice
+            .register_named(
+                "alice-arm",
+                &gjkd_client::Geometry::Sphere { radius: 0.5 },
+                &nalgebra::Isometry3::identity(),
+            )
+            .expect("named");
+        assert_eq!(rejected(bob.remove(orphan)), ErrorCode::NotOwner);
+        (orphan, named)
+    };
+    // Alice's node is gone: her objects are still served...
+    bob.distance(orphan, probe.a, &QueryOptions::default())
+        .expect("still served");
+    // ...and a later client finds the named one and clears both.
+    assert_eq!(carol.lookup("alice-arm").expect("lookup"), named);
+    carol.remove(named).expect("orphan removed");
+    bob.remove(orphan).expect("orphan removed");
+    assert_eq!(
+        rejected(bob.distance(orphan, probe.a, &QueryOptions::default())),
+        ErrorCode::UnknownObject
+    );
+    assert_eq!(rejected(carol.lookup("alice-arm")), ErrorCode::UnknownName);
+    // A running owner's objects stay protected.
+    let mine = carol.register_sphere(0.25).expect("registered");
+    assert_eq!(rejected(bob.remove(mine)), ErrorCode::NotOwner);
+    probe.check(&mut bob);
+}

@@ -13,16 +13,7 @@ fn check(
     pb: &Isometry3<f64>,
     o: &Options,
 ) -> gjk::Answer {
-    let ans = distance(a, pa, b, pb, o, None).expect("valid input");
-    assert!(
-        !ans.distance.is_nan() && !ans.lower.is_nan() && !ans.upper.is_nan(),
-        "{ans:?}"
-    );
-    assert!(
-        ans.lower <= ans.distance && ans.distance <= ans.upper,
-        "{ans:?}"
-    );
-    ans
+    check_from(a, pa, b, pb, o, None)
 }
 
 fn check_warm(
@@ -33,7 +24,20 @@ fn check_warm(
     o: &Options,
     w: &gjk::WarmStart,
 ) -> gjk::Answer {
-    let ans = distance(a, pa, b, pb, o, Some(w)).expect("valid input");
+    check_from(a, pa, b, pb, o, Some(w))
+}
+
+/// The query, with the invariants every answer must keep: no NaN, and
+/// `lower <= distance <= upper`.
+fn check_from(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    o: &Options,
+    w: Option<&gjk::WarmStart>,
+) -> gjk::Answer {
+    let ans = distance(a, pa, b, pb, o, w).expect("valid input");
     assert!(
         !ans.distance.is_nan() && !ans.lower.is_nan() && !ans.upper.is_nan(),
         "{ans:?}"

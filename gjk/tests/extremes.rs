@@ -907,3 +907,68 @@ fn single_precision_at_scales_offsets_and_gaps() {
     // The same cases in f64 meet the tighter requirement.
     run(&cases);
 }
+
+/// The paper's family, separated, touching and intersecting, scaled by powers
+/// of two (exact, so the constructed distance scales with it) from 2^-200 to
+/// 2^200 and moved up to 1e9 of its size from the origin, in f64 and with the
+/// f32 support search: every answer within the requirement (plus, for f32,
+/// its slack) of the constructed distance, whose own round-off (1e-15 of the
+/// scene, and the ulp of the offset) is allowed for.
+#[test]
+fn paper_family_at_scales_and_offsets() {
+    let family = gjk::paper::family();
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for precision in [Precision::Double, Precision::Single] {
+        let options = Options {
+            precision,
+            ..Options::default()
+        };
+        for e in [-200, -60, 20, 200] {
+            let s = 2f64.powi(e);
+            let shapes: Vec<Shape> = family
+                .iter()
+                .map(|c| {
+                    let pts: Vec<P> = c.vertices().iter().map(|q| q * s).collect();
+                    Convex::new(pts, c.radius() * s).unwrap().into()
+                })
+                .collect();
+            for off in [0.0, 1e9] {
+                let shift = v(off, -off, 0.5 * off) * s;
+                for case in gjk::paper::Case::ALL {
+                    for c in gjk::paper::cases(case, 2, 3) {
+                        let place = |p: &Isometry3<f64>| {
+                            Isometry3::from_parts(
+                                Translation3::from(p.translation.vector * s + shift),
+                                p.rotation,
+                            )
+                        };
+                        let (pa, pb) = (place(&c.pose_a), place(&c.pose_b));
+                        let truth = c.expected * s;
+                        let size = 20.0 * s; // The polytopes lie within radius 10.
+                        let known = 1e-14 * size + 4.0 * f64::EPSILON * off * s;
+                        let slack = match precision {
+                            Precision::Double => 0.0,
+                            Precision::Single => 2f64.powi(-18) * size,
+                        };
+                        let allowed = (1e-6 * truth).max(1e-9 * size) + known + slack;
+                        let ans =
+                            distance(&shapes[c.a], &pa, &shapes[c.b], &pb, &options, None).unwrap();
+                        checked += 1;
+                        if (ans.distance - truth).abs() > allowed
+                            || ans.lower > truth + known
+                            || truth > ans.upper + known
+                        {
+                            failures.push(format!(
+                                "{precision:?} 2^{e} offset {off:e} {case:?} pair {}: truth {truth:e}, got {:e} [{:e}, {:e}]",
+                                c.pair, ans.distance, ans.lower, ans.upper
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 2 * 4 * 2 * 3 * 40);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -848,9 +848,7 @@ impl Client {
     /// Removes an object this client registered, or one whose registering
     /// client is gone (its process ended, so its objects would otherwise
     /// stay forever: a restarted process can find its named ones with
-    /// [`Client::lookup`] and clear them; objects that must outlive their
-    /// registering process and stay protected belong in the server's scene
-    /// file). Its id is never reused.
+    /// [`Client::lookup`] and clear them). Its id is never reused.
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for an object of

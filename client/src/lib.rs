@@ -845,15 +845,11 @@ impl Client {
         self.register(&Geometry::Compound(pieces))
     }
 
-    /// Removes an object this client registered, or one whose registering
-    /// client is gone (its process ended, so its objects would otherwise
-    /// stay forever: a restarted process can find its named ones with
-    /// [`Client::lookup`] and clear them). Its id is never reused.
+    /// Removes an object this client registered. Its id is never reused.
     ///
     /// # Errors
-    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for an object of
-    /// another client that is still running, [`ErrorCode::ReadOnly`] for a
-    /// scene object.
+    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
+    /// client's object, [`ErrorCode::ReadOnly`] for a scene object.
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.id = id.raw();

@@ -138,8 +138,7 @@ pub enum ErrorCode {
     /// A field has a value no client should send (unknown item kind or
     /// operation, inconsistent counts, bad UTF-8 in a name).
     Malformed = 10,
-    /// The object belongs to another client, which is still running (the
-    /// object of a client that is gone may be removed by anyone).
+    /// The object belongs to another client.
     NotOwner = 11,
     /// The object was loaded from the server's scene file and cannot be
     /// changed or removed.
@@ -733,8 +732,7 @@ pub enum AdminOp {
     /// Register a convex object (one piece) or a compound (several), with
     /// the vertices in the request's slice payload.
     Register = 2,
-    /// Remove object [`AdminRequest::id`]: one of the requester's own, or
-    /// one whose owner (an iceoryx2 node) no longer runs.
+    /// Remove object [`AdminRequest::id`].
     Remove = 3,
     /// Look an object up by [`AdminRequest::name`].
     Lookup = 4,

@@ -12,7 +12,6 @@ use gjkd_proto::{
     AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, Vertex, WaitMode,
     admin_service_name, query_service_name, wake_service_name,
 };
-use iceoryx2::node::NodeView;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server as IoxServer;
 use iceoryx2::prelude::*;
@@ -115,7 +114,6 @@ pub fn run(
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
         .map_err(ipc("node"))?;
-    state.set_owner_liveness(node_alive);
     // A server killed with -9 leaves its port registered; clearing dead nodes
     // first lets a restarted server take its place.
     let cleaned = node.try_cleanup_dead_nodes();
@@ -289,33 +287,6 @@ pub fn run(
     // Ports, services and the node are dropped here, in reverse order of
     // creation, which removes the services' shared memory.
     Ok(())
-}
-
-/// Whether iceoryx2 node `id` (an object's owner) still runs. A node listed
-/// as dead, or no longer listed at all (cleaned up, or of a process that
-/// ended before this server started), does not; one whose state cannot be
-/// read counts as alive, so that doubt never lets another client remove an
-/// object. Lists every node on the host: called only when a client removes
-/// an object it does not own.
-fn node_alive(id: u128) -> bool {
-    let mut alive = false;
-    let listed = Node::<ipc::Service>::list(Config::global_config(), |state| {
-        let (node, live) = match &state {
-            NodeState::Alive(view) => (view.id().value(), true),
-            NodeState::Dead(view) => (view.id().value(), false),
-            NodeState::Inaccessible(node) | NodeState::Undefined(node) => (node.value(), true),
-        };
-        if node == id {
-            alive = live;
-            return CallbackProgression::Stop;
-        }
-        CallbackProgression::Continue
-    });
-    if let Err(e) = listed {
-        warn!(error = ?e, "cannot list nodes; the owner counts as alive");
-        return true;
-    }
-    alive
 }
 
 /// Drops the warm starts of query clients that are no longer connected.

@@ -115,12 +115,6 @@ pub struct State {
     workspace: gjk::Workspace,
     /// Query clients connected, as last seen by the serving loop.
     clients: u64,
-    /// Whether the client (iceoryx2 node) that owns an object still lives.
-    /// Consulted only when a client removes another's object: the object of
-    /// a client that is gone may then be removed by anyone, so that a
-    /// restarted process can clear what its earlier life left behind.
-    /// Everybody lives until the serving loop says how to tell.
-    owner_alive: fn(u128) -> bool,
 }
 
 /// The shape part of a registration, in the server's terms.
@@ -154,7 +148,6 @@ impl State {
             next_slot: 0,
             persist_errors: 0,
             clients: 0,
-            owner_alive: |_| true,
             workspace: gjk::Workspace::new(),
         }
     }
@@ -502,13 +495,6 @@ impl State {
         self.names.get(name).copied()
     }
 
-    /// How to tell whether the client that owns an object still lives (see
-    /// [`handle_admin`](Self::handle_admin)'s removal rule). Until this is
-    /// called every owner counts as alive, and only owners remove.
-    pub fn set_owner_liveness(&mut self, alive: fn(u128) -> bool) {
-        self.owner_alive = alive;
-    }
-
     /// Forgets the warm starts of a client that has gone away.
     pub fn forget_client(&mut self, client: u128) {
         self.cache.forget_client(client);
@@ -755,17 +741,7 @@ impl State {
         let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
         match object.owner {
             Owner::Scene => return Err(ErrorCode::ReadOnly),
-            Owner::Client(c) if c != requester && (self.owner_alive)(c) => {
-                return Err(ErrorCode::NotOwner);
-            }
-            Owner::Client(c) if c != requester => {
-                tracing::info!(
-                    id,
-                    owner = c,
-                    requester,
-                    "removing an object whose owner is gone"
-                );
-            }
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
             Owner::Client(_) => {}
         }
         let Some(object) = self.drop_object(id) else {
@@ -1291,30 +1267,6 @@ mod tests {
         assert_eq!(s.remove(scene, 1), Err(ErrorCode::ReadOnly));
         assert_eq!(s.remove(id, 1), Ok(()));
         assert!(s.object(id).is_none());
-    }
-
-    #[test]
-    fn objects_of_owners_that_are_gone_are_removable_by_anyone() {
-        let mut s = state();
-        let (gone, live) = (register_box(&mut s, 7), register_box(&mut s, 8));
-        let scene = s
-            .insert(
-                NewObject {
-                    shape: Convex::sphere(1.0).expect("sphere").into(),
-                    pose: Isometry3::identity(),
-                    name: None,
-                },
-                Owner::Scene,
-            )
-            .expect("room");
-        // Until the serving loop says how to tell, every owner lives.
-        assert_eq!(s.remove(gone, 2), Err(ErrorCode::NotOwner));
-        s.set_owner_liveness(|c| c != 7);
-        assert_eq!(s.remove(live, 2), Err(ErrorCode::NotOwner));
-        assert_eq!(s.remove(scene, 2), Err(ErrorCode::ReadOnly));
-        assert_eq!(s.remove(gone, 2), Ok(()));
-        assert!(s.object(gone).is_none() && s.object(live).is_some());
-        assert_eq!(s.remove(gone, 2), Err(ErrorCode::UnknownObject));
     }
 
     #[test]

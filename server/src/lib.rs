@@ -36,6 +36,7 @@ pub mod bench;
 pub mod cache;
 pub mod demo;
 pub mod journal;
+pub mod objects;
 pub mod persist;
 pub mod scene;
 pub mod server;

@@ -1,4 +1,5 @@
-//! `gjkd`: the distance server (`gjkd serve`) and its demo (`gjkd demo`).
+//! `gjkd`: the distance server (`gjkd serve`), its demo (`gjkd demo`), its
+//! measurements (`gjkd bench`) and a state-file tool (`gjkd objects`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,6 +35,11 @@ enum Command {
     /// Measurements: `latency`, `tradeoff` (speed against accuracy) and
     /// `paper` (Section 7). See docs/benchmarks.md.
     Bench(gjkd::bench::BenchArgs),
+    /// List the objects of a stopped server's state file, with whether each
+    /// owner still runs; with --remove-departed, remove those whose
+    /// registering client process is gone (a client can remove only its
+    /// own objects, so no client can remove these).
+    Objects(ObjectsArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -100,6 +106,22 @@ struct ServeArgs {
 }
 
 #[derive(Args, Debug)]
+struct ObjectsArgs {
+    /// Deployment name, for the default state file.
+    #[arg(long, default_value = DEFAULT_SERVICE)]
+    service: String,
+    /// State file (default as for `gjkd serve`). The server using it must
+    /// be stopped: its lock on the file is checked.
+    #[arg(long, value_name = "PATH")]
+    state_file: Option<PathBuf>,
+    /// Remove the objects whose owner (an iceoryx2 node) no longer runs.
+    /// Scene objects and those of running clients stay; ids are never
+    /// reused.
+    #[arg(long)]
+    remove_departed: bool,
+}
+
+#[derive(Args, Debug)]
 struct DemoArgs {
     /// Sweep steps to time, besides the paper's 10, 100 and 1000.
     #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000])]
@@ -136,7 +158,68 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Objects(args) => match objects(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("gjkd objects: {e}");
+                ExitCode::FAILURE
+            }
+        },
     }
+}
+
+/// `gjkd objects`: the table, and the removal when asked for. Loading does
+/// to a damaged change log what a server start would (see `open_state`).
+fn objects(args: &ObjectsArgs) -> Result<(), String> {
+    use gjkd::objects::{alive_nodes, liveness, remove_departed, table};
+    let path = args
+        .state_file
+        .clone()
+        .or_else(|| gjkd::persist::default_path(&args.service))
+        .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file")?;
+    let mut store = Store::open(&path)
+        .map_err(|e| format!("{e} (a server using this file must be stopped first)"))?;
+    let mut snapshot = match store.load_or_quarantine().map_err(|e| e.to_string())? {
+        Loaded::Missing { log } => {
+            report_log(store.log_path(), &log);
+            println!("no state file at {}: no objects", path.display());
+            return Ok(());
+        }
+        Loaded::Corrupt {
+            reason, moved_to, ..
+        } => {
+            return Err(format!(
+                "{} is corrupt ({reason}); it was set aside as {}",
+                path.display(),
+                moved_to.display()
+            ));
+        }
+        Loaded::Snapshot { snapshot, log } => {
+            report_log(store.log_path(), &log);
+            snapshot
+        }
+    };
+    let alive = alive_nodes()?;
+    print!("{}", table(&snapshot, &liveness(&snapshot, &alive)));
+    if !args.remove_departed {
+        return Ok(());
+    }
+    let removed = remove_departed(&mut snapshot, &alive);
+    if removed.is_empty() {
+        println!("no object has an owner that is gone: nothing removed");
+        return Ok(());
+    }
+    store.write(&snapshot).map_err(|e| e.to_string())?;
+    println!(
+        "removed {} object(s) whose owner is gone: {}",
+        removed.len(),
+        removed
+            .iter()
+            .map(|o| format!("{:#x}", o.id))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(())
 }
 
 fn serve(args: ServeArgs) -> ExitCode {

@@ -164,6 +164,86 @@ fn owners_stay_owners_across_a_server_restart() {
     assert_eq!(carol.stats().expect("stats").objects, 0);
 }
 
+/// `gjkd objects` on the state file of a stopped server.
+fn objects_tool(state_file: &Path, remove: bool) -> (bool, String) {
+    let mut cmd = std::process::Command::new(gjkd_e2e::gjkd_binary());
+    cmd.arg("objects").arg("--state-file").arg(state_file);
+    if remove {
+        cmd.arg("--remove-departed");
+    }
+    let out = cmd.output().expect("run gjkd objects");
+    let text =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.success(), text)
+}
+
+/// A client removes only what it registered, so the objects of a process
+/// that is gone (here: a dropped `Client`, whose node ends as at a process
+/// exit) stay for clients. `gjkd objects --remove-departed` is the
+/// operator's way out: it refuses while the server holds the file, and with
+/// the server stopped removes exactly those objects; after a restart the
+/// rest is served under the same ids.
+#[test]
+fn the_operator_removes_objects_of_departed_clients() {
+    let mut server = Server::start("departed", &[]);
+    let state_file = server.state_file().expect("the helper's state file");
+    let mut bob = server.client(Duration::from_secs(2));
+    let his = bob.register_sphere(1.0).expect("his");
+    let (hers, named) = {
+        let mut alice = server.client(Duration::from_secs(2));
+        let hers = alice.register_sphere(0.5).expect("hers");
+        let named = alice
+            .register_named(
+                "alice-arm",
+                &Geometry::Sphere { radius: 0.25 },
+                &Isometry3::identity(),
+            )
+            .expect("named");
+        (hers, named)
+    };
+    // Alice is gone; no client may remove her objects.
+    assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
+    // The tool refuses while the server runs, and changes nothing.
+    let (ok, text) = objects_tool(&state_file, true);
+    assert!(!ok, "{text}");
+    assert!(text.contains("stopped first"), "{text}");
+    assert_eq!(bob.stats().expect("stats").objects, 3);
+
+    server.terminate();
+    let (ok, text) = objects_tool(&state_file, false);
+    assert!(ok, "{text}");
+    assert_eq!(text.matches("gone").count(), 2, "{text}");
+    assert_eq!(text.matches("running").count(), 1, "{text}");
+    assert!(text.contains("alice-arm"), "{text}");
+    let (ok, text) = objects_tool(&state_file, true);
+    assert!(ok, "{text}");
+    assert!(text.contains("removed 2 object(s)"), "{text}");
+    assert!(text.contains(&format!("{:#x}", hers.raw())), "{text}");
+    assert!(text.contains(&format!("{:#x}", named.raw())), "{text}");
+    // A second pass finds nothing more.
+    let (ok, text) = objects_tool(&state_file, true);
+    assert!(ok && text.contains("nothing removed"), "{text}");
+
+    server.restart();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let stats = loop {
+        match bob.stats() {
+            Ok(s) => break s,
+            Err(e) if is_gone(&e) && Instant::now() < deadline => {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => panic!("restarted server not reached: {e}"),
+        }
+    };
+    assert_eq!(stats.objects, 1);
+    assert_eq!(rejected(bob.lookup("alice-arm")), ErrorCode::UnknownName);
+    assert_eq!(
+        rejected(bob.distance(hers, his, &QueryOptions::default())),
+        ErrorCode::UnknownObject
+    );
+    bob.remove(his).expect("his own, as before");
+}
+
 #[test]
 fn scene_objects_stay_read_only_and_keep_their_ids_across_a_restart() {
     let dir = std::env::temp_dir().join(unique_service("scene-ro"));

@@ -407,6 +407,24 @@ pub fn is_gone(e: &ClientError) -> bool {
     matches!(e, ClientError::ServerGone(_))
 }
 
+/// `call` retried while it reports the server gone, up to ten seconds: a
+/// client reaching a restarted server, at most after some `ServerGone`.
+///
+/// # Panics
+/// On any other error, or when the server is still gone after ten seconds.
+pub fn once_reached<T>(mut call: impl FnMut() -> Result<T, ClientError>) -> T {
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        match call() {
+            Ok(v) => return v,
+            Err(e) if is_gone(&e) && Instant::now() < deadline => {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => panic!("restarted server not reached: {e}"),
+        }
+    }
+}
+
 /// A small deterministic generator (xorshift64*), so tests see the same
 /// poses on every run.
 #[derive(Clone, Debug)]

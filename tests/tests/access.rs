@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use gjkd_client::{ClientError, ErrorCode, Geometry, QueryOptions};
-use gjkd_e2e::{Server, is_gone, unique_service};
+use gjkd_e2e::{Server, once_reached, unique_service};
 use nalgebra::Isometry3;
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -134,16 +134,7 @@ fn owners_stay_owners_across_a_server_restart() {
     server.restart();
     // Both notice and reconnect with the same identity.
     for c in [&mut alice, &mut bob] {
-        let deadline = Instant::now() + Duration::from_secs(10);
-        loop {
-            match c.stats() {
-                Ok(_) => break,
-                Err(e) if is_gone(&e) && Instant::now() < deadline => {
-                    std::thread::sleep(Duration::from_millis(20));
-                }
-                Err(e) => panic!("restarted server not reached: {e}"),
-            }
-        }
+        once_reached(|| c.stats());
     }
     assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
     assert_eq!(rejected(alice.remove(his)), ErrorCode::NotOwner);
@@ -225,16 +216,7 @@ fn the_operator_removes_objects_of_departed_clients() {
     assert!(ok && text.contains("nothing removed"), "{text}");
 
     server.restart();
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let stats = loop {
-        match bob.stats() {
-            Ok(s) => break s,
-            Err(e) if is_gone(&e) && Instant::now() < deadline => {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            Err(e) => panic!("restarted server not reached: {e}"),
-        }
-    };
+    let stats = once_reached(|| bob.stats());
     assert_eq!(stats.objects, 1);
     assert_eq!(rejected(bob.lookup("alice-arm")), ErrorCode::UnknownName);
     assert_eq!(

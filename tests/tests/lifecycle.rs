@@ -4,7 +4,9 @@
 use std::time::{Duration, Instant};
 
 use gjkd_client::{Client, ClientError, ErrorCode, QueryOptions};
-use gjkd_e2e::{Server, Solid, assert_same, gjk_options, is_gone, services_exist, unique_service};
+use gjkd_e2e::{
+    Server, Solid, assert_same, gjk_options, is_gone, once_reached, services_exist, unique_service,
+};
 use nalgebra::{Isometry3, Vector3};
 
 /// Registers two spheres 3 apart and checks their distance.
@@ -46,16 +48,7 @@ fn a_killed_server_is_reported_and_a_restarted_one_serves() {
     assert!(is_gone(&client.stats().expect_err("still dead")));
 
     server.restart();
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let stats = loop {
-        match client.stats() {
-            Ok(s) => break s,
-            Err(e) if is_gone(&e) && Instant::now() < deadline => {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            Err(e) => panic!("restarted server not reached: {e}"),
-        }
-    };
+    let stats = once_reached(|| client.stats());
     assert_eq!(
         stats.objects, 2,
         "the restarted server reloaded both objects"
@@ -78,16 +71,7 @@ fn without_persistence_a_restarted_server_starts_empty() {
     let (a, b) = spheres(&mut client);
     server.kill9();
     server.restart();
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let stats = loop {
-        match client.stats() {
-            Ok(s) => break s,
-            Err(e) if is_gone(&e) && Instant::now() < deadline => {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            Err(e) => panic!("restarted server not reached: {e}"),
-        }
-    };
+    let stats = once_reached(|| client.stats());
     assert_eq!(stats.objects, 0, "a new server starts empty");
     // Ids of the dead server are unknown to the new one, never aliases.
     assert_eq!(
@@ -107,16 +91,7 @@ fn a_server_restarted_before_the_client_notices_serves_it() {
     server.restart();
     // The client still holds its old ports; the next calls reach the new
     // server, at most after one ServerGone.
-    let deadline = Instant::now() + Duration::from_secs(10);
-    loop {
-        match client.register_sphere(1.0) {
-            Ok(_) => break,
-            Err(e) if is_gone(&e) && Instant::now() < deadline => {
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            Err(e) => panic!("restarted server not reached: {e}"),
-        }
-    }
+    once_reached(|| client.register_sphere(1.0));
     spheres(&mut client);
 }
 

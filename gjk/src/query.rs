@@ -47,7 +47,7 @@ pub enum Precision {
     /// size of B)`, and the lower bound is lowered by that much.
     ///
     /// It pays on large vertex sets only: about 1.5× at 1 000 vertices and
-    /// 1.9× at 16 000 per shape, nothing measurable below 100 (see
+    /// 1.8× at 16 000 per shape, nothing measurable below 100 (see
     /// `docs/speed-accuracy.md`). The f32 copy it scans is made when the
     /// shape is built (12 bytes a vertex), whatever the queries ask for.
     Single,
@@ -488,8 +488,8 @@ impl<'s> Pair<'s> {
         // pair's sizes near 1: exact (every result is the unscaled one times
         // k, bit for bit), and the cofactors, products of up to three
         // squared lengths, then neither overflow nor underflow for shapes
-        // anywhere from 1e-300 to 1e300 in size.
-        // Sizes within 2^±64 need no scaling: cofactors stay within 2^±400.
+        // anywhere from 1e-300 to 1e300 in size. Sizes within 2^±64 need no
+        // scaling (k = 1): their cofactors stay within 2^±400.
         let m = a.size().max(b.size()).max(t.amax());
         let (k, inv_k) = if m > 5.4e-20 && m < 1.8e19 {
             (1.0, 1.0)
@@ -570,9 +570,8 @@ impl<'s> Pair<'s> {
         self.vertex(ia, ib)
     }
 
-    /// The Numerical Algorithm, steps (1) to (6).
-    /// One run of the Numerical Algorithm, its lengths in the world's units
-    /// (the simplex's points stay in the scaled frame).
+    /// The Numerical Algorithm, steps (1) to (6): one run, its lengths in the
+    /// world's units (the simplex's points stay in the scaled frame).
     fn solve(
         &self,
         simplex: &mut Simplex,

@@ -323,10 +323,11 @@ impl Convex {
     fn scan_single(&self, d: &Vector3<f64>) -> usize {
         let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
         let inv = 1.0 / m;
-        if !(m.is_finite() && inv.is_finite()) {
+        if !inv.is_normal() {
             // A zero direction makes every vertex a support point, and one
-            // that is not finite, or so small that 1/m overflows, cannot be
-            // scaled: the f64 scan decides.
+            // whose 1/m overflows, is subnormal (a direction near 1e308,
+            // scaled with lost bits) or NaN cannot be scaled exactly enough:
+            // the f64 scan decides.
             return self.scan_index(d);
         }
         // Largest component 1 (a scaling keeps the support point), so the
@@ -968,6 +969,25 @@ mod tests {
         // The flat sets did produce misses (about 2e-8 here), so the bound
         // was tested, not just the easy picks.
         assert!(worst > 0.0);
+        // Directions whose largest component is near f64::MAX (1/m would be
+        // subnormal) go to the exact scan.
+        let ring = Convex::new(
+            (0..40)
+                .map(|i| {
+                    let a = f64::from(i) * 0.157;
+                    Point3::new(a.cos(), a.sin(), 0.1 * a)
+                })
+                .collect::<Vec<_>>(),
+            0.0,
+        )
+        .unwrap();
+        assert!(ring.has_single());
+        for d in [
+            Vector3::new(1.7e308, 3e307, -2e307),
+            Vector3::new(-1e-320, 5e-321, 0.0),
+        ] {
+            assert_eq!(ring.support_index_single(&d), ring.scan_index(&d), "{d:?}");
+        }
         // Small and closed-form shapes keep the exact support.
         let small = Convex::new(
             (0..15)

@@ -48,8 +48,10 @@ pub enum Error {
     /// Vertex (or piece) counts must fit in `u32`, the width of warm-start indices.
     #[error("too many vertices or pieces: {0}")]
     TooManyVertices(usize),
-    /// A vertex has a NaN or infinite coordinate (or the set's spread overflows).
-    #[error("vertex {0} is not finite")]
+    /// A vertex has a NaN or infinite coordinate, or the set reaches more
+    /// than 2^999 (about 5e300) from its body origin, where queries could
+    /// overflow.
+    #[error("vertex {0} is not finite, or the set reaches beyond 5e300")]
     NonFiniteVertex(usize),
     /// The rounding radius is negative, NaN or infinite.
     #[error("radius {0} is not a finite number >= 0")]
@@ -57,8 +59,11 @@ pub enum Error {
     /// A compound needs at least one piece.
     #[error("compound with no pieces")]
     EmptyCompound,
-    /// A pose (or a piece offset) has a NaN or infinite component.
-    #[error("pose is not finite")]
+    /// A pose (or a piece offset) has a NaN or infinite component; or a
+    /// compound's piece reaches more than 2^999 (about 5e300) from its body
+    /// origin, or a query's two shapes lie more than 2^1000 (about 1e301)
+    /// apart on an axis, where the arithmetic could overflow.
+    #[error("pose is not finite, or beyond 1e301")]
     NonFinitePose,
     /// An option is out of its domain (named in the message).
     #[error("invalid option: {0}")]

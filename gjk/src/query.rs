@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
 use crate::Error;
 use crate::johnson::{Simplex, Solution, Vertex};
-use crate::shape::{Convex, Shape, pose_is_finite};
+use crate::shape::{Convex, Shape, shift_is_in_range};
 
 /// How hard to work, and when to stop early.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -273,8 +273,9 @@ impl Default for Workspace {
 /// certified bounds and the simplex for a warm start.
 ///
 /// # Errors
-/// [`Error::NonFinitePose`] for a pose with NaN or infinity,
-/// [`Error::InvalidOption`] for options out of their domain, and
+/// [`Error::NonFinitePose`] for a pose with NaN or infinity, or for shapes
+/// more than 2^1000 (about 1e301) apart on an axis, where the arithmetic
+/// could overflow, [`Error::InvalidOption`] for options out of their domain, and
 /// [`Error::WarmStartOutOfRange`] for a warm start that names a piece or vertex
 /// the shapes do not have.
 pub fn distance(
@@ -328,11 +329,15 @@ pub fn distance_in(
     // a⁻¹·b: the translations are subtracted before rotating, so poses far from
     // the world origin cancel exactly when the objects are near each other.
     let rel = pose_a.inv_mul(pose_b);
-    if !pose_is_finite(&rel) {
+    if !shift_is_in_range(&rel) {
         // Every component of either pose reaches `rel` through a product with
         // a unit quaternion's components or a difference of translations, so
         // NaN or infinity anywhere in the inputs shows here; so do finite
-        // poses whose difference overflows f64 (coordinates near 1e308).
+        // poses whose difference overflows f64 (coordinates near 1e308). With
+        // shapes built within MAX_REACH, a shift within MAX_SHIFT keeps every
+        // magnitude of the query far from overflow (fuzzing found a shape of
+        // size 1.6e308 given a lower bound of 1e300 against a true distance
+        // of 0, before shapes were held to MAX_REACH).
         return Err(Error::NonFinitePose);
     }
     let mut answer = match (a, b) {

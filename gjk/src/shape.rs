@@ -56,6 +56,18 @@ pub struct Convex {
     single: Single,
 }
 
+/// How far a shape's vertices (or a compound's pieces) may reach from its
+/// body origin: 2^999, about 5.4e300. With the relative translation of a
+/// query held to [`MAX_SHIFT`], every sum of coordinates, rotated coordinate
+/// and support dot product of a query stays below 2^1006, far from f64's
+/// overflow at 2^1024: beyond, a query could overflow and certify bounds
+/// that do not hold, so such shapes are refused when built.
+pub(crate) const MAX_REACH: f64 = 5.357543035931337e300;
+
+/// How far apart (each coordinate of the relative translation) two shapes
+/// may be in a query: 2^1000, about 1.07e301.
+pub(crate) const MAX_SHIFT: f64 = 1.0715086071862673e301;
+
 /// Shapes with fewer vertices keep the f64 scan under
 /// [`Precision::Single`](crate::Precision::Single): one or two vector steps
 /// cost less than the direction's conversion.
@@ -94,7 +106,8 @@ impl Convex {
     ///
     /// # Errors
     /// [`Error::EmptyVertices`] for no vertices, [`Error::TooManyVertices`] past
-    /// `u32::MAX`, [`Error::NonFiniteVertex`] for NaN or infinity, and
+    /// `u32::MAX`, [`Error::NonFiniteVertex`] for NaN or infinity or a set
+    /// reaching more than 2^999 (about 5e300) from the body origin, and
     /// [`Error::InvalidRadius`] for a negative or non-finite radius.
     pub fn new(vertices: impl Into<Vec<Point3<f64>>>, radius: f64) -> Result<Self, Error> {
         let vertices = vertices.into();
@@ -151,7 +164,7 @@ impl Convex {
             size2 = size2.max(Vector3::new(xs[i] * k, ys[i] * k, zs[i] * k).norm_squared());
         }
         let size = size2.sqrt() * inv_k;
-        if !size.is_finite() {
+        if !size.is_finite() || robust_norm(&centroid.coords) + size > MAX_REACH {
             return Err(Error::NonFiniteVertex(0));
         }
         // Pad the scan arrays to whole vector steps with copies of vertex 0:
@@ -259,6 +272,13 @@ impl Convex {
     /// `|centroid|`.
     pub(crate) fn centroid_norm(&self) -> f64 {
         self.centroid_norm
+    }
+
+    /// How far the shape's core reaches from its body origin: `|centroid| +
+    /// size`, an upper bound on every vertex's distance from it.
+    #[inline]
+    pub(crate) fn reach(&self) -> f64 {
+        self.centroid_norm + self.size
     }
 
     /// The largest distance from the centroid to a vertex: `D(coZ - z̄)` of (6.4),
@@ -402,7 +422,8 @@ impl Compound {
     /// # Errors
     /// [`Error::EmptyCompound`] for no pieces, [`Error::TooManyVertices`] past
     /// `u32::MAX` pieces, and [`Error::NonFinitePose`] for an offset with NaN or
-    /// infinity.
+    /// infinity, or a piece reaching more than 2^999 (about 5e300) from the
+    /// compound's body origin.
     pub fn new(pieces: Vec<(Isometry3<f64>, Convex)>) -> Result<Self, Error> {
         if pieces.is_empty() {
             return Err(Error::EmptyCompound);
@@ -411,6 +432,14 @@ impl Compound {
             return Err(Error::TooManyVertices(pieces.len()));
         }
         if pieces.iter().any(|(offset, _)| !pose_is_finite(offset)) {
+            return Err(Error::NonFinitePose);
+        }
+        // Each piece within MAX_REACH of the compound's body origin, so that
+        // a query's magnitudes stay far from overflow (see MAX_REACH).
+        if pieces
+            .iter()
+            .any(|(o, c)| robust_norm(&o.translation.vector) + c.reach() > MAX_REACH)
+        {
             return Err(Error::NonFinitePose);
         }
         Ok(Self { pieces })
@@ -517,6 +546,17 @@ pub(crate) fn robust_norm(v: &Vector3<f64>) -> f64 {
     }
     let (k, inv_k) = pow2_scale(v.amax());
     (v * k).norm() * inv_k
+}
+
+/// Whether the relative pose of a query is finite and its translation
+/// within [`MAX_SHIFT`] on every axis. Comparisons are false for NaN, and
+/// `&` keeps them branch-free.
+#[inline]
+pub(crate) fn shift_is_in_range(p: &Isometry3<f64>) -> bool {
+    let t = &p.translation.vector;
+    let q = &p.rotation.coords;
+    let q0 = (q.x * 0.0 + q.y * 0.0) + (q.z * 0.0 + q.w * 0.0);
+    (t.x.abs() <= MAX_SHIFT) & (t.y.abs() <= MAX_SHIFT) & (t.z.abs() <= MAX_SHIFT) & (q0 == 0.0)
 }
 
 pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {

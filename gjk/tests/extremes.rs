@@ -434,8 +434,9 @@ fn scales_and_gaps() {
     run(&cases);
 }
 
-/// The whole f64 range: objects of size 2^-1000 (1e-301) to 2^1000 (1e301),
-/// rotated, with gaps from their size down to touching. The cofactors are
+/// The whole f64 range: objects of size 2^-1000 (1e-301) to 2^996 (7e299,
+/// whose reach stays within the 2^1000 a query accepts), rotated, with gaps
+/// from their size down to touching. The cofactors are
 /// products of up to three squared lengths, so without the run's scaling
 /// they leave f64 beyond about 1e±50 (at 1e-300 they used to vanish and
 /// certify [0, 0] around a true distance of 1e-300). The scales are powers
@@ -443,7 +444,7 @@ fn scales_and_gaps() {
 #[test]
 fn the_whole_range_of_scales() {
     let mut cases = Vec::new();
-    for e in [-1000, -600, -300, -150, 150, 300, 600, 1000] {
+    for e in [-1000, -600, -300, -150, 150, 300, 600, 996] {
         let s = 2f64.powi(e);
         for rot in rotations() {
             for g in [1.0, 1e-6, 0.0] {

@@ -171,12 +171,16 @@ fn points_whose_squared_gap_underflows() {
 /// the f32 search could not normalise them and picked vertex 0, and the
 /// lower bound (3.8e301) exceeded a plain vertex-pair distance (3.4e299).
 /// Now the rotation stays unscaled, and a direction the f32 search cannot
-/// normalise goes to the f64 scan.
+/// normalise goes to the f64 scan (tested on its own in `shape.rs`). As
+/// found, the set reaches beyond 2^1000 and the query is now refused (see
+/// `beyond_2_to_the_1000`); it is kept scaled by 2^-30 (exact but for the
+/// subnormal coordinates), where it is answered and its bounds must hold.
 #[test]
 fn subnormal_search_directions_at_1e307() {
-    let p = Point3::new;
+    let s = 2f64.powi(-30);
+    let p = |x: f64, y: f64, z: f64| Point3::new(x * s, y * s, z * s);
     let h = 1.1700000000000001e302;
-    let a = Convex::new(vec![p(2.13033543e-314, h, h), p(h, h, h)], h).unwrap();
+    let a = Convex::new(vec![p(2.13033543e-314, h, h), p(h, h, h)], h * s).unwrap();
     let mut bv = vec![p(h, h, h); 5];
     bv.extend([
         p(h, h, 1e300),
@@ -191,11 +195,11 @@ fn subnormal_search_directions_at_1e307() {
     bv.extend([p(h, 1e300, 0.0625), p(0.0625, 0.125, 33.686018)]);
     let b = Convex::new(bv.clone(), 0.0).unwrap();
     let pa = Isometry3::from_parts(
-        Translation3::new(33.686018, 0.131329, 6.475817e-318),
+        Translation3::from(p(33.686018, 0.131329, 6.475817e-318).coords),
         UnitQuaternion::identity(),
     );
     let pb = Isometry3::from_parts(
-        Translation3::new(0.1, 0.0625, 0.0625),
+        Translation3::from(p(0.1, 0.0625, 0.0625).coords),
         UnitQuaternion::new_unchecked(Quaternion::new(
             0.5773502691896258,
             0.5773502691896258,
@@ -210,10 +214,10 @@ fn subnormal_search_directions_at_1e307() {
         for y in bv.iter().map(|v| pb * v) {
             let d = x - y;
             let m = d.amax();
-            vertex_bound = vertex_bound.min(m * (d / m).norm() - h);
+            vertex_bound = vertex_bound.min(m * (d / m).norm() - h * s);
         }
     }
-    assert!(vertex_bound < 4e299, "{vertex_bound:e}");
+    assert!(vertex_bound < 4e299 * s, "{vertex_bound:e}");
     let (a, b): (Shape, Shape) = (a.into(), b.into());
     for precision in [gjk::Precision::Double, gjk::Precision::Single] {
         for margin in [None, Some(0.0625)] {
@@ -234,4 +238,73 @@ fn subnormal_search_directions_at_1e307() {
             );
         }
     }
+}
+
+/// A shape reaching 1.8e308 from its body origin (size 1.6e308): the
+/// support's dot products overflowed, and a lower bound of 1e300 was
+/// certified where two vertices overlapped. Shapes reaching beyond 2^999
+/// are now refused when built, and queries of shapes more than 2^1000 apart;
+/// just inside, queries are answered and their bounds hold.
+#[test]
+fn beyond_2_to_the_1000() {
+    let p = Point3::new;
+    let huge = vec![
+        p(15.875, 1e300, 5.0625),
+        p(5.0625, -1106.903131, 10.125),
+        p(0.0, 1.793962574802566e308, 15.875),
+    ];
+    assert_eq!(
+        Convex::new(huge, 0.0625).unwrap_err(),
+        gjk::Error::NonFiniteVertex(0)
+    );
+    let edge = 2f64.powi(999);
+    assert!(Convex::new(vec![p(0.0, 0.0, 0.0), p(edge, 0.0, 0.0)], 0.0).is_ok());
+    assert!(Convex::new(vec![p(0.0, 0.0, 0.0), p(edge * 1.01, 0.0, 0.0)], 0.0).is_err());
+    let a: Shape = Convex::new(
+        vec![
+            p(2.625, 1.0625, -421.075226),
+            p(-3.25, -3.25, 0.0),
+            p(0.0625, 4.5625, 4.5625),
+            p(4.5625, 4.5625, 4.5625),
+            p(0.0625, 0.125, 0.0625),
+            p(4.5625, 0.0, -2.125),
+        ],
+        15.875,
+    )
+    .unwrap()
+    .into();
+    let ball = Convex::sphere(1.0).unwrap();
+    assert_eq!(
+        gjk::Compound::new(vec![(Isometry3::translation(0.0, edge * 1.01, 0.0), ball)])
+            .unwrap_err(),
+        gjk::Error::NonFinitePose
+    );
+    // Two shapes 2^1001 apart are refused; 2^999 apart they are answered,
+    // within the requirement.
+    let far = 2f64.powi(1001);
+    let o = Options::default();
+    assert_eq!(
+        distance(
+            &a,
+            &Isometry3::identity(),
+            &a,
+            &Isometry3::translation(far, 0.0, 0.0),
+            &o,
+            None
+        ),
+        Err(gjk::Error::NonFinitePose)
+    );
+    let near = 2f64.powi(999);
+    let ans = check(
+        &a,
+        &Isometry3::identity(),
+        &a,
+        &Isometry3::translation(near, 0.0, 0.0),
+        &o,
+    );
+    assert!((ans.distance - near).abs() <= 1e-6 * near, "{ans:?}");
+    assert!(
+        ans.lower <= near && near <= ans.upper * (1.0 + 1e-15),
+        "{ans:?}"
+    );
 }

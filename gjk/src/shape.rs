@@ -164,7 +164,8 @@ impl Convex {
             size2 = size2.max(Vector3::new(xs[i] * k, ys[i] * k, zs[i] * k).norm_squared());
         }
         let size = size2.sqrt() * inv_k;
-        if !size.is_finite() || robust_norm(&centroid.coords) + size > MAX_REACH {
+        let centroid_norm = robust_norm(&centroid.coords);
+        if !size.is_finite() || centroid_norm + size > MAX_REACH {
             return Err(Error::NonFiniteVertex(0));
         }
         // Pad the scan arrays to whole vector steps with copies of vertex 0:
@@ -204,7 +205,7 @@ impl Convex {
             vertices,
             radius,
             centroid,
-            centroid_norm: robust_norm(&centroid.coords),
+            centroid_norm,
             size,
             xs,
             ys,

@@ -841,16 +841,10 @@ fn precision_by_size(args: &TradeoffArgs) -> Result<BySize, BenchError> {
                 Isometry3::from_parts(Translation3::from(pa.translation.vector + rot * rel), rot);
             let local =
                 rot.inverse_transform_vector(&(pb.translation.vector - pa.translation.vector));
-            let mut s2 = 0.0;
-            for i in 0..3 {
-                let g = local[i].abs() - ha[i] - hb[i];
-                if g > 0.0 {
-                    s2 += g * g;
-                }
-            }
+            let truth = reference::aabb_distance(&Vector3::zeros(), &ha, &local, &hb);
             let before = step_back(&pb, size);
             let warm = gjk::distance(&a, &pa, &b, &before, &Options::default(), None)?.warm_start;
-            qs.push((pa, pb, s2.sqrt(), warm));
+            qs.push((pa, pb, truth, warm));
         }
         cases.push((n, a, b, qs));
     }

@@ -29,6 +29,7 @@
 
 #![warn(missing_docs)]
 
+mod blocks;
 mod dd;
 mod johnson;
 pub mod paper;

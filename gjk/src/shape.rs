@@ -8,6 +8,7 @@
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::Error;
+use crate::blocks::Blocks;
 
 /// A convex object: the convex hull of a vertex set, grown by a radius `r >= 0`
 /// (the paper's r-spherical extension, Section 2).
@@ -50,10 +51,12 @@ pub struct Convex {
     kind: Kind,
     /// The scanned vertices again in f32, divided by `size` so that every
     /// coordinate lies in [-1, 1] (no overflow, whatever the shape's scale),
-    /// for [`Precision::Single`](crate::Precision::Single). Empty for shapes
-    /// that gain nothing from it: closed-form supports and fewer than
-    /// [`SINGLE_MIN_VERTICES`] vertices.
-    single: Single,
+    /// for [`Precision::Single`](crate::Precision::Single). None for shapes
+    /// that gain nothing from it: closed-form supports, fewer than
+    /// [`SINGLE_MIN_VERTICES`] vertices, and [`SINGLE_MAX_VERTICES`] or more.
+    single: Option<Box<Single>>,
+    /// The block search's reordered copy, for [`Kind::Blocks`].
+    blocks: Option<Box<Blocks>>,
 }
 
 /// How far a shape's vertices (or a compound's pieces) may reach from its
@@ -73,8 +76,14 @@ pub(crate) const MAX_SHIFT: f64 = 1.0715086071862673e301;
 /// cost less than the direction's conversion.
 pub(crate) const SINGLE_MIN_VERTICES: usize = 16;
 
+/// Shapes with this many vertices or more keep the exact block search under
+/// [`Precision::Single`](crate::Precision::Single): from about here it is as
+/// fast as the f32 scan of every vertex, and beyond it faster (measured in
+/// `gjkd bench tradeoff`, see `docs/speed-accuracy.md`).
+pub(crate) const SINGLE_MAX_VERTICES: usize = 1024;
+
 /// The f32 copy of a shape's scan arrays.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 struct Single {
     xs: Vec<f32>,
     ys: Vec<f32>,
@@ -97,8 +106,12 @@ enum Kind {
     /// taking `+` on axis `k` when bit `k` of `i` is set ([`Convex::cuboid`]'s
     /// order): the support index is the sign bits of the direction.
     Box,
-    /// Anything else: the linear scan.
+    /// Fewer than [`blocks::MIN_VERTICES`](crate::blocks::MIN_VERTICES)
+    /// vertices otherwise: the linear scan.
     Scan,
+    /// Larger sets: the block search, exact and the scan's own choice, which
+    /// skips blocks of vertices that cannot hold the support point.
+    Blocks,
 }
 
 impl Convex {
@@ -181,25 +194,28 @@ impl Convex {
             Kind::Point
         } else if is_box(&xs, &ys, &zs) {
             Kind::Box
+        } else if len >= crate::blocks::MIN_VERTICES {
+            Kind::Blocks
         } else {
             Kind::Scan
         };
+        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
         // Indices ride in i32 lanes in the f32 scan.
-        let single = if kind == Kind::Scan
-            && len >= SINGLE_MIN_VERTICES
+        let single = if matches!(kind, Kind::Scan | Kind::Blocks)
+            && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
             && i32::try_from(xs.len()).is_ok()
             && size > 0.0
             && (1.0 / size).is_finite()
         {
             let inv = 1.0 / size;
             let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
-            Single {
+            Some(Box::new(Single {
                 xs: to32(&xs),
                 ys: to32(&ys),
                 zs: to32(&zs),
-            }
+            }))
         } else {
-            Single::default()
+            None
         };
         Ok(Self {
             vertices,
@@ -212,6 +228,7 @@ impl Convex {
             zs,
             kind,
             single,
+            blocks,
         })
     }
 
@@ -315,15 +332,30 @@ impl Convex {
             Kind::Box => {
                 usize::from(d.x > 0.0) | usize::from(d.y > 0.0) << 1 | usize::from(d.z > 0.0) << 2
             }
-            Kind::Scan => self.scan_index(d),
+            // One arm for both: the branch between them is taken out of
+            // line, where it costs the family's small shapes nothing
+            // measurable (a fourth arm here cost 1 %).
+            Kind::Scan | Kind::Blocks => self.search_index(d),
         }
+    }
+
+    /// [`support_index`](Self::support_index) by the block search when the
+    /// shape has one, else (or for a direction it declines) the scan.
+    #[inline(never)]
+    fn search_index(&self, d: &Vector3<f64>) -> usize {
+        if let Some(blocks) = self.blocks.as_deref()
+            && let Some(i) = blocks.support(d)
+        {
+            return i;
+        }
+        self.scan_index(d)
     }
 
     /// Whether [`support_index_single`](Self::support_index_single) scans in
     /// f32 (and so may miss the support value by `SINGLE_SLACK · size · |d|`).
     #[inline(always)]
     pub(crate) fn has_single(&self) -> bool {
-        !self.single.xs.is_empty()
+        self.single.is_some()
     }
 
     /// [`support_index`](Self::support_index) for
@@ -356,7 +388,9 @@ impl Convex {
         // round-off, and |u| <= √3 |d| / m keeps the error bound in |d|.
         let u = d * inv;
         let d32 = [u.x as f32, u.y as f32, u.z as f32];
-        let s = &self.single;
+        let Some(s) = self.single.as_deref() else {
+            return self.scan_index(d);
+        };
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx2")
@@ -369,9 +403,10 @@ impl Convex {
         scan_single(&s.xs, &s.ys, &s.zs, d32)
     }
 
-    /// [`support_index`](Self::support_index) by the scan, out of line: the
-    /// closed forms are inlined into the query, the scan is not.
-    #[inline(never)]
+    /// [`support_index`](Self::support_index) by the scan, inlined into its
+    /// out-of-line callers: the closed forms are inlined into the query, the
+    /// scan is not.
+    #[inline(always)]
     fn scan_index(&self, d: &Vector3<f64>) -> usize {
         #[cfg(target_arch = "x86_64")]
         {
@@ -383,7 +418,13 @@ impl Convex {
                 return unsafe { scan_avx2(&self.xs, &self.ys, &self.zs, d) };
             }
         }
-        scan(&self.xs, &self.ys, &self.zs, d)
+        scan_top(&self.xs, &self.ys, &self.zs, d).1
+    }
+
+    /// The block search's data, for shapes that have it.
+    #[cfg(test)]
+    pub(crate) fn blocks(&self) -> Option<&Blocks> {
+        self.blocks.as_deref()
     }
 
     /// Vertex `i` relative to the centroid, as stored for the scan.
@@ -571,9 +612,10 @@ pub(crate) fn pose_is_finite(p: &Isometry3<f64>) -> bool {
 
 /// The support scan on 4 independent lanes. Each lane keeps its running maximum
 /// and the index (as f64, exact below 2^53) through selects, not branches, so
-/// the loop vectorises; lanes are merged lowest index first on ties.
+/// the loop vectorises; lanes are merged lowest index first on ties. Returns
+/// the largest dot product and its index.
 #[inline(always)]
-fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+pub(crate) fn scan_top(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize) {
     const LANES: usize = 4;
     let n = xs.len().min(ys.len()).min(zs.len());
     let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
@@ -589,7 +631,7 @@ fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
                 idx = i;
             }
         }
-        return idx;
+        return (top, idx);
     }
     let mut best = [f64::NEG_INFINITY; LANES];
     let mut best_i = [0.0f64; LANES];
@@ -625,18 +667,24 @@ fn scan(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
             idx = i;
         }
     }
-    idx
+    (top, idx)
 }
 
-/// [`scan`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
+/// [`scan_top`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
 /// lanes, so the two compare-and-select chains overlap, and the comparison
-/// mask used as it is (the compiler's own vectorisation of [`scan`] spends
+/// mask used as it is (the compiler's own vectorisation of [`scan_top`] spends
 /// five instructions per step converting it to booleans and back). Dot
-/// products are fused multiply-adds, so they may differ from [`scan`]'s in
+/// products are fused multiply-adds, so they may differ from [`scan_top`]'s in
 /// the last bit; either vertex of such a near-tie is a valid support point.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+#[inline]
+pub(crate) unsafe fn scan_avx2_top(
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    d: &Vector3<f64>,
+) -> (f64, usize) {
     use std::arch::x86_64::*;
     let n = xs.len().min(ys.len()).min(zs.len());
     let full = n - n % 8;
@@ -709,7 +757,17 @@ unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usi
             idx = i;
         }
     }
-    idx
+    (top, idx)
+}
+
+/// [`scan_avx2_top`]'s index alone, its own function so that the query's
+/// plain scan returns one register, as it did before the block search
+/// needed the value too (1 % of a family query, measured).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+    // SAFETY: this function's own target features are the callee's.
+    unsafe { scan_avx2_top(xs, ys, zs, d).1 }
 }
 
 /// The f32 support scan, portable: 8 lanes, any vertex of the largest dot
@@ -973,7 +1031,7 @@ mod tests {
                         }
                         let best = c.local(brute(&c, &d)).dot(&d);
                         let slack = SINGLE_SLACK * c.size() * d.norm();
-                        let s = &c.single;
+                        let s = c.single.as_deref().unwrap();
                         let d32 = {
                             let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
                             let u = d * (1.0 / m);
@@ -1038,7 +1096,19 @@ mod tests {
         )
         .unwrap();
         let cube = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.0).unwrap();
-        for c in [small, cube] {
+        // So do sets large enough for the block search, which is faster.
+        let large = Convex::new(
+            (0..SINGLE_MAX_VERTICES)
+                .map(|i| {
+                    let a = i as f64 * 0.37;
+                    Point3::new(a.cos(), a.sin(), (i % 17) as f64 * 0.1)
+                })
+                .collect::<Vec<_>>(),
+            0.0,
+        )
+        .unwrap();
+        assert_eq!(large.kind, Kind::Blocks);
+        for c in [small, cube, large] {
             assert!(!c.has_single());
             let d = Vector3::new(0.3, -0.8, 0.1);
             assert_eq!(c.support_index_single(&d), brute(&c, &d));

@@ -48,9 +48,17 @@ impl Bytes<'_> {
 
     fn convex(&mut self) -> Option<Convex> {
         let n = 1 + usize::from(self.u8() % 24);
-        let points: Vec<Point3<f64>> = (0..n)
+        let mut points: Vec<Point3<f64>> = (0..n)
             .map(|_| Point3::new(self.f64(), self.f64(), self.f64()))
             .collect();
+        if self.u8() % 8 == 0 {
+            // Large enough for the block search: scaled copies of the drawn
+            // points, so that extremes and exact ties repeat across blocks.
+            let steps = [1.0, 0.5, 0.25, 1.0 - 1e-9, 0.999];
+            points = (0..512 + n)
+                .map(|k| points[k % n] * steps[(k / n) % steps.len()])
+                .collect();
+        }
         let radius = if self.u8() % 2 == 0 { 0.0 } else { self.f64() };
         Convex::new(points, radius).ok()
     }

@@ -73,8 +73,12 @@ impl Blocks {
     /// arrays (which may be longer, padded for the plain scan).
     pub(crate) fn new(xs: &[f64], ys: &[f64], zs: &[f64], n: usize) -> Self {
         let block = block_size(n);
-        let mut order: Vec<u32> = (0..n as u32).collect();
-        split(&mut order, [&xs[..n], &ys[..n], &zs[..n]], block);
+        // The points themselves are partitioned, not indices into them:
+        // the splits then read memory in order (3× faster to build at 10^6
+        // vertices than through indices, measured).
+        let mut pts: Vec<([f64; 3], u32)> =
+            (0..n).map(|i| ([xs[i], ys[i], zs[i]], i as u32)).collect();
+        split(&mut pts, block);
         let count = n.div_ceil(block);
         let mut out = Blocks {
             xs: Vec::with_capacity(count * block),
@@ -88,18 +92,16 @@ impl Blocks {
             count,
             block,
         };
-        for chunk in order.chunks(block) {
-            let first = chunk[0];
+        for chunk in pts.chunks(block) {
             let padded = chunk
                 .iter()
-                .copied()
-                .chain(std::iter::repeat_n(first, block - chunk.len()));
+                .chain(std::iter::repeat_n(&chunk[0], block - chunk.len()));
             let (mut lo, mut hi) = (
                 Vector3::repeat(f64::INFINITY),
                 Vector3::repeat(f64::NEG_INFINITY),
             );
-            for i in padded {
-                let v = Vector3::new(xs[i as usize], ys[i as usize], zs[i as usize]);
+            for &(p, i) in padded {
+                let v = Vector3::from(p);
                 lo = lo.inf(&v);
                 hi = hi.sup(&v);
                 out.xs.push(v.x);
@@ -111,9 +113,8 @@ impl Blocks {
             // f64::MAX cannot overflow in the sum.
             let c = lo * 0.5 + hi * 0.5;
             let mut r: f64 = 0.0;
-            for &i in chunk {
-                let v = Vector3::new(xs[i as usize], ys[i as usize], zs[i as usize]);
-                r = r.max(robust_norm(&(v - c)));
+            for (p, _) in chunk {
+                r = r.max(robust_norm(&(Vector3::from(*p) - c)));
             }
             out.cx.push(c.x);
             out.cy.push(c.y);
@@ -297,39 +298,32 @@ impl Blocks {
     }
 }
 
-/// Order `idx` so that each run of `block` is a cell of a k-d split: halve
+/// Order `pts` so that each run of `block` is a cell of a k-d split: halve
 /// along the widest extent, at a multiple of `block` so that every block but
 /// the last is full, until a part fits one block; within a block, the
 /// caller's order.
-fn split(idx: &mut [u32], c: [&[f64]; 3], block: usize) {
-    if idx.len() <= block {
-        idx.sort_unstable();
+fn split(pts: &mut [([f64; 3], u32)], block: usize) {
+    if pts.len() <= block {
+        pts.sort_unstable_by_key(|p| p.1);
         return;
     }
-    let mut widest = (0, f64::NEG_INFINITY);
-    for (axis, coord) in c.iter().enumerate() {
-        let (lo, hi) = idx
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
-                let x = coord[i as usize];
-                (lo.min(x), hi.max(x))
-            });
-        // Halves first, so that the extent of coordinates near f64::MAX
-        // does not overflow.
-        let extent = hi * 0.5 - lo * 0.5;
-        if extent > widest.1 {
-            widest = (axis, extent);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (p, _) in pts.iter() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
         }
     }
-    let coord = c[widest.0];
+    // Halves first, so that the extent of coordinates near f64::MAX does
+    // not overflow.
+    let extent = |k: usize| hi[k] * 0.5 - lo[k] * 0.5;
+    let axis = (1..3).fold(0, |best, k| if extent(k) > extent(best) { k } else { best });
     // len > block, so block <= mid < len.
-    let mid = (idx.len() / 2).div_ceil(block) * block;
-    idx.select_nth_unstable_by(mid, |&a, &b| {
-        coord[a as usize].total_cmp(&coord[b as usize])
-    });
-    let (left, right) = idx.split_at_mut(mid);
-    split(left, c, block);
-    split(right, c, block);
+    let mid = (pts.len() / 2).div_ceil(block) * block;
+    pts.select_nth_unstable_by(mid, |a, b| a.0[axis].total_cmp(&b.0[axis]));
+    let (left, right) = pts.split_at_mut(mid);
+    split(left, block);
+    split(right, block);
 }
 
 #[cfg(test)]

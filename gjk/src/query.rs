@@ -40,14 +40,16 @@ pub enum Precision {
     /// f64: the exact support point; the distance is exact to the tolerance.
     #[default]
     Double,
-    /// f32 for shapes of 16 vertices or more (twice the vector lanes; smaller
-    /// and closed-form shapes keep the exact support). The support point may
-    /// then fall short of the true one by 2⁻²⁰ of the shape's size, so the
-    /// distance is exact to the tolerance plus about `1e-6 × (size of A +
-    /// size of B)`, and the lower bound is lowered by that much.
+    /// f32 for shapes of 16 to 1 023 vertices (twice the vector lanes;
+    /// smaller and closed-form shapes keep the exact support, and larger
+    /// ones the exact block search, faster there than any scan of every
+    /// vertex). The support point may then fall short of the true one by
+    /// 2⁻²⁰ of the shape's size, so the distance is exact to the tolerance
+    /// plus about `1e-6 × (size of A + size of B)`, and the lower bound is
+    /// lowered by that much.
     ///
-    /// It pays on large vertex sets only: about 1.5× at 1 000 vertices and
-    /// 1.8× at 16 000 per shape, nothing measurable below 100 (see
+    /// It pays on a few hundred vertices only: about 1.17× at 256 vertices
+    /// and 1.1× to 1.26× at 512 per shape, nothing measurable below 100 (see
     /// `docs/speed-accuracy.md`). The f32 copy it scans is made when the
     /// shape is built (12 bytes a vertex), whatever the queries ask for.
     Single,

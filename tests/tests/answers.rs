@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use gjkd_client::{Item, ItemResult, Precision, QueryOptions};
 use gjkd_e2e::{Rng, Server, Solid, assert_same, gjk_options};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Point3, Vector3};
 
 const TIMEOUT: Duration = Duration::from_secs(5);
 
@@ -13,7 +13,21 @@ const TIMEOUT: Duration = Duration::from_secs(5);
 fn single_pairs_equal_in_process_answers() {
     let server = Server::start("single", &["--wait", "spin"]);
     let mut client = server.client(TIMEOUT);
-    let zoo = Solid::zoo();
+    let mut zoo = Solid::zoo();
+    // A 2 000-point ellipsoid shell, rounded: large enough for the block
+    // search, served as in process.
+    let mut rng = Rng::new(5);
+    let shell: Vec<Point3<f64>> = (0..2000)
+        .map(|_| {
+            let v = Vector3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            Point3::from((v / v.norm().max(1e-3)).component_mul(&Vector3::new(1.2, 0.6, 0.9)))
+        })
+        .collect();
+    zoo.push(Solid::Polytope(shell, 0.02));
     let shapes: Vec<gjk::Shape> = zoo.iter().map(Solid::shape).collect();
     let ids: Vec<_> = zoo
         .iter()
@@ -34,7 +48,8 @@ fn single_pairs_equal_in_process_answers() {
             max_iterations: 2,
             ..QueryOptions::cold()
         },
-        // The zoo's 30-point cloud takes the f32 scan.
+        // The zoo's 30-point cloud takes the f32 scan, the shell the
+        // exact block search.
         QueryOptions {
             precision: Precision::Single,
             ..QueryOptions::cold()
@@ -81,7 +96,7 @@ fn single_pairs_equal_in_process_answers() {
             }
         }
     }
-    assert_eq!(checked, 250);
+    assert_eq!(checked, 360);
 }
 
 #[test]

@@ -331,18 +331,8 @@ fn split(pts: &mut [([f64; 3], u32)], block: usize) {
 mod tests {
     use super::*;
     use crate::Convex;
+    use crate::shape::tests::Rng;
     use nalgebra::Point3;
-
-    /// A small xorshift generator, uniform in [-1, 1).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        }
-    }
 
     /// The shape's vertices in the plain scan's layout, unpadded.
     fn arrays(c: &Convex) -> [Vec<f64>; 3] {

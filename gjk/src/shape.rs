@@ -898,7 +898,7 @@ unsafe fn scan_single_avx2(xs: &[f32], ys: &[f32], zs: &[f32], d: [f32; 3]) -> u
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// The support index by brute force: the first vertex of largest `v·d`.
@@ -971,10 +971,11 @@ mod tests {
         }
     }
 
-    /// A small xorshift generator: the test needs no more.
-    struct Rng(u64);
+    /// A small xorshift generator, uniform in [-1, 1): the tests need no
+    /// more. Shared with the block search's tests.
+    pub(crate) struct Rng(pub(crate) u64);
     impl Rng {
-        fn next(&mut self) -> f64 {
+        pub(crate) fn next(&mut self) -> f64 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;

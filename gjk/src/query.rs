@@ -42,8 +42,8 @@ pub enum Precision {
     Double,
     /// f32 for shapes of 16 to 1 023 vertices (twice the vector lanes;
     /// smaller and closed-form shapes keep the exact support, and larger
-    /// ones the exact block search, faster there than any scan of every
-    /// vertex). The support point may then fall short of the true one by
+    /// ones the exact block search, which from there on keeps up with the
+    /// f32 scan of every vertex and soon beats it). The support point may then fall short of the true one by
     /// 2⁻²⁰ of the shape's size, so the distance is exact to the tolerance
     /// plus about `1e-6 × (size of A + size of B)`, and the lower bound is
     /// lowered by that much.

@@ -67,8 +67,6 @@ pub(crate) struct Blocks {
     count: usize,
     /// Vertices per block.
     block: usize,
-    /// The position of each of the caller's indices: where a hint's block is.
-    pos: Vec<u32>,
 }
 
 impl Blocks {
@@ -94,7 +92,6 @@ impl Blocks {
             r: Vec::with_capacity(count),
             count,
             block,
-            pos: vec![0; n],
         };
         for chunk in pts.chunks(block) {
             let padded = chunk
@@ -125,10 +122,6 @@ impl Blocks {
             out.cz.push(c.z);
             out.r.push(r + (robust_norm(&c) + r) * GROW);
         }
-        // Padding copies come after their original: the first position wins.
-        for (at, &i) in out.perm.iter().enumerate().rev() {
-            out.pos[i as usize] = at as u32;
-        }
         let padded = count.div_ceil(4) * 4;
         out.cx.resize(padded, 0.0);
         out.cy.resize(padded, 0.0);
@@ -141,7 +134,7 @@ impl Blocks {
     /// product with `d`, the plain scan's choice; `None` for a direction
     /// whose length is too small or too large for the bounds' error analysis
     /// (or not finite), which the caller then scans plainly.
-    pub(crate) fn support(&self, d: &Vector3<f64>, hint: u32) -> Option<usize> {
+    pub(crate) fn support(&self, d: &Vector3<f64>) -> Option<usize> {
         let len = d.norm();
         if !(len > 1e-150 && len < 1e150) {
             return None;
@@ -152,24 +145,16 @@ impl Blocks {
                 && std::arch::is_x86_feature_detected!("fma")
             {
                 // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-                return Some(unsafe { self.search_avx2(d, len, hint) }.0);
+                return Some(unsafe { self.search_avx2(d, len) }.0);
             }
         }
-        Some(self.search(d, len, hint).0)
-    }
-
-    /// The block holding the caller's vertex `hint`, if it names one.
-    #[inline(always)]
-    fn hinted(&self, hint: u32) -> Option<usize> {
-        self.pos
-            .get(hint as usize)
-            .map(|&p| p as usize / self.block)
+        Some(self.search(d, len).0)
     }
 
     /// The search, portable: the first block is the one of highest bound,
     /// then every block whose bound reaches the best dot product found.
     /// Returns the index and the number of blocks scanned.
-    fn search(&self, d: &Vector3<f64>, len: f64, hint: u32) -> (usize, usize) {
+    fn search(&self, d: &Vector3<f64>, len: f64) -> (usize, usize) {
         let scan = scan_top;
         // Every computed dot product of a vertex of block b is at most
         // bound(b): |v·d - c·d| <= r|d|, and GROW covers the rounding of both
@@ -180,20 +165,14 @@ impl Blocks {
             (self.cx[b] * d.x + self.cy[b] * d.y + self.cz[b] * d.z) + (self.r[b] * len + TINY)
         };
         let blocks = self.count;
-        let first = match self.hinted(hint) {
-            Some(b) => b,
-            None => {
-                let mut first = 0;
-                let mut first_bound = bound(0);
-                for b in 1..blocks {
-                    let u = bound(b);
-                    if u > first_bound {
-                        (first, first_bound) = (b, u);
-                    }
-                }
-                first
+        let mut first = 0;
+        let mut first_bound = bound(0);
+        for b in 1..blocks {
+            let u = bound(b);
+            if u > first_bound {
+                (first, first_bound) = (b, u);
             }
-        };
+        }
         let size = self.block;
         let at = |b: usize| b * size..(b + 1) * size;
         let block = |b: usize| {
@@ -223,7 +202,7 @@ impl Blocks {
     /// uses on such a CPU, so both compute the same dot products.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn search_avx2(&self, d: &Vector3<f64>, len: f64, hint: u32) -> (usize, usize) {
+    unsafe fn search_avx2(&self, d: &Vector3<f64>, len: f64) -> (usize, usize) {
         use std::arch::x86_64::*;
         let (dx, dy, dz) = (
             _mm256_set1_pd(d.x),
@@ -250,40 +229,34 @@ impl Blocks {
             let cd = _mm256_fmadd_pd(z, dz, _mm256_fmadd_pd(y, dy, _mm256_mul_pd(x, dx)));
             _mm256_add_pd(cd, _mm256_fmadd_pd(r, l, tiny))
         };
-        // Pass 1: the block of highest bound (any of them on a tie), unless
-        // a hint names where to start.
-        let first = match self.hinted(hint) {
-            Some(b) => b,
-            None => {
-                let mut top = _mm256_set1_pd(f64::NEG_INFINITY);
-                let mut top_i = _mm256_setzero_pd();
-                let mut base = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
-                let step = _mm256_set1_pd(4.0);
-                let mut k = 0;
-                while k + 4 <= padded {
-                    let u = bound4(k);
-                    let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(u, top);
-                    top = _mm256_blendv_pd(top, u, gt);
-                    top_i = _mm256_blendv_pd(top_i, base, gt);
-                    base = _mm256_add_pd(base, step);
-                    k += 4;
-                }
-                let (mut tops, mut tops_i) = ([0.0f64; 4], [0.0f64; 4]);
-                // SAFETY: both arrays hold four f64.
-                unsafe {
-                    _mm256_storeu_pd(tops.as_mut_ptr(), top);
-                    _mm256_storeu_pd(tops_i.as_mut_ptr(), top_i);
-                }
-                let mut first = tops_i[0] as usize;
-                let mut first_bound = tops[0];
-                for j in 1..4 {
-                    if tops[j] > first_bound {
-                        (first, first_bound) = (tops_i[j] as usize, tops[j]);
-                    }
-                }
-                first.min(self.count - 1)
+        // Pass 1: the block of highest bound (any of them on a tie).
+        let mut top = _mm256_set1_pd(f64::NEG_INFINITY);
+        let mut top_i = _mm256_setzero_pd();
+        let mut base = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+        let step = _mm256_set1_pd(4.0);
+        let mut k = 0;
+        while k + 4 <= padded {
+            let u = bound4(k);
+            let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(u, top);
+            top = _mm256_blendv_pd(top, u, gt);
+            top_i = _mm256_blendv_pd(top_i, base, gt);
+            base = _mm256_add_pd(base, step);
+            k += 4;
+        }
+        let (mut tops, mut tops_i) = ([0.0f64; 4], [0.0f64; 4]);
+        // SAFETY: both arrays hold four f64.
+        unsafe {
+            _mm256_storeu_pd(tops.as_mut_ptr(), top);
+            _mm256_storeu_pd(tops_i.as_mut_ptr(), top_i);
+        }
+        let mut first = tops_i[0] as usize;
+        let mut first_bound = tops[0];
+        for j in 1..4 {
+            if tops[j] > first_bound {
+                (first, first_bound) = (tops_i[j] as usize, tops[j]);
             }
-        };
+        }
+        let first = first.min(self.count - 1);
         let block = |b: usize| {
             let r = b * self.block..(b + 1) * self.block;
             // SAFETY: the caller's CPU has AVX2 and FMA (this function's
@@ -358,7 +331,6 @@ fn split(pts: &mut [([f64; 3], u32)], block: usize) {
 mod tests {
     use super::*;
     use crate::Convex;
-    use crate::shape::NO_HINT;
     use crate::shape::tests::Rng;
     use nalgebra::Point3;
 
@@ -433,7 +405,7 @@ mod tests {
     }
 
     /// The block search returns the plain scan's own vertex, on both code
-    /// paths and from any starting block, for sets with exact ties, flat, collinear and coincident sets,
+    /// paths, for sets with exact ties, flat, collinear and coincident sets,
     /// at scales from 1e-300 to 1e290 and 1e9 from the origin, for
     /// directions of any length (those outside its range go to the scan).
     #[test]
@@ -481,23 +453,13 @@ mod tests {
                         want,
                         "{name} {scale:e} {offset:e} {d:?}"
                     );
-                    // Starting from any vertex's block finds the same one,
-                    // out-of-range hints included.
-                    let n = c.len() as u32;
-                    let hints = [0, n - 1, (k as u32 * 7919) % n, n];
-                    for hint in hints {
-                        assert_eq!(c.support_index_near(&d, hint), want, "{name} hint {hint}");
-                    }
                     let len = d.norm();
                     if len > 1e-150 && len < 1e150 {
-                        let portable = plain(&flat, &d, false);
-                        for hint in hints {
-                            assert_eq!(
-                                blocks.search(&d, len, hint).0,
-                                portable,
-                                "{name} portable, hint {hint}, {d:?}"
-                            );
-                        }
+                        assert_eq!(
+                            blocks.search(&d, len).0,
+                            plain(&flat, &d, false),
+                            "{name} portable {d:?}"
+                        );
                     }
                     checked += 1;
                 }
@@ -519,7 +481,7 @@ mod tests {
         let mut total = 0;
         for _ in 0..100 {
             let d = Vector3::new(rng.next(), rng.next(), rng.next());
-            total += blocks.search(&d, d.norm(), NO_HINT).1;
+            total += blocks.search(&d, d.norm()).1;
         }
         let per_query = total as f64 / 100.0;
         // 256 blocks of 64; a cap on the sphere of the blocks' own width.

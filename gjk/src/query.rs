@@ -5,7 +5,6 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
 use crate::Error;
 use crate::johnson::{Simplex, Solution, Vertex};
-use crate::shape::NO_HINT;
 use crate::shape::{Convex, Shape, shift_is_in_range};
 
 /// How hard to work, and when to stop early.
@@ -566,14 +565,6 @@ impl<'s> Pair<'s> {
     /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one scan of each vertex set.
     #[inline(always)]
     fn support(&self, eta: &Vector3<f64>) -> Vertex {
-        self.support_near(eta, [NO_HINT; 2])
-    }
-
-    /// [`support`](Self::support), the block search of a large set starting
-    /// from the block of `hint`'s vertex (the last support point found): a
-    /// hint changes the time, never the vertex found.
-    #[inline(always)]
-    fn support_near(&self, eta: &Vector3<f64>, hint: [u32; 2]) -> Vertex {
         let eta_b = -self.r.tr_mul(eta);
         let (ia, ib) = if self.single {
             (
@@ -581,10 +572,7 @@ impl<'s> Pair<'s> {
                 self.b.support_index_single(&eta_b),
             )
         } else {
-            (
-                self.a.support_index_near(eta, hint[0]),
-                self.b.support_index_near(&eta_b, hint[1]),
-            )
+            (self.a.support_index(eta), self.b.support_index(&eta_b))
         };
         self.vertex(ia, ib)
     }
@@ -629,7 +617,6 @@ impl<'s> Pair<'s> {
             }
             None => simplex.reset(&[self.support(&self.t)]),
         }
-        let mut hint = [simplex.vertices[0].ia, simplex.vertices[0].ib];
         let eps_d = options.tolerance * self.d;
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
@@ -708,8 +695,7 @@ impl<'s> Pair<'s> {
                     return finish(Status::Converged, sol, 0.0);
                 }
                 // Step (3): the stopping rule, and the bounds of Theorem 4.1.
-                let s = self.support_near(&-sol.v, hint);
-                hint = [s.ia, s.ib];
+                let s = self.support(&-sol.v);
                 let vs = sol.v.dot(&s.y);
                 lower = lower.max(vs / norm - self.single_slack);
                 let g = v2 - vs;

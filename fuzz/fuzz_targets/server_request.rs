@@ -62,7 +62,26 @@ fuzz_target!(|data: &[u8]| {
         let mut request = AdminRequest::new(AdminOp::Register);
         request.shape = shape_kind::CONVEX;
         request.piece_count = 1;
-        request.pieces[0].vertex_count = (tail.len() / std::mem::size_of::<Vertex>()) as u32;
+        let mut vertices = read::<Vertex>(tail);
+        if op & 0x10 != 0 && !vertices.is_empty() {
+            // Large enough for the block search (512 vertices and up), which
+            // inputs of libFuzzer's usual sizes never reach on their own:
+            // scaled copies of the given points, so that extremes and exact
+            // ties repeat across blocks.
+            let n = vertices.len();
+            let steps = [1.0, 0.5, 0.25, 1.0 - 1e-9, 0.999];
+            vertices = (0..512 + n)
+                .map(|k| {
+                    let (v, s) = (vertices[k % n], steps[(k / n) % steps.len()]);
+                    Vertex {
+                        x: v.x * s,
+                        y: v.y * s,
+                        z: v.z * s,
+                    }
+                })
+                .collect();
+        }
+        request.pieces[0].vertex_count = vertices.len() as u32;
         // SAFETY: `head` is at most the size of AdminRequest, a repr(C)
         // struct of integers, floats and byte arrays, valid for any bits.
         unsafe {
@@ -76,7 +95,6 @@ fuzz_target!(|data: &[u8]| {
         if op % 4 == 0 {
             request.op = AdminOp::Register as u32;
         }
-        let vertices = read::<Vertex>(tail);
         let reply = state.handle_admin(client, &request, &vertices);
         if reply.error == 0 && request.op == AdminOp::Register as u32 {
             assert!(state.object(reply.id).is_some(), "acknowledged but absent");

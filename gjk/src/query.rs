@@ -704,11 +704,18 @@ impl<'s> Pair<'s> {
                 // this), so once it holds the run goes on while |v| still
                 // descends, and stops early only when the certified interval,
                 // of width g/|v|, is within ε·D. A support point already in V̂
-                // proves g = 0 but for round-off: nothing is left to add.
+                // leaves nothing to add: g is then the error of v itself.
                 paper_met = g <= eps_d * self.d + self.single_slack * norm;
                 // The error of |v| is at most min(|v|, g/|v|): stop once that
-                // is within ε·D.
-                if g <= stop_d * norm || norm <= eps_d || simplex.has_pair(sol.mask, s.ia, s.ib) {
+                // is within ε·D, or within the round-off allowance when the
+                // support point repeats a vertex of V̂. Beyond that, a repeat
+                // means the subalgorithm's v is off by more than round-off
+                // (a sliver simplex at contact): step (4) is handled below.
+                if g <= stop_d * norm || norm <= eps_d {
+                    return finish(Status::Converged, sol, lower);
+                }
+                let repeat = simplex.has_pair(sol.mask, s.ia, s.ib);
+                if repeat && g <= self.slack * norm {
                     return finish(Status::Converged, sol, lower);
                 }
                 // Cutoff and margin are the world's: compared there.
@@ -732,7 +739,12 @@ impl<'s> Pair<'s> {
                     } else {
                         Status::IterationCap
                     };
-                    return finish(status, sol, lower);
+                    // The nearer of the last two iterates (see step 5).
+                    let best = match prev {
+                        Some((p, p2)) if p2 < v2 => p,
+                        _ => sol,
+                    };
+                    return finish(status, best, lower);
                 }
                 // Step (4): descend while |v| decreases and V̂ is not full. A
                 // step that only grows V̂ by a dimension, with |v| unchanged at
@@ -748,7 +760,7 @@ impl<'s> Pair<'s> {
                         ok
                     }
                 };
-                if descended && sol.mask.count_ones() <= 3 {
+                if descended && sol.mask.count_ones() <= 3 && !repeat {
                     prev = Some((sol, v2));
                     simplex.push(sol.mask, s);
                     break;
@@ -756,16 +768,21 @@ impl<'s> Pair<'s> {
                 // Step (5): round-off has the last word. The previous iterate,
                 // if nearer, is still valid: its vertices kept their slots.
                 // When (6.2) holds the paper would have stopped at step (3):
-                // no Backup Procedure is needed to confirm that.
-                if by_backup || paper_met {
-                    let best = match prev {
-                        Some((p, p2)) if p2 < v2 => p,
-                        _ => sol,
-                    };
+                // no Backup Procedure is needed to confirm that, unless the
+                // support point repeats a vertex of V̂ (then (6.2) may hold
+                // for a v that is off by up to √ε·D).
+                if by_backup || (paper_met && !repeat) {
                     let status = if paper_met {
                         Status::Converged
                     } else {
                         Status::ToleranceNotMet
+                    };
+                    // A step that failed to descend (round-off in a
+                    // degenerate simplex) leaves the previous iterate, whose
+                    // slots the push kept, as the better upper bound.
+                    let best = match prev {
+                        Some((p, p2)) if p2 < v2 => p,
+                        _ => sol,
                     };
                     return finish(status, best, lower);
                 }

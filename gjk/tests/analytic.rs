@@ -432,6 +432,35 @@ fn point_triangle_regions() {
     }
 }
 
+/// A segment through a triangle just inside one edge (an overlap of depth
+/// `δ` that no separating axis shows clearly) and just outside it (a gap of
+/// exactly `δ`), for `δ` from 1e-3 to 1e-9: the brute force once took the
+/// first for a gap of `δ`. Both it and GJK must tell the two apart.
+#[test]
+fn segment_piercing_a_triangle_near_its_edge() {
+    let tri = [p(0., 0., 0.), p(2., 0., 0.), p(0., 2., 0.)];
+    let a = convex(&tri, 0.0);
+    for k in 3..=9 {
+        let delta = 10f64.powi(-k);
+        for (y, truth) in [(delta, 0.0), (-delta, delta)] {
+            let seg = [p(0.7, y, -1.0), p(0.7, y, 1.0)];
+            assert_eq!(
+                hull_distance(&tri, &seg).distance,
+                truth,
+                "brute force, y = {y}"
+            );
+            let ans = query(&a, &iso(0., 0., 0.), &convex(&seg, 0.0), &iso(0., 0., 0.));
+            assert_distance(&ans, truth, 1e-15);
+            if truth == 0.0 {
+                // Moving the segment out by δ (across the edge) separates.
+                assert!(ans.penetration <= delta * (1.0 + 1e-9), "{ans:?}");
+            } else {
+                assert_point(&ans.point_a, &p(0.7, 0.0, 0.0), 1e-15);
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------
 // Compounds
 

@@ -27,6 +27,9 @@ fn config() -> Config {
     if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
         c.rng_seed = RngSeed::Fixed(0x676a_6b64);
     }
+    // About 4 % of the nearly touching draws are rejected (cores not clearly
+    // apart to begin with): long runs (PROPTEST_CASES=100000) need room.
+    c.max_global_rejects = c.max_global_rejects.max(c.cases / 8);
     c
 }
 

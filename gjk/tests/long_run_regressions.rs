@@ -1,0 +1,216 @@
+//! Inputs found by long runs of the property tests (100 000 cases a test,
+//! random seeds: `PROPTEST_CASES=100000 PROPTEST_RNG_SEED=<n> cargo test
+//! --release -p gjk --test properties`) that broke a promise, kept with the
+//! brute force of `common` as their truth.
+
+mod common;
+
+use common::{P, shape_distance};
+use gjk::{Convex, Options, Shape, Status, distance};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
+
+/// A pose from nalgebra's printed form: quaternion `[i, j, k, w]`, then the
+/// translation.
+fn pose(q: [f64; 4], t: [f64; 3]) -> Isometry3<f64> {
+    // As printed: already unit, to the last bit; normalising again would move
+    // the pose off the case that failed.
+    let q = UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2]));
+    Isometry3::from_parts(Translation3::new(t[0], t[1], t[2]), q)
+}
+
+fn shape(points: &[[f64; 3]]) -> Shape {
+    let points: Vec<P> = points.iter().map(|c| Point3::from(*c)).collect();
+    Convex::new(points, 0.0).unwrap().into()
+}
+
+/// The answer against the brute force: bounds around the truth (to round-off
+/// of the brute force) and the distance within 1e-9 of the scene's size.
+#[track_caller]
+fn check(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    o: &Options,
+) -> gjk::Answer {
+    let truth = shape_distance(a, pa, b, pb);
+    let ans = distance(a, pa, b, pb, o, None).unwrap();
+    let eps = 1e-14 * truth.scale;
+    assert!(
+        ans.lower <= truth.distance + eps && truth.distance <= ans.upper + eps,
+        "bounds miss {}: {ans:?}",
+        truth.distance
+    );
+    assert!(
+        (ans.distance - truth.distance).abs() <= 1e-9 * truth.scale,
+        "distance {} against {}: {ans:?}",
+        ans.distance,
+        truth.distance
+    );
+    ans
+}
+
+/// A point touching a flat five-point polytope, where GJK's last simplex is
+/// a sliver triangle (width 5e-6, three nearly collinear points of K) with
+/// the origin on its long edge. The cofactors' round-off put `v` 2.2e-9 from
+/// the origin, and the support point, a vertex of that triangle, ended the
+/// run as converged with the interval [0, 2.2e-9]. The true distance is
+/// 1.07e-16 (exact rational arithmetic). Now a repeated support point with a
+/// `g` above round-off sends the run to the Backup Procedure, which picks
+/// the candidate by the length of the `v` it gives: the edge, 1e-16 away.
+#[test]
+fn point_touching_a_flat_polytope_through_a_sliver_triangle() {
+    let a = shape(&[
+        [1.019349241613302, -1.3530605765029082, -0.46664571315251197],
+        [1.2789262063173767, -1.2503799709344179, -0.3665644962912866],
+        [0.7726237778160425, -1.4391535366730823, -0.6152900808977939],
+        [1.0463707891245904, -1.331487806293497, -0.5068607108772359],
+        [0.8771339458646912, -1.4026867075185938, -0.5523204254900316],
+    ]);
+    let b = shape(&[[0.9735613174998863, -1.3690383059660265, -0.4942297167317289]]);
+    let id = Isometry3::identity();
+    for tolerance in [Options::default().tolerance, 1e-16, 0.0] {
+        let o = Options {
+            tolerance,
+            ..Options::default()
+        };
+        let ans = check(&a, &id, &b, &id, &o);
+        assert!(ans.distance < 1e-13, "{ans:?}");
+        assert!(ans.upper < 1e-13, "{ans:?}");
+        assert_eq!(ans.status, Status::Converged, "{ans:?}");
+    }
+}
+
+/// B holds its two points five and two times over. With tolerance 0 the run
+/// went past the round-off floor, pushed a point on the nearest edge's
+/// line, got a worse `v` from the degenerate triangle and stopped on it as
+/// converged (1.25645 against 1.25015). Every exit now keeps the nearer of
+/// the last two iterates.
+#[test]
+fn duplicate_vertices_with_tolerance_zero() {
+    let a = shape(&[
+        [-0.21081948153167385, 1.2638059321073152, 1.0875730182761205],
+        [-0.5939506083424364, 2.9128236092718565, -1.7129218678700868],
+        [-0.6643013607551965, 3.2156171601277945, -2.2271503097314134],
+        [-0.2281712436880346, 1.3384888814254121, 0.9607404072350577],
+    ]);
+    let (p0, p1) = (
+        [0.0, 0.25890618642728286, 0.3451851391468265],
+        [-0.9499412498400739, 0.7090744654083216, 0.31547800088111655],
+    );
+    let b = shape(&[p0, p1, p1, p0, p0, p0, p0]);
+    let pa = pose(
+        [
+            0.9352417112536535,
+            0.15974780037609462,
+            0.28839753753934955,
+            0.1289590715986152,
+        ],
+        [0.5013571931474021, 0.4463804862987512, -0.30519530692126806],
+    );
+    let pb = pose(
+        [
+            0.299311253273064,
+            0.7416642211213424,
+            -0.6002377568409003,
+            -0.007848059326012366,
+        ],
+        [
+            -0.9149916763927788,
+            0.10698784342960622,
+            -0.6415872186082893,
+        ],
+    );
+    for max_iterations in [3, 6, 100] {
+        for tolerance in [0.0, 1e-10, Options::default().tolerance] {
+            let o = Options {
+                tolerance,
+                max_iterations,
+                ..Options::default()
+            };
+            let ans = check(&a, &pa, &b, &pb, &o);
+            assert!(ans.upper - ans.lower < 1e-12, "{ans:?}");
+        }
+    }
+}
+
+/// A nearly collinear four-point B (a segment with points along it) moved
+/// to touch a small polytope: the thin triangle of the last simplex left the
+/// Backup Procedure at 1.6e-12 and the run ended as `ToleranceNotMet`. The
+/// Backup Procedure now ranks candidates by the `v` they give, and the run
+/// converges to 7e-14.
+#[test]
+fn collinear_segment_touching_a_polytope() {
+    let a = shape(&[
+        [
+            0.07827334919005685,
+            -0.02103012563931539,
+            -0.06519150545303969,
+        ],
+        [
+            0.04863838953671813,
+            0.09317103393568482,
+            0.03233643089851764,
+        ],
+        [
+            0.05307083196878514,
+            0.06761413271981771,
+            0.012220528469543471,
+        ],
+        [
+            0.08022172659606805,
+            0.07592953106764122,
+            -0.0034602798779392405,
+        ],
+        [
+            0.025373967704677827,
+            0.06160058346182397,
+            0.029827199504797487,
+        ],
+        [
+            0.06931108863643602,
+            -0.04502051795126057,
+            -0.07387366050338376,
+        ],
+        [
+            0.05550930139562036,
+            0.004491623706963044,
+            -0.030849063353147785,
+        ],
+    ]);
+    let b = shape(&[
+        [
+            -0.7583784566294737,
+            2.4032735414138386,
+            -0.21292405430685632,
+        ],
+        [-0.924382050858692, 2.313506553049815, 0.046078932810396454],
+        [-2.6146985488844967, 1.3994623595229916, 2.683353289399],
+        [-0.6469833486262073, 2.46351081163903, -0.38672550636009617],
+    ]);
+    let pa = pose(
+        [
+            0.07593671071899723,
+            -0.7084862408409724,
+            -0.6750305797769837,
+            -0.19134936339103925,
+        ],
+        [1.9160922119217343, -1.7168769147883605, 0.24740431076353991],
+    );
+    let pb = pose(
+        [
+            0.1929289543700242,
+            0.9800669857919969,
+            0.04661822179300793,
+            0.008594377414141846,
+        ],
+        [
+            -0.06855872434477675,
+            -3.2824568761787347,
+            0.5185011465172573,
+        ],
+    );
+    let ans = check(&a, &pa, &b, &pb, &Options::default());
+    assert_eq!(ans.status, Status::Converged, "{ans:?}");
+    assert!(ans.upper < 1e-12, "{ans:?}");
+}

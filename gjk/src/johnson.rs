@@ -723,6 +723,64 @@ impl Simplex {
         if best.is_finite() { best } else { 0.0 }
     }
 
+    /// One step of iterative refinement of `sol` within the affine hull of
+    /// its subset: `v' = v - E (EᵀE)⁻¹ Eᵀ v`, with `E` the edges from the
+    /// subset's first point, taken as differences of the points themselves.
+    /// In exact arithmetic `v'` is `v(aff Y_s)` whatever error `v` had, so one
+    /// step removes the error that cofactors of a thin simplex (nearly
+    /// parallel edges, or nearly collinear points of `K`) put into `v`: up to
+    /// √ε of the simplex's size in its direction, where only the correction's
+    /// own round-off, a small multiple of ε·|v|, remains. `None` when the
+    /// subset has one point or four, when its edges are dependent, or when a
+    /// refined weight leaves `[0, 1]`: `v'` would then not be a point of `K`
+    /// and `|v'|` no longer an upper bound. Out of line: it is rare.
+    #[cold]
+    #[inline(never)]
+    pub fn refine(&self, sol: &Solution) -> Option<Solution> {
+        let (mem, len) = MEMBERS[sol.mask as usize & 15];
+        let base = mem[0] as usize & 3;
+        let y0 = self.vertices[base].y;
+        let mut lambda = sol.lambda;
+        let v = match len {
+            2 => {
+                let j = mem[1] as usize & 3;
+                let e = self.vertices[j].y - y0;
+                let ee = e.norm_squared();
+                if ee.is_nan() || ee <= 0.0 {
+                    return None;
+                }
+                let mu = e.dot(&sol.v) / ee;
+                lambda[j] -= mu;
+                lambda[base] += mu;
+                sol.v - e * mu
+            }
+            3 => {
+                let (j, k) = (mem[1] as usize & 3, mem[2] as usize & 3);
+                let (e1, e2) = (self.vertices[j].y - y0, self.vertices[k].y - y0);
+                let (g11, g12, g22) = (e1.norm_squared(), e1.dot(&e2), e2.norm_squared());
+                let det = g11 * g22 - g12 * g12;
+                if det.is_nan() || det <= 0.0 {
+                    return None;
+                }
+                let (r1, r2) = (e1.dot(&sol.v), e2.dot(&sol.v));
+                let mu1 = (g22 * r1 - g12 * r2) / det;
+                let mu2 = (g11 * r2 - g12 * r1) / det;
+                lambda[j] -= mu1;
+                lambda[k] -= mu2;
+                lambda[base] += mu1 + mu2;
+                sol.v - e1 * mu1 - e2 * mu2
+            }
+            _ => return None,
+        };
+        let inside = lambda.iter().all(|l| (0.0..=1.0).contains(l));
+        let finite = (v.x * 0.0 + v.y * 0.0 + v.z * 0.0) == 0.0;
+        (inside && finite).then_some(Solution {
+            mask: sol.mask,
+            v,
+            lambda,
+        })
+    }
+
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
     pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
         // Non-short-circuit: which slot matches is unpredictable, so a bit

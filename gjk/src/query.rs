@@ -638,6 +638,7 @@ impl<'s> Pair<'s> {
                     (simplex.backup(), true)
                 }
             };
+            let mut refined = false;
             loop {
                 let v2 = sol.v.norm_squared();
                 let norm = v2.sqrt();
@@ -715,8 +716,20 @@ impl<'s> Pair<'s> {
                     return finish(Status::Converged, sol, lower);
                 }
                 let repeat = simplex.has_pair(sol.mask, s.ia, s.ib);
-                if repeat && g <= self.slack * norm {
-                    return finish(Status::Converged, sol, lower);
+                if repeat {
+                    if g <= self.slack * norm {
+                        return finish(Status::Converged, sol, lower);
+                    }
+                    // g above round-off: v carries the error of a thin
+                    // simplex's cofactors. One refinement step in V̂'s affine
+                    // hull removes it, and the refined v is tested afresh.
+                    if !refined {
+                        refined = true;
+                        if let Some(r) = simplex.refine(&sol) {
+                            sol = r;
+                            continue;
+                        }
+                    }
                 }
                 // Cutoff and margin are the world's: compared there.
                 let lower_cert = (lower - self.slack) * self.inv_k - self.radii;

@@ -461,6 +461,41 @@ fn segment_piercing_a_triangle_near_its_edge() {
     }
 }
 
+/// A point 1e-9 to 1e-13 from the middle of a tilted segment of length 1.5:
+/// the distance is the gap itself. The brute force once called these
+/// overlapping: its witness axis, from nearest points with round-off of
+/// 1e-16, is tilted by 1e-16/gap and no other axis it tried was square to
+/// the segment.
+#[test]
+fn point_a_hair_from_a_tilted_segment() {
+    let rot = UnitQuaternion::from_euler_angles(0.3, -1.1, 0.7);
+    let (a, b) = (rot * p(-0.5, 0.2, 0.1), rot * p(1.0, -0.4, 0.3));
+    let mid = a + (b - a) * 0.37;
+    let across = (b - a).cross(&v(0.2, 1.0, -0.3)).normalize();
+    for k in 9..=13 {
+        let gap = 10f64.powi(-k);
+        let x = mid + across * gap;
+        let truth = (common::closest_on_segment(&x, &a, &b) - x).norm();
+        assert!(
+            (truth - gap).abs() <= 1e-15,
+            "closed form {truth} against {gap}"
+        );
+        let brute = hull_distance(&[x], &[a, b]).distance;
+        assert!(
+            (brute - truth).abs() <= 1e-15,
+            "brute force {brute} against {truth}"
+        );
+        let point: Shape = Convex::sphere(0.0).unwrap().into();
+        let ans = query(
+            &convex(&[a, b], 0.0),
+            &iso(0., 0., 0.),
+            &point,
+            &Isometry3::from(Translation3::from(x.coords)),
+        );
+        assert_distance(&ans, truth, 1e-15);
+    }
+}
+
 // ---------------------------------------------------------------------------
 // Compounds
 

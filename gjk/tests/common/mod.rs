@@ -239,8 +239,8 @@ pub fn gap_along(p: &[P], q: &[P], a: &V, origin: &P) -> f64 {
 }
 
 /// The largest gap over the separating-axis candidates (either orientation):
-/// triple normals of each set and cross products of edge pairs, plus an
-/// optional extra axis.
+/// triple normals of each set, cross products of edge pairs and vertex-edge
+/// normals, plus an optional extra axis.
 fn best_separation(p: &[P], q: &[P], witness_axis: Option<V>) -> f64 {
     let origin = p[0];
     let mut best = f64::NEG_INFINITY;
@@ -264,6 +264,19 @@ fn best_separation(p: &[P], q: &[P], witness_axis: Option<V>) -> f64 {
     for (i, j) in pairs(p.len()) {
         for (k, l) in pairs(q.len()) {
             try_axis((p[j] - p[i]).cross(&(q[l] - q[k])));
+        }
+    }
+    // Vertex against edge: the part of (vertex - edge start) across the
+    // edge, built by cross products so that it stays square to the edge to
+    // round-off. The witness axis of a vertex 1e-11 from an edge of length 1
+    // is off by about ε/1e-11 radians, which tilts the edge's projection by
+    // 1e-5: only an axis square to the edge by construction shows the gap.
+    for (a, b) in [(p, q), (q, p)] {
+        for x in a {
+            for (k, l) in pairs(b.len()) {
+                let e = b[l] - b[k];
+                try_axis(e.cross(&(x - b[k]).cross(&e)));
+            }
         }
     }
     best
@@ -416,7 +429,16 @@ pub fn shape_distance(a: &Shape, pa: &Isometry3<f64>, b: &Shape, pb: &Isometry3<
         .chain(wb.iter())
         .map(|w| w.radius)
         .fold(0.0, f64::max);
-    let scale = extent(&all) + radii;
+    // The world points are sums of a translation and a rotated body point:
+    // their round-off follows those terms' sizes, which can exceed the sums'
+    // (a pose that brings a body point far from its origin near the world
+    // origin), so the scale covers them too.
+    let terms = |s: &Shape, pose: &Isometry3<f64>| {
+        let body = world_pieces(s, &Isometry3::identity());
+        let body: Vec<&[P]> = body.iter().map(|w| w.points.as_slice()).collect();
+        pose.translation.vector.amax() + extent(&body)
+    };
+    let scale = extent(&all).max(terms(a, pa)).max(terms(b, pb)) + radii;
     RefShape {
         distance: best,
         per_pair,

@@ -781,6 +781,37 @@ impl Simplex {
         })
     }
 
+    /// For a tetrahedron holding the origin, its weights refined by one step
+    /// so that `Σ λ_i y_i` is the origin to round-off of the points, not to
+    /// that of the cofactors: `λ' = λ - δ`, `E δ = Σ λ_i y_i` with `E` the
+    /// edges from the first point. Cofactors of a flat tetrahedron (cores
+    /// that touch) can leave the sum 1e-9 of the size from the origin, and
+    /// the nearest points, `Σ λ_i a_i` and `Σ λ_i b_i`, that far apart. `None`
+    /// when a weight would leave `[0, 1]` or `E` is singular.
+    #[cold]
+    #[inline(never)]
+    pub fn refine_origin(&self, lambda: &[f64; 4]) -> Option<[f64; 4]> {
+        let y = self.vertices.map(|v| v.y);
+        let (e1, e2, e3) = (y[1] - y[0], y[2] - y[0], y[3] - y[0]);
+        // Σ λ_i y_i = y0 + Σ λ_i e_i when the weights sum to 1.
+        let r = y[0] + e1 * lambda[1] + e2 * lambda[2] + e3 * lambda[3];
+        let det = e1.dot(&e2.cross(&e3));
+        if det.is_nan() || det == 0.0 {
+            return None;
+        }
+        // Cramer's rule for E δ = r.
+        let d1 = r.dot(&e2.cross(&e3)) / det;
+        let d2 = e1.dot(&r.cross(&e3)) / det;
+        let d3 = e1.dot(&e2.cross(&r)) / det;
+        let out = [
+            lambda[0] + d1 + d2 + d3,
+            lambda[1] - d1,
+            lambda[2] - d2,
+            lambda[3] - d3,
+        ];
+        out.iter().all(|l| (0.0..=1.0).contains(l)).then_some(out)
+    }
+
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
     pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
         // Non-short-circuit: which slot matches is unpredictable, so a bit

@@ -711,7 +711,8 @@ impl<'s> Pair<'s> {
                 // is within ε·D, or within the round-off allowance when the
                 // support point repeats a vertex of V̂. Beyond that, a repeat
                 // means the subalgorithm's v is off by more than round-off
-                // (a sliver simplex at contact): step (4) is handled below.
+                // (a thin simplex: nearly parallel edges, or nearly collinear
+                // points of K at contact): refinement, then steps (4) to (6).
                 if g <= stop_d * norm || norm <= eps_d {
                     return finish(Status::Converged, sol, lower);
                 }
@@ -863,13 +864,18 @@ impl<'s> Pair<'s> {
     #[inline(always)]
     fn answer(&self, run: &Run, simplex: &Simplex, place_a: Place<'_>, pieces: [u32; 2]) -> Answer {
         let (pose_a, off_a) = (place_a.pose, place_a.offset);
+        let mut lambda = run.sol.lambda;
+        if run.sol.mask == 0b1111
+            && let Some(l) = simplex.refine_origin(&lambda)
+        {
+            lambda = l;
+        }
         let mut wa = Vector3::zeros();
         let mut pairs = [[0u32; 2]; 4];
         let mut len = 0;
-        for i in 0..4 {
+        for (i, (vx, l)) in simplex.vertices.iter().zip(lambda).enumerate() {
             if run.sol.mask & (1 << i) != 0 {
-                let vx = &simplex.vertices[i];
-                wa += self.a.local(vx.ia as usize) * run.sol.lambda[i];
+                wa += self.a.local(vx.ia as usize) * l;
                 pairs[len & 3] = [vx.ia, vx.ib];
                 len += 1;
             }

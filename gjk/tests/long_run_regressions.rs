@@ -214,3 +214,53 @@ fn collinear_segment_touching_a_polytope() {
     assert_eq!(ans.status, Status::Converged, "{ans:?}");
     assert!(ans.upper < 1e-12, "{ans:?}");
 }
+
+/// Two triangles of size 1.7e4 touching 1e7 from the origin (B nearly
+/// collinear). The run ends on a flat tetrahedron holding the origin, and
+/// its cofactor weights put `Σ λ_i y_i` 2.4e-5 from the origin, so the
+/// nearest point, `Σ λ_i a_i` for both shapes, was 2.4e-5 outside B (1.4e-9
+/// of the size). The weights of a tetrahedron now get one refinement step.
+#[test]
+fn touching_triangles_far_out_share_a_point_of_both() {
+    let a = shape(&[
+        [-1409.3821569138545, -5212.941462484556, -4607.428266037536],
+        [9075.28229966157, 13295.458846061578, -14706.026055567434],
+        [-14865.631624326505, 16093.143091566411, 2899.440319603746],
+    ]);
+    let b = shape(&[
+        [-4249.881435371744, 253.01374445799135, 3554.318229175237],
+        [116.58570410555876, 1122.0242652246495, 1813.557323831502],
+        [2053.624835285726, 1507.532120972254, 1041.3261621232587],
+    ]);
+    let pa = pose(
+        [
+            -0.5614520632937275,
+            0.5449542224690167,
+            -0.5827019500143455,
+            -0.21967001043812293,
+        ],
+        [2535044.6426081755, 9681338.150909241, -7774.93827017703],
+    );
+    let pb = pose(
+        [
+            -0.9544566773597133,
+            -0.24403332105033804,
+            -0.16613163309697246,
+            -0.04313316293911047,
+        ],
+        [2532466.834039514, 9689435.378295429, -397.8633423780231],
+    );
+    let truth = shape_distance(&a, &pa, &b, &pb);
+    let ans = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+    assert!(
+        ans.lower <= truth.distance + 1e-6 && truth.distance <= ans.upper + 1e-6,
+        "{ans:?}"
+    );
+    let size = 17029.937258479084;
+    let on_a = common::point_to_hull(&ans.point_a, &truth.pieces_a[0].points);
+    let on_b = common::point_to_hull(&ans.point_b, &truth.pieces_b[0].points);
+    assert!(
+        on_a <= 1e-9 * size && on_b <= 1e-9 * size,
+        "{on_a:e} {on_b:e}: {ans:?}"
+    );
+}

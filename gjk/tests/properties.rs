@@ -272,6 +272,43 @@ proptest! {
         }
     }
 
+    /// The nearly touching pairs again, scaled by 10^-6 to 10^6 and moved
+    /// 0, 10^3 or 10^6 of their size from the origin (both by the same
+    /// shift). Within 1e-9 of the size, plus what rounding the world
+    /// coordinates to the offset's precision already costs the brute force.
+    #[test]
+    fn scaled_and_offset_nearly_touching_pairs(
+        (pts_a, ra) in (point_set(8), radius()), pa in pose(2.0),
+        (pts_b, rb) in (point_set(8), radius()), pb in pose(2.0),
+        k in prop_oneof![Just(None), (3..=9i32).prop_map(Some)],
+        e in -6..=6i32,
+        off in prop_oneof![Just(0.0), Just(1e3), Just(1e6)],
+        dir in vec3(),
+    ) {
+        let build = |pts: &[P], r: f64, s: f64| -> Shape {
+            Convex::new(pts.iter().map(|x| P::from(x.coords * s)).collect::<Vec<P>>(), r * s).unwrap().into()
+        };
+        let (a1, b1) = (build(&pts_a, ra, 1.0), build(&pts_b, rb, 1.0));
+        let moved = nearly_touching(&a1, &pa, &b1, &pb, k);
+        prop_assume!(moved.is_some() && dir.norm() > 0.1);
+        let (pb, gap) = moved.unwrap();
+        let s = 10f64.powi(e);
+        let shift = dir.normalize() * off * s;
+        let place = |p: &Isometry3<f64>| {
+            Isometry3::from_parts(Translation3::from(p.translation.vector * s + shift), p.rotation)
+        };
+        let (a, b) = (build(&pts_a, ra, s), build(&pts_b, rb, s));
+        let (pa, pb) = (place(&pa), place(&pb));
+        let r = shape_distance(&a, &pa, &b, &pb);
+        let size = shape_distance(&a1, &Isometry3::identity(), &b1, &Isometry3::identity()).scale * s;
+        let far = off * s * f64::EPSILON;
+        let t = Tolerance { distance: 1e-9 * size + 64.0 * far, bounds: 1e-14 * size + 16.0 * far };
+        let ans = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        if let Err(msg) = verify(&a, &pa, &b, &pb, &ans, &r, t) {
+            prop_assert!(false, "gap {gap:e}, scale {s:e}, offset {off:e}: {}", msg);
+        }
+    }
+
     /// The penetration field of touching and nearly touching pairs: exact
     /// (`rA + rB - d(cores)`) while the cores are apart, at most the true
     /// depth (`rA + rB`) when they touch.

@@ -341,7 +341,7 @@ pub fn hull_distance(p: &[P], q: &[P]) -> HullDistance {
         && best_gap <= 1e-13 * span;
     let distance = if best_gap > 1e-13 * span {
         assert!(
-            best_gap <= candidate + 1e-9 * span,
+            best_gap <= candidate + 1e-9 * span + 64.0 * f64::EPSILON * mag,
             "reference inconsistent: gap {best_gap} > candidate {candidate}\nP = {p:?}\nQ = {q:?}"
         );
         candidate

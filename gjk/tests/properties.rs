@@ -276,10 +276,15 @@ proptest! {
     /// 0, 10^3 or 10^6 of their size from the origin (both by the same
     /// shift). Within 1e-9 of the size, plus what rounding the world
     /// coordinates to the offset's precision already costs the brute force.
+    /// General point sets only: rounding to the offset's precision turns a
+    /// collinear set into a sliver (sin 1e-10) whose plane the f64 brute
+    /// force cannot place (it once reported 4.3e-11 for a true 6.3e-11,
+    /// checked in rational arithmetic; GJK had it right). The unscaled tests
+    /// cover degenerate sets.
     #[test]
     fn scaled_and_offset_nearly_touching_pairs(
-        (pts_a, ra) in (point_set(8), radius()), pa in pose(2.0),
-        (pts_b, rb) in (point_set(8), radius()), pb in pose(2.0),
+        (pts_a, ra) in (general(8), radius()), pa in pose(2.0),
+        (pts_b, rb) in (general(8), radius()), pb in pose(2.0),
         k in prop_oneof![Just(None), (3..=9i32).prop_map(Some)],
         e in -6..=6i32,
         off in prop_oneof![Just(0.0), Just(1e3), Just(1e6)],

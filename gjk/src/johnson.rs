@@ -736,7 +736,7 @@ impl Simplex {
     /// and `|v'|` no longer an upper bound. Out of line: it is rare.
     #[cold]
     #[inline(never)]
-    pub fn refine(&self, sol: &Solution) -> Option<Solution> {
+    pub fn refine(&self, sol: Solution) -> Option<Solution> {
         let (mem, len) = MEMBERS[sol.mask as usize & 15];
         let base = mem[0] as usize & 3;
         let y0 = self.vertices[base].y;
@@ -787,22 +787,26 @@ impl Simplex {
     /// edges from the first point. Cofactors of a flat tetrahedron (cores
     /// that touch) can leave the sum 1e-9 of the size from the origin, and
     /// the nearest points, `Σ λ_i a_i` and `Σ λ_i b_i`, that far apart. `None`
-    /// when a weight would leave `[0, 1]` or `E` is singular.
-    #[cold]
+    /// when the sum is already within `floor` of the origin on every axis
+    /// (the usual case, which then costs one weighted sum), when a weight
+    /// would leave `[0, 1]`, or when `E` is singular.
     #[inline(never)]
-    pub fn refine_origin(&self, lambda: &[f64; 4]) -> Option<[f64; 4]> {
+    pub fn refine_origin(&self, lambda: [f64; 4], floor: f64) -> Option<[f64; 4]> {
         let y = self.vertices.map(|v| v.y);
         let (e1, e2, e3) = (y[1] - y[0], y[2] - y[0], y[3] - y[0]);
         // Σ λ_i y_i = y0 + Σ λ_i e_i when the weights sum to 1.
         let r = y[0] + e1 * lambda[1] + e2 * lambda[2] + e3 * lambda[3];
-        let det = e1.dot(&e2.cross(&e3));
+        if r.amax() <= floor {
+            return None;
+        }
+        // Cramer's rule for E δ = r, the three cofactor vectors shared.
+        let (c23, c31, c12) = (e2.cross(&e3), e3.cross(&e1), e1.cross(&e2));
+        let det = e1.dot(&c23);
         if det.is_nan() || det == 0.0 {
             return None;
         }
-        // Cramer's rule for E δ = r.
-        let d1 = r.dot(&e2.cross(&e3)) / det;
-        let d2 = e1.dot(&r.cross(&e3)) / det;
-        let d3 = e1.dot(&e2.cross(&r)) / det;
+        let inv = 1.0 / det;
+        let (d1, d2, d3) = (r.dot(&c23) * inv, r.dot(&c31) * inv, r.dot(&c12) * inv);
         let out = [
             lambda[0] + d1 + d2 + d3,
             lambda[1] - d1,

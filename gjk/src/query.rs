@@ -717,20 +717,8 @@ impl<'s> Pair<'s> {
                     return finish(Status::Converged, sol, lower);
                 }
                 let repeat = simplex.has_pair(sol.mask, s.ia, s.ib);
-                if repeat {
-                    if g <= self.slack * norm {
-                        return finish(Status::Converged, sol, lower);
-                    }
-                    // g above round-off: v carries the error of a thin
-                    // simplex's cofactors. One refinement step in V̂'s affine
-                    // hull removes it, and the refined v is tested afresh.
-                    if !refined {
-                        refined = true;
-                        if let Some(r) = simplex.refine(&sol) {
-                            sol = r;
-                            continue;
-                        }
-                    }
+                if repeat && g <= self.slack * norm {
+                    return finish(Status::Converged, sol, lower);
                 }
                 // Cutoff and margin are the world's: compared there.
                 let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
@@ -800,10 +788,25 @@ impl<'s> Pair<'s> {
                     };
                     return finish(status, best, lower);
                 }
-                // Step (6): redo v_k with the Backup Procedure.
-                sol = simplex.backup();
-                by_backup = true;
-                backup_used = true;
+                // A repeat with g above round-off: v carries the error of a
+                // thin simplex's cofactors. One refinement step in V̂'s affine
+                // hull removes it, and the refined v goes back to step (3);
+                // the Backup Procedure comes after, if needed.
+                let refined_sol = if repeat && !refined {
+                    refined = true;
+                    simplex.refine(sol)
+                } else {
+                    None
+                };
+                match refined_sol {
+                    Some(r) => sol = r,
+                    None => {
+                        // Step (6): redo v_k with the Backup Procedure.
+                        sol = simplex.backup();
+                        by_backup = true;
+                        backup_used = true;
+                    }
+                }
             }
         }
     }
@@ -866,7 +869,7 @@ impl<'s> Pair<'s> {
         let (pose_a, off_a) = (place_a.pose, place_a.offset);
         let mut lambda = run.sol.lambda;
         if run.sol.mask == 0b1111
-            && let Some(l) = simplex.refine_origin(&lambda)
+            && let Some(l) = simplex.refine_origin(lambda, self.slack)
         {
             lambda = l;
         }

@@ -23,6 +23,35 @@ const fn members(mask: usize) -> ([u8; 4], u8) {
     (out, n as u8)
 }
 
+/// A triangle is thin when `Δ(Y_s)` is below this times its longest squared
+/// edge squared (its smallest angle below about 1e-3 rad): (5.6) then loses
+/// more than 1e-10 of its cofactors to round-off.
+const THIN: f64 = 1e-6;
+
+/// The slot a triangle's mask leaves out. A triangle's cofactors use three
+/// of its row's four entries; the fourth marks it thin (1) or not (0).
+#[inline(always)]
+const fn missing(mask: usize) -> usize {
+    (!mask & 15).trailing_zeros() as usize & 3
+}
+
+/// `a × b`, each component `p·q - r·s` with one rounding (Kahan's fused
+/// difference of products): exact to a unit in the last place of the
+/// component, however much the two products cancel.
+#[inline(always)]
+fn fused_cross(a: &Vector3<f64>, b: &Vector3<f64>) -> Vector3<f64> {
+    let dop = |p: f64, q: f64, r: f64, t: f64| {
+        let w = r * t;
+        let err = (-r).mul_add(t, w);
+        p.mul_add(q, -w) + err
+    };
+    Vector3::new(
+        dop(a.y, b.z, a.z, b.y),
+        dop(a.z, b.x, a.x, b.z),
+        dop(a.x, b.y, a.y, b.x),
+    )
+}
+
 /// Every non-empty subset, smallest first, so that a subset's cofactors are
 /// computed after those of the subsets they recurse on.
 const BY_SIZE: [u8; 15] = [1, 2, 4, 8, 3, 5, 6, 9, 10, 12, 7, 11, 13, 14, 15];
@@ -427,6 +456,88 @@ impl Simplex {
             }
             self.delta[MASK][j] = acc;
         }
+        if len == 3 {
+            self.check_thin(MASK);
+        }
+    }
+
+    /// After (5.6) for a triangle: if it is thin, its cofactors again, by
+    /// [`thin_triangle`](Self::thin_triangle). `Δ(Y_s)` is `|e1 × e2|²`, so
+    /// its ratio to the largest squared edge squared is at most the squared
+    /// sine of the triangle's smallest angle, times a constant.
+    #[inline(always)]
+    fn check_thin(&mut self, mask: usize) {
+        let mask = mask & 15;
+        let (mem, _) = MEMBERS[mask];
+        let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
+        // A pair's cofactors sum to its squared edge length.
+        let edge = |a: usize, b: usize| {
+            let m = (1 << a) | (1 << b);
+            self.delta[m][a] + self.delta[m][b]
+        };
+        let longest = edge(i, j).max(edge(i, k)).max(edge(j, k));
+        let total = self.delta[mask][i] + self.delta[mask][j] + self.delta[mask][k];
+        // NaN counts as thin.
+        match total.partial_cmp(&(THIN * longest * longest)) {
+            Some(std::cmp::Ordering::Greater) => self.delta[mask][missing(mask)] = 0.0,
+            _ => self.thin_triangle(mask),
+        }
+    }
+
+    /// The cofactors of a thin triangle (nearly parallel edges of A and B
+    /// make one: two long edges of K a small angle θ apart), from cross
+    /// products instead of (5.6). The recursion takes them from differences
+    /// of dot products of size `|y|²` whose result is of size `θ²|y|⁴`:
+    /// relative error `ε/θ²`, all of it at `θ = 1e-8`. Here `Δ_i = n·(y_j ×
+    /// y_k)` with `n = (y_j - y_i) × (y_k - y_i)`, each component of each cross
+    /// product a difference of products fused to one rounding: relative error
+    /// `ε/θ`. Out of line: thin triangles are rare.
+    #[cold]
+    #[inline(never)]
+    fn thin_triangle(&mut self, mask: usize) {
+        let mask = mask & 15;
+        let (mem, _) = MEMBERS[mask];
+        let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
+        let [yi, yj, yk] = [i, j, k].map(|x| self.vertices[x].y);
+        let n = fused_cross(&(yj - yi), &(yk - yi));
+        self.delta[mask][i] = n.dot(&fused_cross(&yj, &yk));
+        self.delta[mask][j] = n.dot(&fused_cross(&yk, &yi));
+        self.delta[mask][k] = n.dot(&fused_cross(&yi, &yj));
+        self.delta[mask][missing(mask)] = 1.0;
+    }
+
+    /// Whether the triangle `mask` is thin (see [`check_thin`](Self::check_thin)).
+    #[inline(always)]
+    fn is_thin(&self, mask: usize) -> bool {
+        self.delta[mask & 15][missing(mask)] != 0.0
+    }
+
+    /// `v(aff Y_s)` of a thin triangle: the origin's projection on its plane,
+    /// `n (n·y_i) / |n|²`. `Σ λ_i y_i` would carry the weights' error `ε/θ`
+    /// times the triangle's length, along its length, which is more than the
+    /// whole distance near contact. The plane's normal, from two long edges
+    /// by fused products, is tilted by round-off only about the triangle's
+    /// long axis, where the triangle is narrow, so `|v|` is right to
+    /// `ε·|y|` and `v`'s direction separates K from the origin to within
+    /// that: the lower bound of Theorem 4.1 stays tight.
+    #[cold]
+    #[inline(never)]
+    fn thin_v(&self, mask: usize) -> Vector3<f64> {
+        let (mem, _) = MEMBERS[mask & 15];
+        let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
+        let [yi, yj, yk] = [i, j, k].map(|x| self.vertices[x].y);
+        let n = fused_cross(&(yj - yi), &(yk - yi));
+        let nn = n.norm_squared();
+        if nn.is_nan() || nn == 0.0 {
+            // A triangle flat to the last bit: no plane; the weights decide.
+            let (mem, _) = MEMBERS[mask & 15];
+            let total = self.total(mask);
+            return mem[..3].iter().fold(Vector3::zeros(), |acc, &x| {
+                let x = x as usize & 3;
+                acc + self.vertices[x].y * (self.delta[mask & 15][x] / total)
+            });
+        }
+        n * (n.dot(&yi) / nn)
     }
 
     /// (5.6): `Δ_j(Y_s ∪ {y_j}) = Σ_{i∈I_s} Δ_i(Y_s)(y_i·y_k - y_i·y_j)`,
@@ -452,6 +563,9 @@ impl Simplex {
                 acc += self.delta[sub][i] * (self.dot[i][k] - self.dot[i][j]);
             }
             self.delta[mask][j] = acc;
+        }
+        if len == 3 {
+            self.check_thin(mask);
         }
     }
 
@@ -573,6 +687,9 @@ impl Simplex {
             let l = self.delta[mask][i] * inv;
             lambda[i] = l;
             v += self.vertices[i].y * l;
+        }
+        if len == 3 && self.is_thin(mask) {
+            v = self.thin_v(mask);
         }
         Solution {
             mask: mask as u8,
@@ -754,6 +871,9 @@ impl Simplex {
                 lambda[base] += mu;
                 sol.v - e * mu
             }
+            // A thin triangle's v is already its plane's (`thin_v`); the
+            // normal equations below would square its condition.
+            3 if self.is_thin(sol.mask as usize) => return None,
             3 => {
                 let (j, k) = (mem[1] as usize & 3, mem[2] as usize & 3);
                 let (e1, e2) = (self.vertices[j].y - y0, self.vertices[k].y - y0);

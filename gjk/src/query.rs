@@ -716,7 +716,7 @@ impl<'s> Pair<'s> {
                 if g <= stop_d * norm || norm <= eps_d {
                     return finish(Status::Converged, sol, lower);
                 }
-                let repeat = simplex.has_pair(sol.mask, s.ia, s.ib);
+                let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
                 if repeat && g <= self.slack * norm {
                     return finish(Status::Converged, sol, lower);
                 }
@@ -757,7 +757,15 @@ impl<'s> Pair<'s> {
                     Some((_, p2)) if v2 < p2 => true,
                     Some((p, p2)) => {
                         let grew = sol.mask.count_ones() > p.mask.count_ones();
-                        let ok = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON) && flat_steps < 3;
+                        let flat = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON);
+                        // |v| up by no more than its round-off while the new
+                        // support point, not yet in Y, lies beyond v's plane
+                        // by more than the tolerance: near contact, Johnson's
+                        // v of a new face can be εD worse than the refined v
+                        // of the last, and stopping there leaves |v| at
+                        // (6.2)'s √ε·D (nearly parallel edges touching).
+                        let level = norm <= p2.sqrt() + self.slack;
+                        let ok = (flat || level) && flat_steps < 4;
                         flat_steps += ok as u32;
                         ok
                     }
@@ -767,13 +775,24 @@ impl<'s> Pair<'s> {
                     simplex.push(sol.mask, s);
                     break;
                 }
+                // A repeat with g above round-off: v carries the error of a
+                // thin simplex's cofactors, or of the Backup Procedure's
+                // (which redoes them). One refinement step in V̂'s affine hull
+                // removes it, and the refined v goes back to step (3); the
+                // Backup Procedure comes after, if needed.
+                let refined_sol = if repeat && !refined {
+                    refined = true;
+                    simplex.refine(sol)
+                } else {
+                    None
+                };
                 // Step (5): round-off has the last word. The previous iterate,
                 // if nearer, is still valid: its vertices kept their slots.
                 // When (6.2) holds the paper would have stopped at step (3):
                 // no Backup Procedure is needed to confirm that, unless the
-                // support point repeats a vertex of V̂ (then (6.2) may hold
-                // for a v that is off by up to √ε·D).
-                if by_backup || (paper_met && !repeat) {
+                // support point repeats a point of Y (then (6.2) may hold
+                // for a v that is off by up to √ε·D) and refinement is left.
+                if refined_sol.is_none() && (by_backup || (paper_met && !repeat)) {
                     let status = if paper_met {
                         Status::Converged
                     } else {
@@ -788,16 +807,6 @@ impl<'s> Pair<'s> {
                     };
                     return finish(status, best, lower);
                 }
-                // A repeat with g above round-off: v carries the error of a
-                // thin simplex's cofactors. One refinement step in V̂'s affine
-                // hull removes it, and the refined v goes back to step (3);
-                // the Backup Procedure comes after, if needed.
-                let refined_sol = if repeat && !refined {
-                    refined = true;
-                    simplex.refine(sol)
-                } else {
-                    None
-                };
                 match refined_sol {
                     Some(r) => sol = r,
                     None => {

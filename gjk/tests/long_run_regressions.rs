@@ -264,3 +264,49 @@ fn touching_triangles_far_out_share_a_point_of_both() {
         "{on_a:e} {on_b:e}: {ans:?}"
     );
 }
+
+/// A point 6.4e-7 from a six-point polytope (seed 405). GJK's triangle had
+/// the right `|v|` but a direction 4e-7 rad off (Johnson's absolute error
+/// over a small `|v|`), so the support point, a vertex of K, seemed 1e-6
+/// beyond it; the tetrahedron it made failed every test of Theorem 5.2, the
+/// Backup Procedure gave the same triangle back, and the run ended
+/// `ToleranceNotMet` with the interval [0, 6.4e-7]. Now the Backup
+/// Procedure's `v` is refined like any other when its support point
+/// repeats: converged, the interval 2.6e-13 wide.
+#[test]
+fn point_near_a_polytope_after_the_backup_procedure() {
+    let a = shape(&[[0.4288650930956947, 0.7673668302098899, -0.8359669313612114]]);
+    let b = shape(&[
+        [
+            -0.10139386171450789,
+            -0.18114483874530896,
+            1.8373773687491055,
+        ],
+        [-1.4310402014356518, 4.465161361294857, 1.2778767459942941],
+        [0.23072867355445864, -1.3994631349828008, 2.213847934857871],
+        [-0.25143035458104174, 0.4172430290854605, 1.47051145402525],
+        [0.23743151900258602, -1.2687810206887602, 1.5850143671640304],
+        [-0.7666175173618951, 1.938540877440295, 2.397180799049291],
+    ]);
+    let pa = pose(
+        [
+            -0.4265915088784146,
+            -0.5301484100987622,
+            0.5557246749304,
+            -0.4776321110395459,
+        ],
+        [-1.9230562683305288, 1.211716536952994, 1.9841842846050257],
+    );
+    let pb = pose(
+        [
+            -0.08184933059847838,
+            -0.6218112833433539,
+            -0.6179901139007595,
+            -0.47406711983473243,
+        ],
+        [-2.4693723940005015, 1.068258687324044, 1.1960919025838705],
+    );
+    let ans = check(&a, &pa, &b, &pb, &Options::default());
+    assert_eq!(ans.status, Status::Converged, "{ans:?}");
+    assert!(ans.upper - ans.lower < 1e-12, "{ans:?}");
+}

@@ -459,6 +459,9 @@ impl Simplex {
         if len == 3 {
             self.check_thin(MASK);
         }
+        if len == 4 {
+            self.check_sliver();
+        }
     }
 
     /// After (5.6) for a triangle: if it is thin, its cofactors again, by
@@ -482,6 +485,52 @@ impl Simplex {
             Some(std::cmp::Ordering::Greater) => self.delta[mask][missing(mask)] = 0.0,
             _ => self.thin_triangle(mask),
         }
+    }
+
+    /// After (5.6) for the tetrahedron: if it is a sliver, its cofactors
+    /// again, from signed volumes. Near nearly parallel edges of A and B the
+    /// four points of `Y` can lie within 1e-9 of a plane; the recursion then
+    /// leaves `Δ_l(Y)`, whose signs decide which face holds the nearest point
+    /// (condition (3) of Theorem 5.2), as round-off, and the run settles on a
+    /// face whose plane passes 1e-9 of the size from the origin while the
+    /// true distance is 0.
+    #[inline(always)]
+    fn check_sliver(&mut self) {
+        let edge = |b: usize| {
+            let m = 1 | (1 << b);
+            self.delta[m][0] + self.delta[m][b]
+        };
+        // Hadamard: V² is at most the product of the squared edges from y0,
+        // with equality for orthogonal edges.
+        let bound = edge(1) * edge(2) * edge(3);
+        let total = self.total(15);
+        // NaN counts as a sliver.
+        if total.partial_cmp(&(THIN * bound)) != Some(std::cmp::Ordering::Greater) {
+            self.sliver();
+        }
+    }
+
+    /// A sliver tetrahedron's cofactors, `Δ_l(Y) = V_l·V`: `Δ(Y)` is `V²`, `V`
+    /// the signed volume `det(y1 - y0, y2 - y0, y3 - y0)`, and `Δ_l/Δ` is the
+    /// origin's barycentric weight `V_l/V`, `V_l` the volume with the origin
+    /// in place of `y_l`. Each volume is a triple product through fused cross
+    /// products, whose error is relative to the volume, not to `|y|³`. Out of
+    /// line: slivers are rare.
+    #[cold]
+    #[inline(never)]
+    fn sliver(&mut self) {
+        let y = self.vertices.map(|v| v.y);
+        let volume = |p: Vector3<f64>, q: Vector3<f64>, r: Vector3<f64>, s: Vector3<f64>| {
+            (q - p).dot(&fused_cross(&(r - p), &(s - p)))
+        };
+        let z = Vector3::zeros();
+        let v = volume(y[0], y[1], y[2], y[3]);
+        self.delta[15] = [
+            volume(z, y[1], y[2], y[3]) * v,
+            volume(y[0], z, y[2], y[3]) * v,
+            volume(y[0], y[1], z, y[3]) * v,
+            volume(y[0], y[1], y[2], z) * v,
+        ];
     }
 
     /// The cofactors of a thin triangle (nearly parallel edges of A and B
@@ -566,6 +615,9 @@ impl Simplex {
         }
         if len == 3 {
             self.check_thin(mask);
+        }
+        if len == 4 {
+            self.check_sliver();
         }
     }
 

@@ -157,7 +157,8 @@ fn points(p: &[[f64; 3]]) -> gjk::Shape {
 /// One found case against its truth, computed in exact rational arithmetic
 /// from the f64 inputs (the minimum over vertex-triangle and edge-edge pairs,
 /// the hulls being disjoint by construction): the distance within 1e-9 of
-/// the size, the bounds around the truth, and converged.
+/// the size, the bounds around the truth and no wider than that, and
+/// converged.
 #[track_caller]
 fn found(
     a: &gjk::Shape,
@@ -387,4 +388,55 @@ fn collinear_set_and_box_with_nearly_parallel_edges() {
         ),
     );
     found(&a, &pa, &b, &pb, 2.427420964845699e-12, 2.4272879401201464);
+}
+
+/// Two boxes of size 4.4e6, 1e9 from the origin, their edges nearly
+/// parallel, 4.4e-3 apart (1e-9 of the size). Near the contact four points
+/// of `Y` lay within 1e-9 of a plane (a sliver tetrahedron), and (5.6) left
+/// the signs that pick its nearest face to round-off: the run settled on a
+/// face of K away from the contact and reported 9.2e-3 as converged (also
+/// on bfb3fbd). Now a sliver's cofactors come from signed volumes.
+#[test]
+fn boxes_with_nearly_parallel_edges_far_out() {
+    let a = points(&[
+        [-945720.8242906576, -758406.6962977852, -1370118.4836559885],
+        [945720.8242906576, -758406.6962977852, -1370118.4836559885],
+        [-945720.8242906576, 758406.6962977852, -1370118.4836559885],
+        [945720.8242906576, 758406.6962977852, -1370118.4836559885],
+        [-945720.8242906576, -758406.6962977852, 1370118.4836559885],
+        [945720.8242906576, -758406.6962977852, 1370118.4836559885],
+        [-945720.8242906576, 758406.6962977852, 1370118.4836559885],
+        [945720.8242906576, 758406.6962977852, 1370118.4836559885],
+    ]);
+    let b = points(&[
+        [-679474.58873018, -1542328.2956423978, -1392499.8471586998],
+        [679474.588730214, -1542328.2956423978, -1392499.8471586998],
+        [-679474.58873018, 1542328.295642422, -1392499.8471586998],
+        [679474.588730214, 1542328.295642422, -1392499.8471586998],
+        [-679474.58873018, -1542328.2956423978, 1392499.847158677],
+        [679474.588730214, -1542328.2956423978, 1392499.847158677],
+        [-679474.58873018, 1542328.295642422, 1392499.847158677],
+        [679474.588730214, 1542328.295642422, 1392499.847158677],
+    ]);
+    let (pa, pb) = (
+        pose(
+            [
+                -0.5508668759394175,
+                -0.101028352064601,
+                -0.78203014305604,
+                -0.2734370355742012,
+            ],
+            [893225265.43513, 440135603.3255972, 91811087.96629171],
+        ),
+        pose(
+            [
+                0.5622831281169708,
+                -0.14647899598240824,
+                -0.643018121225067,
+                0.4989080910820799,
+            ],
+            [895630704.0610824, 442041475.8278197, 92677021.36581834],
+        ),
+    );
+    found(&a, &pa, &b, &pb, 0.004372421954476569, 4.372421806096142e6);
 }

@@ -23,7 +23,7 @@
 #![allow(dead_code)]
 
 use gjk::{Convex, Shape};
-use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 pub type P = Point3<f64>;
 pub type V = Vector3<f64>;
@@ -135,6 +135,11 @@ pub struct Body {
     /// Added to every template vertex to absorb a far pose's rounding;
     /// zero when the pose was stored exactly.
     pub shift: V,
+    /// For a collinear or coplanar set, the hull's corners (the two ends, or
+    /// the rectangle's corners in the order (-,-), (+,-), (-,+), (+,+)), for
+    /// libraries that cannot take the hull of a flat set; shifted as the
+    /// vertices are.
+    pub outline: Vec<P>,
     feature: Feature,
 }
 
@@ -146,12 +151,23 @@ impl Body {
         radius: f64,
         feature: Feature,
     ) -> Self {
+        let outline = match (name, feature) {
+            ("collinear", Feature::Segment(a, b)) => vec![a, b],
+            ("coplanar", Feature::Box(h)) => vec![
+                P::new(-h.x, -h.y, 0.0),
+                P::new(h.x, -h.y, 0.0),
+                P::new(-h.x, h.y, 0.0),
+                P::new(h.x, h.y, 0.0),
+            ],
+            _ => Vec::new(),
+        };
         Body {
             name,
             form,
             vertices,
             radius,
             shift: V::zeros(),
+            outline,
             feature,
         }
     }
@@ -230,14 +246,9 @@ impl Body {
                 let d = b - a;
                 if rng.below(2) == 0 {
                     // Perpendicular: the whole segment is the support feature.
-                    let n = loop {
-                        let x = rng.direction();
-                        let perp = x - d * (x.dot(&d) / d.norm_squared());
-                        if perp.norm() > 1e-3 {
-                            break perp.normalize();
-                        }
-                    };
-                    (n, a + d * rng.unit_interval(), Some(d.normalize()))
+                    let e = d.normalize();
+                    let n = perpendicular(&e, rng);
+                    (n, a + d * rng.unit_interval(), Some(e))
                 } else {
                     let n = rng.direction();
                     (n, self.argmax(&n), None)
@@ -512,17 +523,34 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, (a - (s - bb)) + (b - bb))
 }
 
-/// A rotation taking unit `from` to unit `to`, turned about `to` by `spin`.
-fn aligning(from: &V, to: &V, spin: f64) -> UnitQuaternion<f64> {
-    let base = UnitQuaternion::rotation_between(from, to).unwrap_or_else(|| {
-        // Antiparallel: a half turn about any perpendicular.
-        let perp = from
-            .cross(&V::x())
-            .try_normalize(1e-6)
-            .unwrap_or_else(|| from.cross(&V::y()).normalize());
-        UnitQuaternion::from_axis_angle(&Unit::new_normalize(perp), std::f64::consts::PI)
-    });
-    UnitQuaternion::from_axis_angle(&Unit::new_normalize(*to), spin) * base
+/// `x` made orthogonal to unit `u` and normalised: Gram-Schmidt twice, so
+/// that `u·result` is round-off of `ε` however close `x` was to `u` (once
+/// leaves `ε/|x - (u·x)u|`, which the generator's nearly parallel edges turn
+/// into a tilt of the common normal, and a truth off by 1e-13 of the size).
+fn orthogonal(u: &V, x: &V) -> V {
+    let once = x - u * u.dot(x);
+    let twice = once - u * u.dot(&once);
+    twice.normalize()
+}
+
+/// A random unit vector orthogonal to unit `u`.
+fn perpendicular(u: &V, rng: &mut Rng) -> V {
+    loop {
+        let x = rng.direction();
+        if u.cross(&x).norm() > 0.5 {
+            return orthogonal(u, &x);
+        }
+    }
+}
+
+/// The rotation taking the orthonormal pair `(from, from_t)` to `(to, to_t)`,
+/// built from the two frames rather than from an angle and an axis (whose
+/// round-off grows as the vectors near antiparallel): it maps `from` to `to`
+/// within a few ε.
+fn frame_rotation(from: &V, from_t: &V, to: &V, to_t: &V) -> UnitQuaternion<f64> {
+    let frame = |a: &V, b: &V| nalgebra::Matrix3::from_columns(&[*a, *b, a.cross(b)]);
+    let m = frame(to, to_t) * frame(from, from_t).transpose();
+    UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m))
 }
 
 /// Draw one case. `big` lets 100 000-point bodies in.
@@ -598,21 +626,25 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
                             break f;
                         }
                     };
-                    let spin = if contact == Contact::NearlyParallelEdges {
-                        // The spin that makes B's edge parallel to A's, then
-                        // off by a drawn angle (or not at all).
-                        let base = aligning(&nb, &-n, 0.0);
-                        let (u, w) = (base * edge_b.expect("drawn"), ra * edge_a.expect("drawn"));
-                        let parallel = (-n).cross(&u).dot(&w).atan2(u.dot(&w));
+                    // B's feature faces A's: nb goes to -n; its second axis
+                    // (B's edge, or any direction across nb) goes to A's edge
+                    // turned by a drawn angle about n (or to any direction
+                    // across n).
+                    let from_t = match edge_b {
+                        Some(e) => orthogonal(&nb, &e),
+                        None => perpendicular(&nb, rng),
+                    };
+                    let to_t = if contact == Contact::NearlyParallelEdges {
+                        let w = orthogonal(&n, &(ra * edge_a.expect("drawn")));
                         let off = match rng.below(7) {
                             0 => 0.0,
                             k => rng.sign() * 10f64.powi(-2 * k as i32),
                         };
-                        parallel + off
+                        orthogonal(&n, &(w * off.cos() + n.cross(&w) * off.sin()))
                     } else {
-                        rng.uniform(0.0, std::f64::consts::TAU)
+                        perpendicular(&n, rng)
                     };
-                    (aligning(&nb, &-n, spin), q)
+                    (frame_rotation(&nb, &from_t, &-n, &to_t), q)
                 }
             };
             (rb, q, c, ra * p.coords + n * c)
@@ -650,7 +682,7 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
         let shift = rb.inverse() * err;
         if shift != V::zeros() {
             b.shift = shift;
-            for x in &mut b.vertices {
+            for x in b.vertices.iter_mut().chain(&mut b.outline) {
                 *x += shift;
             }
         }

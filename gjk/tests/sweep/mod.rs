@@ -61,6 +61,13 @@ impl Rng {
         items[self.below(items.len())]
     }
 
+    /// Fisher-Yates.
+    pub fn shuffle<T>(&mut self, items: &mut [T]) {
+        for i in (1..items.len()).rev() {
+            items.swap(i, self.below(i + 1));
+        }
+    }
+
     pub fn sign(&mut self) -> f64 {
         if self.next_u64() & 1 == 0 { 1.0 } else { -1.0 }
     }
@@ -396,9 +403,7 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
                     }
                 }
             }
-            for i in (1..pts.len()).rev() {
-                pts.swap(i, rng.below(i + 1));
-            }
+            rng.shuffle(&mut pts);
             Body::new(
                 "duplicates",
                 Form::Points,
@@ -415,9 +420,7 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
             for _ in 0..6 {
                 pts.push(a + (b - a) * rng.unit_interval());
             }
-            for i in (1..pts.len()).rev() {
-                pts.swap(i, rng.below(i + 1));
-            }
+            rng.shuffle(&mut pts);
             Body::new(
                 "collinear",
                 Form::Points,

@@ -171,6 +171,7 @@ fn the_generator_covers_its_kinds_and_its_truths_are_consistent() {
         Contact::ShallowOverlap,
         Contact::DeepOverlap,
         Contact::Identical,
+        Contact::Twins,
     ] {
         assert!(
             seen.get(&kind).copied().unwrap_or(0) > 20,
@@ -478,4 +479,65 @@ fn boxes_with_nearly_parallel_edges_far_out() {
         ),
     );
     found(&a, &pa, &b, &pb, 0.004372421954476569, 4.372421806096142e6);
+}
+
+/// Two copies of a coplanar set (a rectangle's corners, each twice, and six
+/// points inside), the copy turned 1e-8 rad about the normal of an edge and
+/// touching the original along it (truth 0). Warm from the answer at a pose
+/// 1 % of the size away, the run sat on an edge of K whose line passes
+/// 1.3e-9 below the origin (each new support point left that edge the
+/// nearest of its triangle) and reported 1.28e-9, 1.6e-9 of the size, as
+/// converged; cold it finds 0. Now a warm run whose interval is looser than
+/// the tolerance is asked again cold, and the two intervals intersected.
+#[test]
+fn coplanar_twins_touching_asked_warm() {
+    let rect = [
+        [-0.19629538615010655, -0.30942091365794466, -0.0],
+        [0.19629538615010655, -0.30942091365794466, -0.0],
+        [-0.19629538615010655, 0.30942091365794466, -0.0],
+        [0.19629538615010655, 0.30942091365794466, -0.0],
+        [-0.19629538615010655, -0.30942091365794466, 0.0],
+        [0.19629538615010655, -0.30942091365794466, 0.0],
+        [-0.19629538615010655, 0.30942091365794466, 0.0],
+        [0.19629538615010655, 0.30942091365794466, 0.0],
+        [0.07283620358330484, -0.19061864508819343, 0.0],
+        [-0.15374453374057837, -0.06589449166542075, 0.0],
+        [0.11827771458570413, 0.2743543736149002, 0.0],
+        [0.0651439552095564, 0.1729024681984801, 0.0],
+        [-0.09994804950546984, 0.20129957967143763, 0.0],
+        [0.13742106341017124, -0.1019377308120698, 0.0],
+    ];
+    let s = points(&rect);
+    // As printed by nalgebra: [i, j, k, w].
+    let q = |c: [f64; 4]| [c[3], c[0], c[1], c[2]];
+    let pa = pose(
+        q([
+            0.2879830480643115,
+            0.7228859819637057,
+            -0.2183212459738708,
+            0.5889290743921326,
+        ]),
+        [0.0, 0.0, 0.0],
+    );
+    let qb = q([
+        0.28798304697270527,
+        0.7228859790190603,
+        -0.21832124741378603,
+        0.5889290780065625,
+    ]);
+    let pb = pose(
+        qb,
+        [0.436083465453695, 0.4353398167314386, 0.1487714286482771],
+    );
+    let near = pose(
+        qb,
+        [0.43291130087451657, 0.436560936064922, 0.15577620447308632],
+    );
+    let size = 7.78592607849783e-1;
+    let o = Options::default();
+    let prev = distance(&s, &pa, &s, &near, &o, None).unwrap();
+    let ans = distance(&s, &pa, &s, &pb, &o, Some(&prev.warm_start)).unwrap();
+    assert!(ans.distance <= 1e-9 * size, "{ans:?}");
+    assert!(ans.lower <= 1e-15 * size, "{ans:?}");
+    assert!(ans.upper <= 1e-9 * size, "{ans:?}");
 }

@@ -474,6 +474,11 @@ pub enum Contact {
     DeepOverlap,
     /// The same body at the same pose twice.
     Identical,
+    /// B a copy of a centrally symmetric A, facing it across the drawn
+    /// feature and turned about the normal by 0 or 1e-2 to 1e-12 rad:
+    /// parallel faces, and equal edges nearly parallel, whose K has nearly
+    /// coincident points.
+    Twins,
 }
 
 /// One query with its truth.
@@ -560,14 +565,15 @@ fn frame_rotation(from: &V, from_t: &V, to: &V, to_t: &V) -> UnitQuaternion<f64>
 pub fn draw(rng: &mut Rng, big: bool) -> Case {
     let scale = rng.pick(&SCALES) * rng.uniform(0.5, 2.0);
     let offset = rng.pick(&OFFSETS);
-    let contact = match rng.below(20) {
+    let contact = match rng.below(22) {
         0..=6 => Contact::Separated,
         7..=10 => Contact::Aligned,
         11..=13 => Contact::NearlyParallelEdges,
         14..=15 => Contact::ShellsOverlap,
         16..=17 => Contact::ShallowOverlap,
         18 => Contact::DeepOverlap,
-        _ => Contact::Identical,
+        19 => Contact::Identical,
+        _ => Contact::Twins,
     };
     let scale_b = scale * rng.uniform(0.3, 3.0);
     let mut a = template(rng, scale, big);
@@ -593,7 +599,24 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
             b.radius = scale * rng.uniform(0.05, 0.5);
         }
     }
-    if contact == Contact::Identical {
+    if contact == Contact::Twins {
+        // Centrally symmetric bodies only: the copy's support point facing
+        // A is then the reflection of A's.
+        while !matches!(
+            a.name,
+            "box"
+                | "sphere"
+                | "segment"
+                | "capsule"
+                | "duplicates"
+                | "collinear"
+                | "coplanar"
+                | "point"
+        ) {
+            a = template(rng, scale, false);
+        }
+    }
+    if matches!(contact, Contact::Identical | Contact::Twins) {
         b = a.clone();
     }
     let size = a.diameter().max(b.diameter());
@@ -672,6 +695,16 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
             (rb, b.centre(), 0.0, ra * a.centre().coords)
         }
         Contact::Identical => (ra, p, 0.0, ra * p.coords),
+        Contact::Twins => {
+            gap = rng.pick(&GAPS);
+            let c = gap * size + a.radius + b.radius;
+            let off = match rng.below(7) {
+                0 => 0.0,
+                k => rng.sign() * 10f64.powi(-2 * k as i32),
+            };
+            let turn = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(na), off);
+            (ra * turn, -p, c, ra * p.coords + n * c)
+        }
     };
 
     let delta = world_target - rb * q.coords;
@@ -692,7 +725,7 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
     }
     let pb = Isometry3::from_parts(Translation3::from(tb), rb);
     let (truth, depth) = match contact {
-        Contact::Separated | Contact::Aligned | Contact::NearlyParallelEdges => {
+        Contact::Separated | Contact::Aligned | Contact::NearlyParallelEdges | Contact::Twins => {
             ((c - a.radius - b.radius).max(0.0), None)
         }
         Contact::ShellsOverlap => (0.0, Some(a.radius + b.radius - c)),

@@ -352,11 +352,10 @@ pub fn distance_in(
             };
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
             let run = pair.solve(simplex, options, warm_pairs, f64::INFINITY);
-            let answer = pair.answer(&run, simplex, place, [0, 0]);
-            if warm_pairs.is_some() && answer.upper - answer.lower > pair.loose(options.tolerance) {
-                pair.cold_again(answer, simplex, options, place)
+            if warm_pairs.is_some() && pair.loose(&run, options.tolerance) {
+                pair.cold_again(&run, simplex, options, place)
             } else {
-                answer
+                pair.answer(&run, simplex, place, [0, 0])
             }
         }
         _ => compound(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
@@ -817,11 +816,12 @@ impl<'s> Pair<'s> {
         }
     }
 
-    /// An interval wider than this (in the world's units) was not certified
-    /// to the tolerance: (6.2) alone ended the run near contact.
+    /// Whether the run's certified interval is wider than the tolerance
+    /// allows: (6.2) alone ended it, near contact.
     #[inline(always)]
-    fn loose(&self, tolerance: f64) -> f64 {
-        2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k
+    fn loose(&self, run: &Run, tolerance: f64) -> bool {
+        let (lower, upper, _) = self.bounds(run);
+        upper - lower > 2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k
     }
 
     /// A warm run that ended with a loose interval (the warm simplex can sit
@@ -833,11 +833,12 @@ impl<'s> Pair<'s> {
     #[inline(never)]
     fn cold_again(
         &self,
-        warm: Answer,
+        warm_run: &Run,
         simplex: &mut Simplex,
         options: &Options,
         place: Place<'_>,
     ) -> Answer {
+        let warm = self.answer(warm_run, simplex, place, [0, 0]);
         let run = self.solve(simplex, options, None, f64::INFINITY);
         let cold = self.answer(&run, simplex, place, [0, 0]);
         let (lower, upper) = (warm.lower.max(cold.lower), warm.upper.min(cold.upper));

@@ -1053,7 +1053,17 @@ fn compound(
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel, None, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
-        let run = pair.solve(simplex, options, warm_pairs, cutoff);
+        let mut run = pair.solve(simplex, options, warm_pairs, cutoff);
+        if warm_pairs.is_some() && run.exit != Exit::Pruned && pair.loose(&run, options.tolerance) {
+            // As for a single pair (`cold_again`), but the cold run is kept
+            // whole, since the simplex now holds its points; the warm run's
+            // lower bound, certified too, still counts.
+            let warm = run;
+            run = pair.solve(simplex, options, None, cutoff);
+            run.lower = run.lower.max(warm.lower);
+            run.iterations = run.iterations.saturating_add(warm.iterations);
+            run.backup_used |= warm.backup_used;
+        }
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
         if pair_upper < kept[1].0 {
             let entry = (pair_upper, PieceSimplex::of(simplex, run.sol.mask, [i, j]));

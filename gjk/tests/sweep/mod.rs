@@ -180,7 +180,7 @@ impl Body {
     }
 
     /// The mean of the vertices: a point of the core.
-    fn centre(&self) -> P {
+    pub fn centre(&self) -> P {
         let sum = self
             .vertices
             .iter()

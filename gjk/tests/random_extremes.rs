@@ -593,3 +593,104 @@ fn coplanar_twins_touching_asked_warm() {
         assert!(ans.upper <= 1e-9 * size, "{ans:?}");
     }
 }
+
+/// The certified bounds hold whatever the options: tolerance 0 or loose,
+/// iteration caps of 1 and 2, a margin on either side of the truth or at it.
+/// With tolerance 0 the distance must also meet the requirement.
+#[test]
+fn bounds_hold_under_every_option() {
+    let cases = env("SWEEP_CASES", 3000) as usize;
+    let mut rng = Rng::new(env("SWEEP_SEED", 1) ^ 0x5eed);
+    let mut failed = Vec::new();
+    for i in 0..cases {
+        let case = draw(&mut rng, i % 500 == 499);
+        let (a, b) = (case.a.shape(), case.b.shape());
+        let d = Options::default();
+        let variants = [
+            (
+                "tolerance 0",
+                Options {
+                    tolerance: 0.0,
+                    ..d
+                },
+            ),
+            (
+                "tolerance 1e-6",
+                Options {
+                    tolerance: 1e-6,
+                    ..d
+                },
+            ),
+            (
+                "cap 1",
+                Options {
+                    max_iterations: 1,
+                    ..d
+                },
+            ),
+            (
+                "cap 2",
+                Options {
+                    max_iterations: 2,
+                    ..d
+                },
+            ),
+            (
+                "margin below",
+                Options {
+                    margin: Some(0.5 * case.truth),
+                    ..d
+                },
+            ),
+            (
+                "margin above",
+                Options {
+                    margin: Some(case.truth + 1e-3 * case.size),
+                    ..d
+                },
+            ),
+            (
+                "margin at",
+                Options {
+                    margin: Some(case.truth),
+                    ..d
+                },
+            ),
+        ];
+        for (name, o) in variants {
+            let ans = match distance(&a, &case.pa, &b, &case.pb, &o, None) {
+                Ok(x) => x,
+                Err(e) => {
+                    failed.push(format!("{name}: {}: error {e:?}", case.describe()));
+                    continue;
+                }
+            };
+            let mut why: Vec<String> = bounds_error(&case, ans.lower, ans.upper)
+                .into_iter()
+                .collect();
+            if name == "tolerance 0" {
+                why.extend(distance_error(&case, ans.distance));
+            }
+            if !(ans.lower <= ans.distance && ans.distance <= ans.upper) {
+                why.push("distance outside its bounds".into());
+            }
+            if !why.is_empty() {
+                failed.push(format!(
+                    "{name}: {}: got {:e} [{:e}, {:e}] {:?}: {}",
+                    case.describe(),
+                    ans.distance,
+                    ans.lower,
+                    ans.upper,
+                    ans.status,
+                    why.join("; ")
+                ));
+            }
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "{} failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
+}

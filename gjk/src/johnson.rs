@@ -561,8 +561,9 @@ impl Simplex {
         self.delta[mask & 15][missing(mask)] != 0.0
     }
 
-    /// `v(aff Y_s)` of a thin triangle: the origin's projection on its plane,
-    /// `n (n·y_i) / |n|²`. `Σ λ_i y_i` would carry the weights' error `ε/θ`
+    /// `v(aff Y_s)` of a thin triangle, `None` when it has no plane: the
+    /// origin's projection on its plane, `n (n·y_i) / |n|²`. `Σ λ_i y_i`
+    /// would carry the weights' error `ε/θ`
     /// times the triangle's length, along its length, which is more than the
     /// whole distance near contact. The plane's normal, from two long edges
     /// by fused products, is tilted by round-off only about the triangle's
@@ -571,22 +572,14 @@ impl Simplex {
     /// that: the lower bound of Theorem 4.1 stays tight.
     #[cold]
     #[inline(never)]
-    fn thin_v(&self, mask: usize) -> Vector3<f64> {
+    fn thin_v(&self, mask: usize) -> Option<Vector3<f64>> {
         let (mem, _) = MEMBERS[mask & 15];
         let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
         let [yi, yj, yk] = [i, j, k].map(|x| self.vertices[x].y);
         let n = fused_cross(&(yj - yi), &(yk - yi));
         let nn = n.norm_squared();
-        if nn.is_nan() || nn == 0.0 {
-            // A triangle flat to the last bit: no plane; the weights decide.
-            let (mem, _) = MEMBERS[mask & 15];
-            let total = self.total(mask);
-            return mem[..3].iter().fold(Vector3::zeros(), |acc, &x| {
-                let x = x as usize & 3;
-                acc + self.vertices[x].y * (self.delta[mask & 15][x] / total)
-            });
-        }
-        n * (n.dot(&yi) / nn)
+        // A triangle flat to the last bit has no plane: the weights decide.
+        (nn > 0.0).then(|| n * (n.dot(&yi) / nn))
     }
 
     /// (5.6): `Δ_j(Y_s ∪ {y_j}) = Σ_{i∈I_s} Δ_i(Y_s)(y_i·y_k - y_i·y_j)`,
@@ -740,8 +733,11 @@ impl Simplex {
             lambda[i] = l;
             v += self.vertices[i].y * l;
         }
-        if len == 3 && self.is_thin(mask) {
-            v = self.thin_v(mask);
+        if len == 3
+            && self.is_thin(mask)
+            && let Some(p) = self.thin_v(mask)
+        {
+            v = p;
         }
         Solution {
             mask: mask as u8,

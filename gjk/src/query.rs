@@ -351,12 +351,11 @@ pub fn distance_in(
                 offset: None,
             };
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let run = pair.solve(simplex, options, warm_pairs, f64::INFINITY);
+            let mut run = pair.solve(simplex, options, warm_pairs, f64::INFINITY);
             if warm_pairs.is_some() && pair.loose(&run, options.tolerance) {
-                pair.cold_again(&run, simplex, options, place)
-            } else {
-                pair.answer(&run, simplex, place, [0, 0])
+                run = pair.cold_again(run, simplex, options, f64::INFINITY);
             }
+            pair.answer(&run, simplex, place, [0, 0])
         }
         _ => compound(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
     };
@@ -827,32 +826,17 @@ impl<'s> Pair<'s> {
     /// A warm run that ended with a loose interval (the warm simplex can sit
     /// on an edge of a flat K whose line passes 1e-9 of the size from the
     /// origin, coplanar sets touching, where no support point leads off it):
-    /// the query once more from the single-point start, and the nearer of
-    /// the two answers with the intersection of their certified intervals.
+    /// the run once more from the single-point start. The cold run is kept
+    /// whole, since the simplex now holds its points; the warm run's lower
+    /// bound, certified too, still counts.
     #[cold]
     #[inline(never)]
-    fn cold_again(
-        &self,
-        warm_run: &Run,
-        simplex: &mut Simplex,
-        options: &Options,
-        place: Place<'_>,
-    ) -> Answer {
-        let warm = self.answer(warm_run, simplex, place, [0, 0]);
-        let run = self.solve(simplex, options, None, f64::INFINITY);
-        let cold = self.answer(&run, simplex, place, [0, 0]);
-        let (lower, upper) = (warm.lower.max(cold.lower), warm.upper.min(cold.upper));
-        let iterations = warm.iterations.saturating_add(cold.iterations);
-        let backup_used = warm.backup_used || cold.backup_used;
-        let mut best = if cold.upper <= warm.upper { cold } else { warm };
-        if lower <= upper {
-            best.lower = lower;
-            best.upper = upper;
-            best.distance = best.distance.max(lower).min(upper);
-        }
-        best.iterations = iterations;
-        best.backup_used = backup_used;
-        best
+    fn cold_again(&self, warm: Run, simplex: &mut Simplex, options: &Options, cutoff: f64) -> Run {
+        let mut run = self.solve(simplex, options, None, cutoff);
+        run.lower = run.lower.max(warm.lower);
+        run.iterations = run.iterations.saturating_add(warm.iterations);
+        run.backup_used |= warm.backup_used;
+        run
     }
 
     /// A lower bound on the cores' penetration depth once `v` is the origin.
@@ -1055,14 +1039,7 @@ fn compound(
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
         let mut run = pair.solve(simplex, options, warm_pairs, cutoff);
         if warm_pairs.is_some() && run.exit != Exit::Pruned && pair.loose(&run, options.tolerance) {
-            // As for a single pair (`cold_again`), but the cold run is kept
-            // whole, since the simplex now holds its points; the warm run's
-            // lower bound, certified too, still counts.
-            let warm = run;
-            run = pair.solve(simplex, options, None, cutoff);
-            run.lower = run.lower.max(warm.lower);
-            run.iterations = run.iterations.saturating_add(warm.iterations);
-            run.backup_used |= warm.backup_used;
+            run = pair.cold_again(run, simplex, options, cutoff);
         }
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
         if pair_upper < kept[1].0 {

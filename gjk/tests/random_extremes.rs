@@ -527,8 +527,8 @@ fn boxes_with_nearly_parallel_edges_far_out() {
 /// 1.3e-9 below the origin (each new support point left that edge the
 /// nearest of its triangle) and reported 1.28e-9, 1.6e-9 of the size, as
 /// converged; cold it finds 0. Now a warm run whose interval is looser than
-/// the tolerance is asked again cold, and the two intervals intersected; a
-/// union's warm piece pair likewise.
+/// the tolerance runs again cold, keeping the warm lower bound; a union's
+/// warm piece pair likewise.
 #[test]
 fn coplanar_twins_touching_asked_warm() {
     let rect = [

@@ -5,23 +5,9 @@
 
 mod common;
 
-use common::{P, shape_distance};
-use gjk::{Convex, Options, Shape, Status, distance};
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
-
-/// A pose from nalgebra's printed form: quaternion `[i, j, k, w]`, then the
-/// translation.
-fn pose(q: [f64; 4], t: [f64; 3]) -> Isometry3<f64> {
-    // As printed: already unit, to the last bit; normalising again would move
-    // the pose off the case that failed.
-    let q = UnitQuaternion::new_unchecked(Quaternion::new(q[3], q[0], q[1], q[2]));
-    Isometry3::from_parts(Translation3::new(t[0], t[1], t[2]), q)
-}
-
-fn shape(points: &[[f64; 3]]) -> Shape {
-    let points: Vec<P> = points.iter().map(|c| Point3::from(*c)).collect();
-    Convex::new(points, 0.0).unwrap().into()
-}
+use common::{points as shape, printed_pose as pose, shape_distance};
+use gjk::{Options, Shape, Status, distance};
+use nalgebra::Isometry3;
 
 /// The answer against the brute force: bounds around the truth (to round-off
 /// of the brute force) and the distance within 1e-9 of the scene's size.

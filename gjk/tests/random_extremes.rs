@@ -9,8 +9,10 @@
 //! `SWEEP_CASES` and `SWEEP_SEED` set a longer hunt (release mode advised):
 //! `SWEEP_CASES=1000000 SWEEP_SEED=7 cargo test --release -p gjk --test random_extremes`.
 
+mod common;
 mod sweep;
 
+use common::{points, printed_pose as pose};
 use gjk::{Options, Status, distance};
 use sweep::{Case, Contact, Rng, bounds_error, depth_error, distance_error, draw};
 
@@ -219,20 +221,6 @@ fn the_generator_covers_its_kinds_and_its_truths_are_consistent() {
     }
 }
 
-/// A pose from the sweep's printed form: quaternion `[w, i, j, k]`, then the
-/// translation.
-fn pose(q: [f64; 4], t: [f64; 3]) -> nalgebra::Isometry3<f64> {
-    // As printed: unit to the last bit; normalising again would move the case.
-    let q =
-        nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
-    nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(t[0], t[1], t[2]), q)
-}
-
-fn points(p: &[[f64; 3]]) -> gjk::Shape {
-    let p: Vec<sweep::P> = p.iter().map(|&c| c.into()).collect();
-    gjk::Convex::new(p, 0.0).unwrap().into()
-}
-
 /// One found case against its truth, computed in exact rational arithmetic
 /// from the f64 inputs (the minimum over vertex-triangle and edge-edge pairs,
 /// the hulls being disjoint by construction): the distance within 1e-9 of
@@ -365,19 +353,19 @@ fn nearly_parallel_collinear_sets_a_hair_apart() {
     let (pa, pb) = (
         pose(
             [
-                0.9483637100386378,
                 -0.28612318318787855,
                 0.016218487145190582,
                 0.1359292396760447,
+                0.9483637100386378,
             ],
             [0.0, -0.0, 0.0],
         ),
         pose(
             [
-                0.26056901177646513,
                 0.4136082656251566,
                 -0.868766496042635,
                 -0.07922605671234945,
+                0.26056901177646513,
             ],
             [
                 1.3076576195849176e-06,
@@ -449,19 +437,19 @@ fn collinear_set_and_box_with_nearly_parallel_edges() {
     let (pa, pb) = (
         pose(
             [
-                0.3276651837731185,
                 0.5227586200636163,
                 0.6127923240727258,
                 0.49380615635050507,
+                0.3276651837731185,
             ],
             [-758.1517388459449, 565.2869125632442, 325.048684614452],
         ),
         pose(
             [
-                0.7154342980937066,
                 -0.31243112960746033,
                 -0.6158946669832605,
                 0.10589765599365461,
+                0.7154342980937066,
             ],
             [-758.7709759420346, 565.1332534612295, 324.4072596382188],
         ),
@@ -500,19 +488,19 @@ fn boxes_with_nearly_parallel_edges_far_out() {
     let (pa, pb) = (
         pose(
             [
-                -0.5508668759394175,
                 -0.101028352064601,
                 -0.78203014305604,
                 -0.2734370355742012,
+                -0.5508668759394175,
             ],
             [893225265.43513, 440135603.3255972, 91811087.96629171],
         ),
         pose(
             [
-                0.5622831281169708,
                 -0.14647899598240824,
                 -0.643018121225067,
                 0.4989080910820799,
+                0.5622831281169708,
             ],
             [895630704.0610824, 442041475.8278197, 92677021.36581834],
         ),
@@ -548,23 +536,21 @@ fn coplanar_twins_touching_asked_warm() {
         [0.13742106341017124, -0.1019377308120698, 0.0],
     ];
     let s = points(&rect);
-    // As printed by nalgebra: [i, j, k, w].
-    let q = |c: [f64; 4]| [c[3], c[0], c[1], c[2]];
     let pa = pose(
-        q([
+        [
             0.2879830480643115,
             0.7228859819637057,
             -0.2183212459738708,
             0.5889290743921326,
-        ]),
+        ],
         [0.0, 0.0, 0.0],
     );
-    let qb = q([
+    let qb = [
         0.28798304697270527,
         0.7228859790190603,
         -0.21832124741378603,
         0.5889290780065625,
-    ]);
+    ];
     let pb = pose(
         qb,
         [0.436083465453695, 0.4353398167314386, 0.1487714286482771],

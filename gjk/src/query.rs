@@ -232,7 +232,8 @@ pub struct Answer {
     /// Lower bound on the penetration depth (the smallest translation that
     /// separates the shapes): 0 when separated, exact when only the rounded
     /// shells overlap, the inner radius of the final simplex (5.9) plus the
-    /// radii when the cores intersect.
+    /// radii when the cores intersect. For a compound, the largest of its
+    /// piece pairs' bounds.
     pub penetration: f64,
     /// Subalgorithm iterations, summed over piece pairs for compounds.
     pub iterations: u32,
@@ -241,7 +242,8 @@ pub struct Answer {
     /// Whether the Backup Procedure (6.5) was needed.
     pub backup_used: bool,
     /// `[piece of A, piece of B]` that realise the distance (`[0, 0]` for two
-    /// convex shapes).
+    /// convex shapes). After an early exit on a margin, the pair nearest so
+    /// far, which need not be the nearest of all.
     pub pieces: [u32; 2],
     /// The final simplex, for the next query of this pair.
     pub warm_start: WarmStart,
@@ -1053,9 +1055,15 @@ fn compound(
         iterations = iterations.saturating_add(run.iterations);
         backup_used |= run.backup_used;
         lower = lower.min(pair_lower);
-        if run.norm == 0.0 {
-            penetration = penetration.max(run.inner + pair.radii);
-        }
+        // Separating the union means separating every piece pair: the
+        // deepest pair's bound, whichever pair ends up named, bounds the
+        // union's depth (a pair whose only the shells overlap counts too).
+        let pair_depth = if run.norm == 0.0 {
+            run.inner + pair.radii
+        } else {
+            pair.radii - run.norm
+        };
+        penetration = penetration.max(pair_depth);
         let status = match run.exit {
             Exit::Pruned => continue,
             Exit::Status(s) => s,

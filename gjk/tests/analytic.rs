@@ -563,6 +563,32 @@ fn penetration_exact_when_only_shells_overlap() {
     assert_distance(&ans, 0.4, 1e-14);
 }
 
+/// A union's penetration bound is its deepest piece pair's, whichever pair
+/// the answer names. A ball of radius 1 at the origin against a long capsule
+/// (radius 1, core 1.9 above the origin: shells 0.1 deep) and a ball of
+/// radius 1 at x = 1 (shells 1.0 deep). The capsule's loose bounding sphere
+/// puts it first, and both overlapping pairs report distance 0, so the capsule
+/// is named; before, only its 0.1 was reported. Separating the ball from the
+/// union needs at least 1.0 (from the ball piece alone) and at most √3
+/// (moving it along -y clears both).
+#[test]
+fn compound_penetration_is_the_deepest_pairs() {
+    let a: Shape = Compound::new(vec![
+        (
+            iso(0., 1.9, 0.),
+            Convex::capsule(p(-10., 0., 0.), p(10., 0., 0.), 1.0).unwrap(),
+        ),
+        (iso(1., 0., 0.), Convex::sphere(1.0).unwrap()),
+    ])
+    .unwrap()
+    .into();
+    let ball: Shape = Convex::sphere(1.0).unwrap().into();
+    let ans = query(&a, &iso(0., 0., 0.), &ball, &iso(0., 0., 0.));
+    assert_distance(&ans, 0.0, 0.0);
+    assert_eq!(ans.pieces, [0, 0], "{ans:?}");
+    assert!((ans.penetration - 1.0).abs() < 1e-14, "{ans:?}");
+    assert!(ans.penetration <= 3f64.sqrt(), "{ans:?}");
+}
 // ---------------------------------------------------------------------------
 // Margins
 

@@ -581,8 +581,10 @@ fn coplanar_twins_touching_asked_warm() {
 }
 
 /// The certified bounds hold whatever the options: tolerance 0 or loose,
-/// iteration caps of 1 and 2, a margin on either side of the truth or at it.
-/// With tolerance 0 the distance must also meet the requirement.
+/// iteration caps of 1 and 2, a margin on either side of the truth (far, or
+/// 1e-9 of the size away) or at it. With tolerance 0 the distance must also
+/// meet the requirement, and an early exit on a margin must decide it as the
+/// truth does.
 #[test]
 fn bounds_hold_under_every_option() {
     let cases = env("SWEEP_CASES", 3000) as usize;
@@ -642,6 +644,20 @@ fn bounds_hold_under_every_option() {
                     ..d
                 },
             ),
+            (
+                "margin a hair below",
+                Options {
+                    margin: Some((case.truth - 1e-9 * case.size).max(0.0)),
+                    ..d
+                },
+            ),
+            (
+                "margin a hair above",
+                Options {
+                    margin: Some(case.truth + 1e-9 * case.size),
+                    ..d
+                },
+            ),
         ];
         for (name, o) in variants {
             let ans = match distance(&a, &case.pa, &b, &case.pb, &o, None) {
@@ -657,8 +673,28 @@ fn bounds_hold_under_every_option() {
             if name == "tolerance 0" {
                 why.extend(distance_error(&case, ans.distance));
             }
+            // An early exit is a decision about the truth: "farther than m"
+            // must hold of the truth, and so must "at most m".
+            if let Some(m) = o.margin {
+                let t = case.truth;
+                let wrong = match ans.status {
+                    Status::Farther => !(ans.lower > m && t + case.truth_slack > m),
+                    Status::Closer => !(ans.upper <= m && t - case.truth_slack <= m),
+                    _ => false,
+                };
+                if wrong {
+                    why.push(format!("{:?} about margin {m:e}", ans.status));
+                }
+            }
             if !(ans.lower <= ans.distance && ans.distance <= ans.upper) {
                 why.push("distance outside its bounds".into());
+            }
+            // Whatever ended the run, the depth bound is a lower bound.
+            if let Some(depth) = case.depth {
+                let allowed = (1e-6 * depth).max(1e-9 * case.size) + case.truth_slack;
+                if ans.penetration.is_nan() || ans.penetration > depth + allowed {
+                    why.push(format!("penetration {:e} above {depth:e}", ans.penetration));
+                }
             }
             if !why.is_empty() {
                 failed.push(format!(
@@ -668,6 +704,196 @@ fn bounds_hold_under_every_option() {
                     ans.lower,
                     ans.upper,
                     ans.status,
+                    why.join("; ")
+                ));
+            }
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "{} failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
+}
+
+/// Copies of `body` as pieces of a union, none nearer to the other body than
+/// `body` itself: each copy is turned (or not), shrunk about its centre (or
+/// not) and placed so that its reach along `u` (the body-frame direction
+/// towards the other body) is `body`'s own less a drawn `δ` from 0 (a tie) to
+/// 3 sizes, and slid across `u` by up to 2 sizes. The construction puts the
+/// other body's core beyond the plane where `body`'s reach along `u` ends, so
+/// each copy stays behind that plane and the union's distance is the case's
+/// truth. `body` itself is one of the pieces, at a drawn place in the order.
+fn copies(
+    rng: &mut Rng,
+    body: &sweep::Body,
+    u: &sweep::V,
+    size: f64,
+) -> (gjk::Shape, Vec<(nalgebra::Isometry3<f64>, gjk::Convex)>) {
+    let reach = |vertices: &[sweep::P], r: f64| {
+        vertices
+            .iter()
+            .map(|x| u.dot(&x.coords))
+            .fold(f64::NEG_INFINITY, f64::max)
+            + r
+    };
+    let own = reach(&body.vertices, body.radius);
+    let centre = body.centre();
+    let count = 1 + rng.below(4);
+    let mut pieces = vec![(
+        nalgebra::Isometry3::identity(),
+        gjk::Convex::new(body.vertices.clone(), body.radius).unwrap(),
+    )];
+    for _ in 0..count {
+        let turn = if rng.below(2) == 0 {
+            nalgebra::UnitQuaternion::identity()
+        } else {
+            rng.rotation()
+        };
+        let (shrink, radius) = if rng.below(2) == 0 {
+            (1.0, body.radius)
+        } else {
+            (rng.uniform(0.1, 0.9), body.radius * rng.unit_interval())
+        };
+        let vertices: Vec<sweep::P> = body
+            .vertices
+            .iter()
+            .map(|x| centre + (x - centre) * shrink)
+            .collect();
+        let turned: Vec<sweep::P> = vertices.iter().map(|x| turn * x).collect();
+        let delta = rng.pick(&[0.0, 1e-9, 1e-6, 1e-3, 0.1, 1.0, 3.0]) * size;
+        let across = rng.direction();
+        let across = (across - u * u.dot(&across)) * (rng.uniform(0.0, 2.0) * size);
+        let t = u * (own - reach(&turned, radius) - delta) + across;
+        pieces.push((
+            nalgebra::Isometry3::from_parts(t.into(), turn),
+            gjk::Convex::new(vertices, radius).unwrap(),
+        ));
+    }
+    rng.shuffle(&mut pieces);
+    let shape = gjk::Compound::new(pieces.clone()).unwrap().into();
+    (shape, pieces)
+}
+
+/// Unions of up to five pieces on each side, the case's bodies among copies
+/// of themselves that are no nearer (some exactly as near: ties), asked cold,
+/// warm and with a margin at the truth or 1e-9 or 1e-3 of the size either
+/// side of it: the distance, bounds and status as for one pair, or an early
+/// exit that decides the margin as the truth does; the pieces the
+/// answer names realise the distance (their own distance is the truth); a
+/// penetration bound at least the near pieces' exact depth (the union's depth
+/// can only be larger); and nearest points `distance` apart.
+#[test]
+fn unions_of_many_pieces_keep_the_truth() {
+    let cases = env("SWEEP_CASES", 3000) as usize / 3;
+    let mut rng = Rng::new(env("SWEEP_SEED", 1) ^ 0x0c0b1e5);
+    let mut failed = Vec::new();
+    let o = Options::default();
+    for _ in 0..cases {
+        let case = draw(&mut rng, false);
+        // Towards B in A's body frame, and towards A in B's.
+        let ua = case.pa.rotation.inverse() * case.normal;
+        let ub = case.pb.rotation.inverse() * -case.normal;
+        let (a, pieces_a) = copies(&mut rng, &case.a, &ua, case.size);
+        let (b, pieces_b) = copies(&mut rng, &case.b, &ub, case.size);
+        let nudge = nalgebra::Translation3::from(rng.direction() * (0.01 * case.size));
+        let m = (case.truth + rng.pick(&[-1e-3, -1e-9, 0.0, 1e-9, 1e-3]) * case.size).max(0.0);
+        let margin = Options {
+            margin: Some(m),
+            ..o
+        };
+        let asked = distance(&a, &case.pa, &b, &(nudge * case.pb), &o, None).and_then(|prev| {
+            Ok([
+                ("cold", distance(&a, &case.pa, &b, &case.pb, &o, None)?),
+                (
+                    "warm",
+                    distance(&a, &case.pa, &b, &case.pb, &o, Some(&prev.warm_start))?,
+                ),
+                (
+                    "margin",
+                    distance(&a, &case.pa, &b, &case.pb, &margin, None)?,
+                ),
+            ])
+        });
+        let answers = match asked {
+            Ok(x) => x,
+            Err(e) => {
+                failed.push(format!("{}: error {e:?}", case.describe()));
+                continue;
+            }
+        };
+        let allowed = (1e-6 * case.truth).max(1e-9 * case.size) + case.truth_slack;
+        for (how, ans) in answers {
+            let mut why: Vec<String> = bounds_error(&case, ans.lower, ans.upper)
+                .into_iter()
+                .collect();
+            if how == "margin" {
+                // An early exit must decide as the truth does; a run to the
+                // end must meet the requirement.
+                let t = case.truth;
+                match ans.status {
+                    Status::Farther if !(ans.lower > m && t + case.truth_slack > m) => {
+                        why.push(format!("Farther than margin {m:e}"));
+                    }
+                    Status::Closer if !(ans.upper <= m && t - case.truth_slack <= m) => {
+                        why.push(format!("Closer than margin {m:e}"));
+                    }
+                    Status::Farther | Status::Closer => {}
+                    _ => why.extend(distance_error(&case, ans.distance)),
+                }
+            } else {
+                why.extend(distance_error(&case, ans.distance));
+                why.extend(status_error(&case, &ans));
+            }
+            // An early exit stops before the depth is worked out (its bound
+            // may be far below): checked on runs to the end only.
+            if let Some(depth) = case.depth
+                && how != "margin"
+                && (ans.penetration.is_nan() || ans.penetration < depth - allowed)
+            {
+                why.push(format!("penetration {:e} below {depth:e}", ans.penetration));
+            }
+            // The named pieces alone, each at its offset: a union of one. An
+            // early exit names the pair that decided it, not the nearest.
+            let [i, j] = ans.pieces.map(|k| k as usize);
+            let alone = |p: &(nalgebra::Isometry3<f64>, gjk::Convex)| -> gjk::Shape {
+                gjk::Compound::new(vec![p.clone()]).unwrap().into()
+            };
+            match distance(
+                &alone(&pieces_a[i]),
+                &case.pa,
+                &alone(&pieces_b[j]),
+                &case.pb,
+                &o,
+                None,
+            ) {
+                Ok(pair) if how != "margin" && pair.lower > case.truth + allowed => {
+                    why.push(format!(
+                        "pieces {:?} are {:e} apart, not the nearest",
+                        ans.pieces, pair.lower
+                    ))
+                }
+                Ok(_) => {}
+                Err(e) => why.push(format!("pieces {:?}: error {e:?}", ans.pieces)),
+            }
+            // World points at 1e9 from the origin carry 1e-7 of round-off.
+            let span = (ans.point_b - ans.point_a).norm();
+            if case.truth > 0.0 && case.offset == 0.0 && (span - ans.distance).abs() > allowed {
+                why.push(format!("nearest points {span:e} apart"));
+            }
+            if !why.is_empty() {
+                failed.push(format!(
+                    "{} ({how}, {}×{} pieces): got {:e} [{:e}, {:e}] pen {:e} {:?} pieces {:?}: {}",
+                    case.describe(),
+                    pieces_a.len(),
+                    pieces_b.len(),
+                    ans.distance,
+                    ans.lower,
+                    ans.upper,
+                    ans.penetration,
+                    ans.status,
+                    ans.pieces,
                     why.join("; ")
                 ));
             }

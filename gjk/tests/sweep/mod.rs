@@ -500,6 +500,10 @@ pub struct Case {
     pub offset: f64,
     /// The gap drawn, as a fraction of `size` (0 for overlaps).
     pub gap: f64,
+    /// The world direction `n` of the construction: for the separated kinds
+    /// (and twins) A's core lies in `n·x <= h` and B's in `n·x >= h + c`, so
+    /// a body moved or shrunk within its half space is no nearer.
+    pub normal: V,
 }
 
 impl Case {
@@ -745,6 +749,7 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
         scale,
         offset,
         gap,
+        normal: n,
     }
 }
 

@@ -778,12 +778,13 @@ fn copies(
 
 /// Unions of up to five pieces on each side, the case's bodies among copies
 /// of themselves that are no nearer (some exactly as near: ties), asked cold,
-/// warm and with a margin at the truth or 1e-9 or 1e-3 of the size either
-/// side of it: the distance, bounds and status as for one pair, or an early
-/// exit that decides the margin as the truth does; the pieces the
-/// answer names realise the distance (their own distance is the truth); a
-/// penetration bound at least the near pieces' exact depth (the union's depth
-/// can only be larger); and nearest points `distance` apart.
+/// warm, in f32 (held as [`check_single`] holds one pair) and with a margin at
+/// the truth or 1e-9 or 1e-3 of the size either side of it: the distance,
+/// bounds and status as for one pair, or an early exit that decides the
+/// margin as the truth does; the pieces the answer names realise the distance
+/// (their own distance is the truth); a penetration bound at least the near
+/// pieces' exact depth (the union's depth can only be larger); and nearest
+/// points `distance` apart.
 #[test]
 fn unions_of_many_pieces_keep_the_truth() {
     let cases = env("SWEEP_CASES", 3000) as usize / 3;
@@ -803,6 +804,10 @@ fn unions_of_many_pieces_keep_the_truth() {
             margin: Some(m),
             ..o
         };
+        let single = Options {
+            precision: gjk::Precision::Single,
+            ..o
+        };
         let asked = distance(&a, &case.pa, &b, &(nudge * case.pb), &o, None).and_then(|prev| {
             Ok([
                 ("cold", distance(&a, &case.pa, &b, &case.pb, &o, None)?),
@@ -813,6 +818,10 @@ fn unions_of_many_pieces_keep_the_truth() {
                 (
                     "margin",
                     distance(&a, &case.pa, &b, &case.pb, &margin, None)?,
+                ),
+                (
+                    "single",
+                    distance(&a, &case.pa, &b, &case.pb, &single, None)?,
                 ),
             ])
         });
@@ -825,6 +834,23 @@ fn unions_of_many_pieces_keep_the_truth() {
         };
         let allowed = (1e-6 * case.truth).max(1e-9 * case.size) + case.truth_slack;
         for (how, ans) in answers {
+            if how == "single" {
+                // The f32 search's own allowance; its bounds hold all the same.
+                let why = check_single(&case, &ans);
+                if !why.is_empty() {
+                    failed.push(format!(
+                        "{} (single, {}×{} pieces): got {:e} [{:e}, {:e}]: {}",
+                        case.describe(),
+                        pieces_a.len(),
+                        pieces_b.len(),
+                        ans.distance,
+                        ans.lower,
+                        ans.upper,
+                        why.join("; ")
+                    ));
+                }
+                continue;
+            }
             let mut why: Vec<String> = bounds_error(&case, ans.lower, ans.upper)
                 .into_iter()
                 .collect();

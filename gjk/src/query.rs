@@ -749,6 +749,7 @@ impl<'s> Pair<'s> {
                 // step that only grows V̂ by a dimension, with |v| unchanged at
                 // round-off level, is also progress (nearly parallel edges give
                 // such steps); a few are allowed before step (5) takes over.
+                let mut not_down = false;
                 let descended = match prev {
                     None => true,
                     Some((_, p2)) if v2 < p2 => true,
@@ -762,12 +763,14 @@ impl<'s> Pair<'s> {
                         // of the last, and stopping there leaves |v| at
                         // (6.2)'s √ε·D (nearly parallel edges touching).
                         let level = norm <= p2.sqrt() + self.slack;
-                        let ok = (flat || level) && flat_steps < 4;
-                        flat_steps += ok as u32;
-                        ok
+                        not_down = true;
+                        (flat || level) && flat_steps < 4
                     }
                 };
                 if descended && sol.mask.count_ones() <= 3 && !repeat {
+                    // Only a step taken counts against the budget: a repeat
+                    // refined within the iteration is the same step.
+                    flat_steps += not_down as u32;
                     prev = Some((sol, v2));
                     simplex.push(sol.mask, s);
                     break;

@@ -193,9 +193,12 @@ fn random_extreme_cases_meet_the_requirement() {
 fn the_generator_covers_its_kinds_and_its_truths_are_consistent() {
     let mut rng = Rng::new(99);
     let mut seen = std::collections::BTreeMap::new();
+    let mut names = std::collections::BTreeMap::new();
     for _ in 0..2000 {
         let case = draw(&mut rng, false);
         *seen.entry(case.contact).or_insert(0) += 1;
+        *names.entry(case.a.name).or_insert(0) += 1;
+        *names.entry(case.b.name).or_insert(0) += 1;
         // World vertices of both cores.
         let world = |b: &sweep::Body, pose: &nalgebra::Isometry3<f64>| -> Vec<sweep::P> {
             b.vertices.iter().map(|x| pose * x).collect()
@@ -214,6 +217,22 @@ fn the_generator_covers_its_kinds_and_its_truths_are_consistent() {
             case.describe(),
             nearest_pair - radii
         );
+        // The slab itself: A's cores end where the drawn normal says, and
+        // B's begin the truth (plus the radii) beyond.
+        if matches!(
+            case.contact,
+            Contact::Separated | Contact::Aligned | Contact::NearlyParallelEdges | Contact::Twins
+        ) {
+            let n = case.normal;
+            let top_a = wa.iter().map(|x| n.dot(&x.coords)).fold(f64::MIN, f64::max);
+            let low_b = wb.iter().map(|x| n.dot(&x.coords)).fold(f64::MAX, f64::min);
+            let slab = low_b - top_a - radii;
+            assert!(
+                (slab - case.truth).abs() <= tol,
+                "{}: the slab is {slab:e} wide",
+                case.describe()
+            );
+        }
     }
     for kind in [
         Contact::Separated,
@@ -228,6 +247,24 @@ fn the_generator_covers_its_kinds_and_its_truths_are_consistent() {
         assert!(
             seen.get(&kind).copied().unwrap_or(0) > 20,
             "{kind:?} drawn {seen:?}"
+        );
+    }
+    for name in [
+        "box",
+        "sphere",
+        "segment",
+        "capsule",
+        "triangle",
+        "polytope",
+        "duplicates",
+        "collinear",
+        "coplanar",
+        "point",
+        "prism",
+    ] {
+        assert!(
+            names.get(name).copied().unwrap_or(0) > 50,
+            "{name} drawn {names:?}"
         );
     }
 }

@@ -127,6 +127,9 @@ enum Feature {
     Box(V),
     Segment(P, P),
     Triangle([P; 3]),
+    /// An `n`-gonal frustum (a prism when its ends match): vertices `0..n`
+    /// are the bottom end's, `n..2n` the top's, in the same turn.
+    Prism(usize),
     /// Only the vertex maximising `n·x` is known.
     Generic,
 }
@@ -290,7 +293,68 @@ impl Body {
                     }
                 }
             }
+            Feature::Prism(k) => self.prism_feature(k, rng),
             Feature::Generic => {
+                let n = rng.direction();
+                (n, self.argmax(&n), None)
+            }
+        }
+    }
+
+    /// [`feature`](Self::feature) of an `k`-gonal frustum: an end face, a
+    /// side face, a side edge, an end edge or a vertex. Faces get a point of
+    /// the face (a mix of three of its corners); edges a normal between their
+    /// two faces' normals.
+    fn prism_feature(&self, k: usize, rng: &mut Rng) -> (V, P, Option<V>) {
+        let v = &self.vertices;
+        let (bottom, top) = (&v[..k], &v[k..2 * k]);
+        let mix = |rng: &mut Rng, a: P, b: P, c: P| {
+            let (mut u, mut w) = (rng.unit_interval(), rng.unit_interval());
+            if u + w > 1.0 {
+                (u, w) = (1.0 - u, 1.0 - w);
+            }
+            a + (b - a) * u + (c - a) * w
+        };
+        let i = rng.below(k);
+        let j = (i + 1) % k;
+        // Side face i (corners bottom i, i + 1, top i + 1, i), outward.
+        let side = |i: usize| {
+            let j = (i + 1) % k;
+            let n = (bottom[j] - bottom[i]).cross(&(top[i] - bottom[i]));
+            let n = n.normalize();
+            if n.dot(&bottom[i].coords) < 0.0 {
+                -n
+            } else {
+                n
+            }
+        };
+        let end_up = rng.below(2) == 0;
+        let (end, end_n) = if end_up {
+            (top, V::z())
+        } else {
+            (bottom, -V::z())
+        };
+        let blend = |rng: &mut Rng, x: V, y: V| {
+            let t = rng.uniform(0.05, 0.95);
+            (x * t + y * (1.0 - t)).normalize()
+        };
+        match rng.below(5) {
+            0 => {
+                let (a, b, c) = (end[i], end[(i + k / 3) % k], end[(i + 2 * k / 3) % k]);
+                (end_n, mix(rng, a, b, c), None)
+            }
+            1 => (side(i), mix(rng, bottom[i], bottom[j], top[i]), None),
+            2 => {
+                let n = blend(rng, side((i + k - 1) % k), side(i));
+                let e = top[i] - bottom[i];
+                (n, bottom[i] + e * rng.unit_interval(), Some(e.normalize()))
+            }
+            3 => {
+                let n = blend(rng, end_n, side(i));
+                let e = end[j] - end[i];
+                (n, end[i] + e * rng.unit_interval(), Some(e.normalize()))
+            }
+            _ => {
                 let n = rng.direction();
                 (n, self.argmax(&n), None)
             }
@@ -325,7 +389,7 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
             })
             .collect()
     };
-    let kinds = if big { 10 } else { 9 };
+    let kinds = if big { 11 } else { 10 };
     match rng.below(kinds) {
         0 => {
             let h = half(rng);
@@ -446,6 +510,27 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
             0.0,
             Feature::Generic,
         ),
+        9 => {
+            // A frustum or prism of 3 to 12 sides, like the paper's family:
+            // end faces of up to 12 coplanar vertices, trapezoid sides.
+            let k = 3 + rng.below(10);
+            let rb = s * rng.uniform(0.2, 1.0);
+            let rt = if rng.below(2) == 0 {
+                rb
+            } else {
+                s * rng.uniform(0.2, 1.0)
+            };
+            let h = s * rng.uniform(0.1, 1.0);
+            let phase = rng.uniform(0.0, std::f64::consts::TAU);
+            let ring = |r: f64, z: f64| {
+                (0..k).map(move |i| {
+                    let a = phase + std::f64::consts::TAU * i as f64 / k as f64;
+                    P::new(r * a.cos(), r * a.sin(), z)
+                })
+            };
+            let pts = ring(rb, -h).chain(ring(rt, h)).collect();
+            Body::new("prism", Form::Points, pts, rounded(rng), Feature::Prism(k))
+        }
         _ => {
             let r = s * rng.uniform(0.5, 1.0);
             let pts = (0..100_000).map(|_| P::from(rng.direction() * r)).collect();
@@ -587,7 +672,10 @@ pub fn draw(rng: &mut Rng, big: bool) -> Case {
         let edged = |rng: &mut Rng, s: f64| loop {
             let t = template(rng, s, false);
             if matches!(t.feature, Feature::Box(h) if h.z != 0.0)
-                || matches!(t.feature, Feature::Segment(..) | Feature::Triangle(_))
+                || matches!(
+                    t.feature,
+                    Feature::Segment(..) | Feature::Triangle(_) | Feature::Prism(_)
+                )
             {
                 break t;
             }

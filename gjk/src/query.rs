@@ -1060,7 +1060,7 @@ fn compound(
         lower = lower.min(pair_lower);
         // Separating the union means separating every piece pair: the
         // deepest pair's bound, whichever pair ends up named, bounds the
-        // union's depth (a pair whose only the shells overlap counts too).
+        // union's depth (a pair whose rounded shells alone overlap counts too).
         let pair_depth = if run.norm == 0.0 {
             run.inner + pair.radii
         } else {

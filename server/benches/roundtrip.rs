@@ -67,6 +67,7 @@ impl Fixture {
             let options = ServeOptions {
                 service: name,
                 wait: WaitMode::Spin,
+                remove_departed: false,
             };
             if let Err(e) = run(&options, state, &flag, || {}) {
                 eprintln!("bench server failed: {e}");

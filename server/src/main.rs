@@ -103,6 +103,13 @@ struct ServeArgs {
     /// Keep objects in memory only: they are lost when the server stops.
     #[arg(long)]
     no_persist: bool,
+    /// Remove, while serving, the objects of clients whose process has
+    /// ended, within seconds of it (scene objects and those of running
+    /// clients stay; ids are never reused). Off by default: such objects
+    /// keep being served, and `gjkd objects --remove-departed` removes
+    /// them with the server stopped.
+    #[arg(long)]
+    remove_departed: bool,
 }
 
 #[derive(Args, Debug)]
@@ -268,6 +275,7 @@ fn serve(args: ServeArgs) -> ExitCode {
     let options = ServeOptions {
         service: args.service,
         wait: args.wait.into(),
+        remove_departed: args.remove_departed,
     };
     match run(&options, state, &shutdown, || {}) {
         Ok(()) => ExitCode::SUCCESS,

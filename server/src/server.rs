@@ -84,6 +84,10 @@ pub struct ServeOptions {
     pub service: String,
     /// Wait strategy.
     pub wait: WaitMode,
+    /// Remove, while serving, the objects of clients whose process has
+    /// ended (checked at housekeeping, as `gjkd objects --remove-departed`
+    /// does offline). Off, they stay until the operator removes them.
+    pub remove_departed: bool,
 }
 
 /// Runs a server until `shutdown` becomes true, then removes its services and
@@ -251,6 +255,9 @@ pub fn run(
             // Always compared with the live list, not the count: a client
             // that died while another connected leaves the count unchanged.
             forget_departed_clients(&query_service, &mut state);
+            if options.remove_departed {
+                remove_departed_objects(&mut state);
+            }
             state.set_clients(query_service.dynamic_config().number_of_clients());
             if let Err(e) = state.flush() {
                 error!("cannot sync the pose journal: {e}");
@@ -310,6 +317,30 @@ fn forget_departed_clients(
     let dropped = before - state.stats().cache_entries;
     if dropped > 0 {
         debug!(dropped, "forgot warm starts of departed clients");
+    }
+}
+
+/// Removes the objects of clients whose iceoryx2 node no longer runs. A
+/// node whose state cannot be read counts as running, and when the nodes
+/// cannot be listed at all nothing is removed.
+fn remove_departed_objects(state: &mut State) {
+    let alive = match crate::objects::alive_nodes() {
+        Ok(alive) => alive,
+        Err(e) => {
+            warn!("cannot list the running clients, no object removed: {e}");
+            return;
+        }
+    };
+    let (removed, failed) = state.remove_departed(alive);
+    if !removed.is_empty() {
+        info!(
+            count = removed.len(),
+            ids = ?removed.iter().map(|id| format!("{id:#x}")).collect::<Vec<_>>(),
+            "removed the objects of departed clients"
+        );
+    }
+    if let Some(e) = failed {
+        error!("cannot remove an object of a departed client: {e:?}");
     }
 }
 

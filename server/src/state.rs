@@ -490,6 +490,35 @@ impl State {
         self.remove_committed(id, requester).map(|_| ())
     }
 
+    /// Removes the objects of every client for which `alive` is false (its
+    /// process ended: no client could remove them, since a restarted
+    /// process gets a new identity), each committed like a client's removal.
+    /// Scene objects stay; ids are never reused. Returns the ids removed,
+    /// in id order, and the error that stopped the pass if a commit failed
+    /// (the object it concerned is kept).
+    pub fn remove_departed(
+        &mut self,
+        alive: impl Fn(u128) -> bool,
+    ) -> (Vec<u64>, Option<ErrorCode>) {
+        let mut doomed: Vec<(u64, u128)> = self
+            .objects
+            .iter()
+            .filter_map(|(&id, o)| match o.owner {
+                Owner::Client(c) if !alive(c) => Some((id, c)),
+                _ => None,
+            })
+            .collect();
+        doomed.sort_unstable();
+        let mut removed = Vec::with_capacity(doomed.len());
+        for (id, owner) in doomed {
+            match self.remove_committed(id, owner) {
+                Ok(id) => removed.push(id),
+                Err(e) => return (removed, Some(e)),
+            }
+        }
+        (removed, None)
+    }
+
     /// The id of the object named `name`.
     pub fn lookup(&self, name: &str) -> Option<u64> {
         self.names.get(name).copied()
@@ -1267,6 +1296,38 @@ mod tests {
         assert_eq!(s.remove(scene, 1), Err(ErrorCode::ReadOnly));
         assert_eq!(s.remove(id, 1), Ok(()));
         assert!(s.object(id).is_none());
+    }
+
+    #[test]
+    fn the_objects_of_departed_clients_are_removed_and_no_others() {
+        let mut s = state();
+        let kept = register_box(&mut s, 1);
+        let gone = [register_box(&mut s, 2), register_named(&mut s, 2, "arm")];
+        let scene = s
+            .insert(
+                NewObject {
+                    shape: Convex::sphere(1.0).expect("sphere").into(),
+                    pose: Isometry3::identity(),
+                    name: Some("fixed".into()),
+                },
+                Owner::Scene,
+            )
+            .expect("room");
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!(failed, None);
+        assert_eq!(removed, gone.to_vec());
+        assert!(gone.iter().all(|&id| s.object(id).is_none()));
+        assert!(s.object(kept).is_some() && s.object(scene).is_some());
+        assert_eq!(s.lookup("arm"), None);
+        assert_eq!(s.lookup("fixed"), Some(scene));
+        // Nothing more to remove, and the name is free again under a new id.
+        assert_eq!(s.remove_departed(|c| c == 1), (vec![], None));
+        let again = register_named(&mut s, 1, "arm");
+        assert!(!gone.contains(&again));
+        // Everybody gone: only the scene object is left.
+        let (removed, _) = s.remove_departed(|_| false);
+        assert_eq!(removed.len(), 2);
+        assert_eq!(s.len(), 1);
     }
 
     #[test]

@@ -7,8 +7,8 @@ use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use gjkd_client::{ClientError, ErrorCode, Geometry, QueryOptions};
-use gjkd_e2e::{Server, once_reached, unique_service};
+use gjkd_client::{ClientError, ErrorCode, Geometry, ObjectId, QueryOptions};
+use gjkd_e2e::{LoadProcess, Server, once_reached, unique_service};
 use nalgebra::Isometry3;
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -224,6 +224,87 @@ fn the_operator_removes_objects_of_departed_clients() {
         ErrorCode::UnknownObject
     );
     bob.remove(his).expect("his own, as before");
+}
+
+/// The ids a `gjkd-load` process says it registered.
+fn registered(load: &LoadProcess) -> Vec<ObjectId> {
+    load.seen
+        .iter()
+        .filter_map(|l| l.strip_prefix("REG ")?.split(' ').next()?.parse().ok())
+        .map(ObjectId::from_raw)
+        .collect()
+}
+
+/// A client process killed (`kill -9`) leaves its objects behind. A plain
+/// server keeps serving them past its housekeeping (5 s at most); one started
+/// with `--remove-departed` on the same state file removes them within its
+/// housekeeping, keeping the scene object and a running client's, and the
+/// removal is on disk: after a restart only the survivors come back.
+#[test]
+fn serve_remove_departed_removes_the_objects_of_killed_clients() {
+    let dir = std::env::temp_dir().join(unique_service("reap-scene"));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[[object]]\nname = \"wall\"\ntype = \"box\"\nhalf_extents = [1.0, 1.0, 1.0]\n",
+    )
+    .expect("scene");
+    let scene = scene.to_str().expect("utf-8");
+    let mut plain = Server::start("reap", &["--scene", scene]);
+    let state_file = plain.state_file().expect("the helper's state file");
+    let state = state_file.to_str().expect("utf-8");
+    let mut bob = plain.client(Duration::from_secs(2));
+    let his = bob.register_sphere(1.0).expect("his");
+    let mut victim = LoadProcess::spawn(&plain.service, "victim", 5, None);
+    assert!(
+        victim.wait_for("READY", Duration::from_secs(30)).is_some(),
+        "{:?}",
+        victim.seen
+    );
+    let theirs = registered(&victim);
+    assert!(theirs.len() > 3, "{:?}", victim.seen);
+    victim.kill9();
+    let all = 2 + theirs.len() as u64;
+    // Past the forced housekeeping: a plain server still has them all.
+    std::thread::sleep(Duration::from_secs(6));
+    assert_eq!(bob.stats().expect("stats").objects, all);
+    let wall = bob.lookup("wall").expect("wall");
+    bob.distance(theirs[0], his, &QueryOptions::default())
+        .expect("still served");
+    plain.terminate();
+
+    let reaper = Server::start_on(
+        &plain.service,
+        &["--scene", scene, "--state-file", state, "--remove-departed"],
+    );
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let objects = once_reached(|| bob.stats()).objects;
+        if objects == 2 {
+            break;
+        }
+        assert!(objects == all, "{objects} objects");
+        assert!(Instant::now() < deadline, "still {objects} objects");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    for &id in &theirs {
+        assert_eq!(
+            rejected(bob.distance(id, his, &QueryOptions::default())),
+            ErrorCode::UnknownObject
+        );
+    }
+    let d = bob
+        .distance(wall, his, &QueryOptions::default())
+        .expect("scene and running client's objects stay");
+    assert!(d.distance.is_finite());
+    drop(reaper);
+
+    let mut again = Server::start_on(&plain.service, &["--scene", scene, "--state-file", state]);
+    assert_eq!(once_reached(|| bob.stats()).objects, 2);
+    bob.remove(his).expect("his own, as before");
+    again.terminate();
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

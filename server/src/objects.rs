@@ -6,7 +6,9 @@
 //! its iceoryx2 node, which a restarted process does not get back. So the
 //! objects of a process that died stay forever as far as clients go. This
 //! is the operator's way out, with the server stopped (the store's lock
-//! keeps the two apart): list them, then remove them explicitly.
+//! keeps the two apart): list them, then remove them explicitly. A server
+//! started with `--remove-departed` uses [`alive_nodes`] to do the same
+//! while it runs.
 
 use std::fmt::Write as _;
 

@@ -1278,21 +1278,25 @@ mod tests {
         assert_eq!(s.handle_admin(1, &req, &v).error_code(), ErrorCode::Ok);
     }
 
+    /// A scene object: a unit ball named `name`.
+    fn insert_scene_ball(s: &mut State, name: &str) -> u64 {
+        s.insert(
+            NewObject {
+                shape: Convex::sphere(1.0).expect("sphere").into(),
+                pose: Isometry3::identity(),
+                name: Some(name.into()),
+            },
+            Owner::Scene,
+        )
+        .expect("room")
+    }
+
     #[test]
     fn only_the_owner_removes_and_scene_objects_stay() {
         let mut s = state();
         let id = register_box(&mut s, 1);
         assert_eq!(s.remove(id, 2), Err(ErrorCode::NotOwner));
-        let scene = s
-            .insert(
-                NewObject {
-                    shape: Convex::sphere(1.0).expect("sphere").into(),
-                    pose: Isometry3::identity(),
-                    name: Some("fixed".into()),
-                },
-                Owner::Scene,
-            )
-            .expect("room");
+        let scene = insert_scene_ball(&mut s, "fixed");
         assert_eq!(s.remove(scene, 1), Err(ErrorCode::ReadOnly));
         assert_eq!(s.remove(id, 1), Ok(()));
         assert!(s.object(id).is_none());
@@ -1303,16 +1307,7 @@ mod tests {
         let mut s = state();
         let kept = register_box(&mut s, 1);
         let gone = [register_box(&mut s, 2), register_named(&mut s, 2, "arm")];
-        let scene = s
-            .insert(
-                NewObject {
-                    shape: Convex::sphere(1.0).expect("sphere").into(),
-                    pose: Isometry3::identity(),
-                    name: Some("fixed".into()),
-                },
-                Owner::Scene,
-            )
-            .expect("room");
+        let scene = insert_scene_ball(&mut s, "fixed");
         let (removed, failed) = s.remove_departed(|c| c == 1);
         assert_eq!(failed, None);
         assert_eq!(removed, gone.to_vec());

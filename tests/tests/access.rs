@@ -226,6 +226,20 @@ fn the_operator_removes_objects_of_departed_clients() {
     bob.remove(his).expect("his own, as before");
 }
 
+/// A fresh directory holding a scene file of one box named "wall": the
+/// directory (for removal) and the file.
+fn wall_scene(tag: &str) -> (PathBuf, PathBuf) {
+    let dir = std::env::temp_dir().join(unique_service(tag));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("scene.toml");
+    std::fs::write(
+        &path,
+        "[[object]]\nname = \"wall\"\ntype = \"box\"\nhalf_extents = [1.0, 1.0, 1.0]\n",
+    )
+    .expect("scene");
+    (dir, path)
+}
+
 /// The ids a `gjkd-load` process says it registered.
 fn registered(load: &LoadProcess) -> Vec<ObjectId> {
     load.seen
@@ -242,14 +256,7 @@ fn registered(load: &LoadProcess) -> Vec<ObjectId> {
 /// removal is on disk: after a restart only the survivors come back.
 #[test]
 fn serve_remove_departed_removes_the_objects_of_killed_clients() {
-    let dir = std::env::temp_dir().join(unique_service("reap-scene"));
-    std::fs::create_dir_all(&dir).expect("dir");
-    let scene = dir.join("scene.toml");
-    std::fs::write(
-        &scene,
-        "[[object]]\nname = \"wall\"\ntype = \"box\"\nhalf_extents = [1.0, 1.0, 1.0]\n",
-    )
-    .expect("scene");
+    let (dir, scene) = wall_scene("reap-scene");
     let scene = scene.to_str().expect("utf-8");
     let mut plain = Server::start("reap", &["--scene", scene]);
     let state_file = plain.state_file().expect("the helper's state file");
@@ -309,14 +316,7 @@ fn serve_remove_departed_removes_the_objects_of_killed_clients() {
 
 #[test]
 fn scene_objects_stay_read_only_and_keep_their_ids_across_a_restart() {
-    let dir = std::env::temp_dir().join(unique_service("scene-ro"));
-    std::fs::create_dir_all(&dir).expect("dir");
-    let path = dir.join("scene.toml");
-    std::fs::write(
-        &path,
-        "[[object]]\nname = \"wall\"\ntype = \"box\"\nhalf_extents = [1.0, 1.0, 1.0]\n",
-    )
-    .expect("scene");
+    let (dir, path) = wall_scene("scene-ro");
     let mut server = Server::start("scene-ro", &["--scene", path.to_str().expect("utf-8")]);
     let mut client = server.client(Duration::from_secs(2));
     let wall = client.lookup("wall").expect("wall");

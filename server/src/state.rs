@@ -492,10 +492,13 @@ impl State {
 
     /// Removes the objects of every client for which `alive` is false (its
     /// process ended: no client could remove them, since a restarted
-    /// process gets a new identity), each committed like a client's removal.
-    /// Scene objects stay; ids are never reused. Returns the ids removed,
-    /// in id order, and the error that stopped the pass if a commit failed
-    /// (the object it concerned is kept).
+    /// process gets a new identity). Scene objects stay; ids are never
+    /// reused. A few are committed one by one, like a client's removals;
+    /// more than [`BULK_REMOVAL`] at once with one snapshot write, since a
+    /// crashed process's thousand objects would otherwise hold the request
+    /// loop for a thousand synced appends. Returns the ids removed, in id
+    /// order, and the error that stopped the pass if a commit failed (the
+    /// objects it concerned are kept).
     pub fn remove_departed(
         &mut self,
         alive: impl Fn(u128) -> bool,
@@ -509,6 +512,9 @@ impl State {
             })
             .collect();
         doomed.sort_unstable();
+        if doomed.len() > BULK_REMOVAL && self.store.is_some() {
+            return self.remove_in_bulk(&doomed);
+        }
         let mut removed = Vec::with_capacity(doomed.len());
         for (id, owner) in doomed {
             match self.remove_committed(id, owner) {
@@ -517,6 +523,31 @@ impl State {
             }
         }
         (removed, None)
+    }
+
+    /// [`remove_departed`](Self::remove_departed)'s many: all dropped, then
+    /// one snapshot; if it cannot be written, all put back (the previous
+    /// file and log are intact).
+    fn remove_in_bulk(&mut self, doomed: &[(u64, u128)]) -> (Vec<u64>, Option<ErrorCode>) {
+        let dropped: Vec<(u64, Object)> = doomed
+            .iter()
+            .filter_map(|&(id, _)| Some((id, self.drop_object(id)?)))
+            .collect();
+        if let Err(e) = self.persist() {
+            tracing::error!("{e}; the removals are undone");
+            // In reverse: each object's slot is then on top of the stack.
+            for (id, object) in dropped.into_iter().rev() {
+                if self.free_slots.last() == Some(&object.slot) {
+                    self.free_slots.pop();
+                }
+                if let Some(name) = &object.name {
+                    self.names.insert(name.clone(), id);
+                }
+                self.objects.insert(id, object);
+            }
+            return (Vec::new(), Some(ErrorCode::Internal));
+        }
+        (dropped.into_iter().map(|(id, _)| id).collect(), None)
     }
 
     /// The id of the object named `name`.
@@ -789,6 +820,10 @@ impl State {
         Ok(id)
     }
 }
+
+/// Most objects of departed clients removed one committed record at a time;
+/// beyond, [`State::remove_departed`] writes one snapshot instead.
+pub const BULK_REMOVAL: usize = 16;
 
 /// The wire value of a gjk status.
 pub fn status_code(s: gjk::Status) -> u32 {
@@ -1496,6 +1531,54 @@ mod tests {
         let reply = s.handle_admin(owner, &req, &[Vertex::default()]);
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         reply.id
+    }
+
+    /// More than [`BULK_REMOVAL`] objects of a departed client go with one
+    /// snapshot write: a restart sees none of them. If that write fails,
+    /// every one of them is put back, named ones still found by name.
+    #[test]
+    fn a_departed_clients_many_objects_go_in_one_write_or_not_at_all() {
+        let dir = scratch("bulk-removal");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        let kept = register_box(&mut s, 1);
+        let mut gone: Vec<u64> = (0..BULK_REMOVAL + 4)
+            .map(|_| register_box(&mut s, 2))
+            .collect();
+        gone.push(register_named(&mut s, 2, "arm"));
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!((removed, failed), (gone, None));
+        drop(s);
+        let (snapshot, log) = reload(&path);
+        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
+        assert_eq!(ids, vec![kept]);
+        assert_eq!(log.applied, 0, "one snapshot, no records: {log:?}");
+
+        // Again, with the state file's path blocked: nothing is removed.
+        let path = dir.join("again");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        register_box(&mut s, 1);
+        let doomed: Vec<u64> = (0..BULK_REMOVAL + 1)
+            .map(|_| register_box(&mut s, 3))
+            .collect();
+        let named = register_named(&mut s, 3, "leg");
+        let before = s.len();
+        std::fs::remove_file(&path).expect("rm");
+        std::fs::create_dir(&path).expect("block the path");
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!((removed, failed), (vec![], Some(ErrorCode::Internal)));
+        assert_eq!(s.len(), before);
+        assert!(doomed.iter().all(|&id| s.object(id).is_some()));
+        assert_eq!(s.lookup("leg"), Some(named));
+        // Their slots are still theirs: a new object gets a fresh one.
+        let fresh = register_box(&mut s, 1);
+        let slots: std::collections::HashSet<u32> = s.objects.values().map(|o| o.slot).collect();
+        assert_eq!(slots.len(), s.len(), "{fresh}: no slot shared");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

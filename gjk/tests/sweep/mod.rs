@@ -389,7 +389,7 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
             })
             .collect()
     };
-    let kinds = if big { 11 } else { 10 };
+    let kinds = if big { 12 } else { 10 };
     match rng.below(kinds) {
         0 => {
             let h = half(rng);
@@ -530,6 +530,25 @@ fn template(rng: &mut Rng, s: f64, big: bool) -> Body {
             };
             let pts = ring(rb, -h).chain(ring(rt, h)).collect();
             Body::new("prism", Form::Points, pts, rounded(rng), Feature::Prism(k))
+        }
+        10 => {
+            // 100 000 points on a box's faces, its corners among them: the
+            // hull is the box, and each face holds some 16 000 coplanar
+            // points, every one a tie for the support in its normal.
+            let h = half(rng);
+            let mut pts = corners(h);
+            while pts.len() < 100_000 {
+                let axis = rng.below(3);
+                let mut x = V::new(
+                    rng.uniform(-h.x, h.x),
+                    rng.uniform(-h.y, h.y),
+                    rng.uniform(-h.z, h.z),
+                );
+                x[axis] = rng.sign() * h[axis];
+                pts.push(P::from(x));
+            }
+            rng.shuffle(&mut pts);
+            Body::new("100k box", Form::Points, pts, 0.0, Feature::Box(h))
         }
         _ => {
             let r = s * rng.uniform(0.5, 1.0);

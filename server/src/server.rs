@@ -61,6 +61,9 @@ const IDLE_BEFORE_HOUSEKEEPING: Duration = Duration::from_millis(20);
 /// the state of a client killed while others keep it busy would never be
 /// freed.
 const HOUSEKEEPING_FORCED: Duration = Duration::from_secs(5);
+/// After a removal of departed clients' objects could not be committed, how
+/// long before the next attempt.
+const REAP_BACKOFF: Duration = Duration::from_secs(60);
 
 /// In spin mode, the admin service is polled once per this many idle loop
 /// turns: each poll scans every connected client, and registrations are rare.
@@ -223,6 +226,7 @@ pub fn run(
     let mut last_request = Instant::now();
     let mut last_yield = Instant::now();
     let mut last_housekeeping = Instant::now();
+    let mut reap_after = Instant::now();
     let mut turns: u32 = 0;
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
@@ -255,8 +259,12 @@ pub fn run(
             // Always compared with the live list, not the count: a client
             // that died while another connected leaves the count unchanged.
             forget_departed_clients(&query_service, &mut state);
-            if options.remove_departed {
-                remove_departed_objects(&mut state);
+            if options.remove_departed && now >= reap_after {
+                // A store that cannot be written is not retried at every
+                // housekeeping: each attempt may write a whole snapshot.
+                if !remove_departed_objects(&mut state) {
+                    reap_after = now + REAP_BACKOFF;
+                }
             }
             state.set_clients(query_service.dynamic_config().number_of_clients());
             if let Err(e) = state.flush() {
@@ -322,26 +330,38 @@ fn forget_departed_clients(
 
 /// Removes the objects of clients whose iceoryx2 node no longer runs. A
 /// node whose state cannot be read counts as running, and when the nodes
-/// cannot be listed at all nothing is removed.
-fn remove_departed_objects(state: &mut State) {
+/// cannot be listed at all nothing is removed. False when a removal could
+/// not be committed.
+fn remove_departed_objects(state: &mut State) -> bool {
     let alive = match crate::objects::alive_nodes() {
         Ok(alive) => alive,
         Err(e) => {
             warn!("cannot list the running clients, no object removed: {e}");
-            return;
+            return true;
         }
     };
     let (removed, failed) = state.remove_departed(alive);
     if !removed.is_empty() {
+        // A crashed process may leave thousands: the first few name them.
+        let first: Vec<String> = removed
+            .iter()
+            .take(16)
+            .map(|id| format!("{id:#x}"))
+            .collect();
         info!(
             count = removed.len(),
-            ids = ?removed.iter().map(|id| format!("{id:#x}")).collect::<Vec<_>>(),
+            first = ?first,
             "removed the objects of departed clients"
         );
     }
     if let Some(e) = failed {
-        error!("cannot remove an object of a departed client: {e:?}");
+        error!(
+            "cannot remove the objects of departed clients ({e:?}); next try in {} s",
+            REAP_BACKOFF.as_secs()
+        );
+        return false;
     }
+    true
 }
 
 /// Sleeps until a client notifies or [`BLOCK_SLICE`] passes. The listener is

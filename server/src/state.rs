@@ -382,12 +382,20 @@ impl State {
     }
 
     fn drop_object(&mut self, id: u64) -> Option<Object> {
+        let object = self.unlink_object(id)?;
+        self.cache.forget_object(id);
+        Some(object)
+    }
+
+    /// [`drop_object`](Self::drop_object) but for the warm-start cache,
+    /// whose entries naming `id` are left for the caller to drop (one pass
+    /// over the cache for many objects instead of one each).
+    fn unlink_object(&mut self, id: u64) -> Option<Object> {
         let object = self.objects.remove(&id)?;
         if let Some(name) = &object.name {
             self.names.remove(name);
         }
         self.free_slots.push(object.slot);
-        self.cache.forget_object(id);
         Some(object)
     }
 
@@ -527,11 +535,12 @@ impl State {
 
     /// [`remove_departed`](Self::remove_departed)'s many: all dropped, then
     /// one snapshot; if it cannot be written, all put back (the previous
-    /// file and log are intact).
+    /// file and log are intact). Their warm starts go in one pass over the
+    /// cache once the snapshot is written, not in one pass per object.
     fn remove_in_bulk(&mut self, doomed: &[(u64, u128)]) -> (Vec<u64>, Option<ErrorCode>) {
         let dropped: Vec<(u64, Object)> = doomed
             .iter()
-            .filter_map(|&(id, _)| Some((id, self.drop_object(id)?)))
+            .filter_map(|&(id, _)| Some((id, self.unlink_object(id)?)))
             .collect();
         if let Err(e) = self.persist() {
             tracing::error!("{e}; the removals are undone");
@@ -547,6 +556,9 @@ impl State {
             }
             return (Vec::new(), Some(ErrorCode::Internal));
         }
+        let gone: std::collections::HashSet<u64> = dropped.iter().map(|&(id, _)| id).collect();
+        self.cache
+            .retain(|k| !gone.contains(&k.a) && !gone.contains(&k.b));
         (dropped.into_iter().map(|(id, _)| id).collect(), None)
     }
 
@@ -1548,8 +1560,31 @@ mod tests {
             .map(|_| register_box(&mut s, 2))
             .collect();
         gone.push(register_named(&mut s, 2, "arm"));
+        // Warm starts: one naming a doomed object, one not.
+        let pair = |a: u64, b: u64| {
+            Item::distance(
+                ObjectId::from_raw(a),
+                ObjectId::from_raw(b),
+                &QueryOptions::default(),
+            )
+            .with_pose_b(&Isometry3::translation(3.0, 0.0, 0.0))
+        };
+        one(&mut s, 10, pair(kept, gone[0]));
+        one(&mut s, 10, pair(kept, kept));
+        assert_eq!(s.stats().cache_entries, 2);
         let (removed, failed) = s.remove_departed(|c| c == 1);
         assert_eq!((removed, failed), (gone, None));
+        assert_eq!(
+            s.stats().cache_entries,
+            1,
+            "the doomed pair's entry is gone"
+        );
+        assert!(
+            one(&mut s, 10, pair(kept, kept))
+                .answer()
+                .expect("ok")
+                .warm_started
+        );
         drop(s);
         let (snapshot, log) = reload(&path);
         let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
@@ -1566,6 +1601,7 @@ mod tests {
             .map(|_| register_box(&mut s, 3))
             .collect();
         let named = register_named(&mut s, 3, "leg");
+        one(&mut s, 10, pair(doomed[0], named));
         let before = s.len();
         std::fs::remove_file(&path).expect("rm");
         std::fs::create_dir(&path).expect("block the path");
@@ -1574,6 +1610,12 @@ mod tests {
         assert_eq!(s.len(), before);
         assert!(doomed.iter().all(|&id| s.object(id).is_some()));
         assert_eq!(s.lookup("leg"), Some(named));
+        assert!(
+            one(&mut s, 10, pair(doomed[0], named))
+                .answer()
+                .expect("ok")
+                .warm_started
+        );
         // Their slots are still theirs: a new object gets a fresh one.
         let fresh = register_box(&mut s, 1);
         let slots: std::collections::HashSet<u32> = s.objects.values().map(|o| o.slot).collect();

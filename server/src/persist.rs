@@ -968,13 +968,22 @@ impl Store {
             f.write_all(bytes).map_err(io("cannot write", &self.tmp))?;
             f.sync_all().map_err(io("cannot fsync", &self.tmp))?;
             drop(f);
-            std::fs::rename(&self.tmp, &self.path).map_err(io("cannot rename to", &self.path))?;
-            sync_dir(&self.path)
+            std::fs::rename(&self.tmp, &self.path).map_err(io("cannot rename to", &self.path))
         })();
         if result.is_err() {
             let _ = std::fs::remove_file(&self.tmp);
+            return result;
         }
-        result
+        // The new file is in place: reporting a failure now would have the
+        // caller undo in memory a change that the file already holds. A
+        // machine crash before the directory entry is durable can only
+        // bring back the previous file and log, a state as consistent.
+        if let Err(e) = sync_dir(&self.path) {
+            tracing::error!(
+                "{e}; the state file is written, its directory entry maybe not yet durable"
+            );
+        }
+        Ok(())
     }
 
     /// Starts an empty change log (just the header) for a snapshot of

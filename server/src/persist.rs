@@ -778,6 +778,9 @@ pub struct Store {
     /// drops the lock when the process dies, `kill -9` included. It covers
     /// the change log too.
     _lock: File,
+    /// Test hook: the next log resets fail (see [`Store::fail_log_resets`]).
+    #[cfg(test)]
+    resets_fail: bool,
 }
 
 /// Why a state file or change log could not be written or read.
@@ -897,6 +900,8 @@ impl Store {
             log_len: 0,
             snapshot_len: 0,
             _lock: lock,
+            #[cfg(test)]
+            resets_fail: false,
         })
     }
 
@@ -938,9 +943,11 @@ impl Store {
     /// now holds.
     ///
     /// Once the rename is durable the change is, so a failure to empty the
-    /// log is not an error of the write: the old log is left as it is (its
-    /// records replay onto this snapshot as no-ops, see [`replay_log`]),
-    /// logged, and the next change is written as a snapshot again.
+    /// log is not an error of the write: the old log is removed instead
+    /// (its records would replay onto this snapshot as no-ops, see
+    /// [`replay_log`], but for registrations of objects the snapshot has
+    /// since dropped, which they would bring back), the failure is logged,
+    /// and the next change is written as a snapshot again.
     ///
     /// # Errors
     /// A step up to the rename that fails; the old file and log are then
@@ -950,7 +957,21 @@ impl Store {
         self.write_snapshot_file(&bytes)?;
         self.snapshot_len = bytes.len() as u64;
         if let Err(e) = self.reset_log(snapshot.epoch) {
-            tracing::error!("{e}; the next change is written as a full snapshot");
+            // The old log's records would replay onto this snapshot at the
+            // next start, and a registration there of an object that this
+            // snapshot no longer holds (removed since) would bring it back.
+            // With no log there is nothing to replay.
+            match std::fs::remove_file(&self.log_path) {
+                Ok(()) => tracing::error!(
+                    "{e}; the old change log is removed, the next change is written as a full snapshot"
+                ),
+                Err(r) if r.kind() == std::io::ErrorKind::NotFound => {
+                    tracing::error!("{e}; the next change is written as a full snapshot")
+                }
+                Err(r) => tracing::error!(
+                    "{e}; the old change log cannot be removed either ({r}): a restart before the next change may replay it"
+                ),
+            }
         }
         Ok(())
     }
@@ -994,6 +1015,12 @@ impl Store {
         self.log = None;
         self.log_len = 0;
         let path = &self.log_path;
+        #[cfg(test)]
+        if self.resets_fail {
+            return Err(io("cannot create the change log", path)(
+                std::io::Error::other("test hook"),
+            ));
+        }
         let f = OpenOptions::new()
             .write(true)
             .create(true)
@@ -1115,6 +1142,13 @@ impl Store {
             snapshot,
             log: replay,
         })
+    }
+
+    /// Test hook: every further reset of the change log (after a snapshot
+    /// write) fails, leaving the old log's content where it is.
+    #[cfg(test)]
+    pub(crate) fn fail_log_resets(&mut self) {
+        self.resets_fail = true;
     }
 
     /// Test hook: makes every further write to the open change log fail as

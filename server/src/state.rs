@@ -1623,6 +1623,32 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    /// A snapshot that drops objects registered since the last one, whose
+    /// change log cannot then be emptied: the old log, whose records would
+    /// bring them back at the next start, is removed instead.
+    #[test]
+    fn a_log_that_cannot_be_emptied_does_not_bring_removed_objects_back() {
+        let dir = scratch("stale-log");
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        let kept = register_box(&mut s, 1);
+        // Appended to the log after the first snapshot.
+        let gone: Vec<u64> = (0..BULK_REMOVAL + 1)
+            .map(|_| register_box(&mut s, 2))
+            .collect();
+        assert!(s.store().expect("store").has_changes());
+        s.store.as_mut().expect("store").fail_log_resets();
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!((removed, failed), (gone, None));
+        drop(s);
+        let (snapshot, log) = reload(&path);
+        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
+        assert_eq!(ids, vec![kept], "{log:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn a_failed_write_undoes_the_change_and_says_internal() {
         let dir = scratch("failed-write");

@@ -1524,6 +1524,17 @@ mod tests {
         dir
     }
 
+    /// A state persisted in `<scratch dir>/objects`: the directory, the
+    /// state file and the state.
+    fn stored(tag: &str) -> (std::path::PathBuf, std::path::PathBuf, State) {
+        let dir = scratch(tag);
+        let path = dir.join("objects");
+        let mut s = state();
+        s.set_store(Store::open(&path).expect("store"))
+            .expect("journal");
+        (dir, path, s)
+    }
+
     /// The store as a restarted server would load it.
     fn reload(path: &std::path::Path) -> (Snapshot, crate::persist::Replay) {
         let mut store = Store::open(path).expect("store");
@@ -1550,11 +1561,7 @@ mod tests {
     /// every one of them is put back, named ones still found by name.
     #[test]
     fn a_departed_clients_many_objects_go_in_one_write_or_not_at_all() {
-        let dir = scratch("bulk-removal");
-        let path = dir.join("objects");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
+        let (dir, path, mut s) = stored("bulk-removal");
         let kept = register_box(&mut s, 1);
         let mut gone: Vec<u64> = (0..BULK_REMOVAL + 4)
             .map(|_| register_box(&mut s, 2))
@@ -1628,11 +1635,7 @@ mod tests {
     /// bring them back at the next start, is removed instead.
     #[test]
     fn a_log_that_cannot_be_emptied_does_not_bring_removed_objects_back() {
-        let dir = scratch("stale-log");
-        let path = dir.join("objects");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
+        let (dir, path, mut s) = stored("stale-log");
         let kept = register_box(&mut s, 1);
         // Appended to the log after the first snapshot.
         let gone: Vec<u64> = (0..BULK_REMOVAL + 1)

@@ -353,10 +353,7 @@ pub fn distance_in(
                 offset: None,
             };
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let mut run = pair.solve(simplex, options, warm_pairs, f64::INFINITY);
-            if warm_pairs.is_some() && pair.loose(&run, options.tolerance) {
-                run = pair.cold_again(run, simplex, options, f64::INFINITY);
-            }
+            let run = pair.solve_retrying(simplex, options, warm_pairs, f64::INFINITY);
             pair.answer(&run, simplex, place, [0, 0])
         }
         _ => compound(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
@@ -820,6 +817,25 @@ impl<'s> Pair<'s> {
         }
     }
 
+    /// [`solve`](Self::solve), then, when a warm start ended with a loose
+    /// interval, once more cold ([`cold_again`](Self::cold_again)): single
+    /// pairs and a compound's piece pairs alike. A pruned run is left
+    /// alone: it only had to prove that its pair cannot win.
+    #[inline(always)]
+    fn solve_retrying(
+        &self,
+        simplex: &mut Simplex,
+        options: &Options,
+        warm: Option<&[[u32; 2]]>,
+        cutoff: f64,
+    ) -> Run {
+        let run = self.solve(simplex, options, warm, cutoff);
+        if warm.is_some() && run.exit != Exit::Pruned && self.loose(&run, options.tolerance) {
+            return self.cold_again(run, simplex, options, cutoff);
+        }
+        run
+    }
+
     /// Whether the run's certified interval is wider than the tolerance
     /// allows: (6.2) alone ended it, near contact.
     #[inline(always)]
@@ -1042,10 +1058,7 @@ fn compound(
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel, None, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
-        let mut run = pair.solve(simplex, options, warm_pairs, cutoff);
-        if warm_pairs.is_some() && run.exit != Exit::Pruned && pair.loose(&run, options.tolerance) {
-            run = pair.cold_again(run, simplex, options, cutoff);
-        }
+        let run = pair.solve_retrying(simplex, options, warm_pairs, cutoff);
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
         if pair_upper < kept[1].0 {
             let entry = (pair_upper, PieceSimplex::of(simplex, run.sol.mask, [i, j]));

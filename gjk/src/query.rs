@@ -449,6 +449,18 @@ struct Run {
     backup_used: bool,
 }
 
+/// What a run carries from one iteration to the next.
+struct RunState {
+    iterations: u32,
+    /// The last iterate that led to a step, with `|v|²`.
+    prev: Option<(Solution, f64)>,
+    /// Best lower bound on the core distance seen, before slack.
+    lower: f64,
+    backup_used: bool,
+    /// Steps taken without a measurable descent (see step 4).
+    flat_steps: u32,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Exit {
     Status(Status),
@@ -592,6 +604,13 @@ impl<'s> Pair<'s> {
 
     /// [`solve`](Self::solve) in the scaled frame: every length in the
     /// returned run is `k` times the world's.
+    ///
+    /// The common iteration (the subalgorithm succeeds, the support point is
+    /// new, `|v|` descends and no end is reached) is taken in this loop, which
+    /// keeps few values live; any other outcome goes to [`step`](Self::step),
+    /// out of line, which takes steps (3) to (6) in full from the same state.
+    /// Both take the same decisions on the same values, so the split changes
+    /// the time of a query, never its answer.
     #[inline(always)]
     fn solve_scaled(
         &self,
@@ -615,203 +634,286 @@ impl<'s> Pair<'s> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
-        let mut iterations = 0u32;
-        let mut prev: Option<(Solution, f64)> = None;
-        let mut lower = 0.0f64;
-        let mut backup_used = false;
-        // Steps taken without a measurable descent (see step 4).
-        let mut flat_steps = 0u32;
-        let mut paper_met;
+        let mut st = RunState {
+            iterations: 0,
+            prev: None,
+            lower: 0.0,
+            backup_used: false,
+            flat_steps: 0,
+        };
         loop {
-            iterations += 1;
+            st.iterations += 1;
             // Step (2).
-            let (mut sol, mut by_backup) = match simplex.solve() {
-                Some(s) => (s, false),
-                None => {
-                    backup_used = true;
-                    (simplex.backup(), true)
+            let Some(sol) = simplex.solve() else {
+                st.backup_used = true;
+                let sol = simplex.backup();
+                match self.step(simplex, options, cutoff, &mut st, sol, true, None) {
+                    Some(run) => return run,
+                    None => continue,
                 }
             };
-            let mut refined = false;
-            loop {
-                let v2 = sol.v.norm_squared();
-                let norm = v2.sqrt();
-                if !norm.is_finite() {
-                    // The subalgorithm overflowed. Fuzzing found points
-                    // ~1e108 apart whose cofactors exceeded f64 (before the
-                    // run was scaled to sizes near 1; kept as a guard, see
-                    // gjk/tests/fuzz_regressions.rs), and NaN weights would
-                    // make every bound below meaningless. Keep the last
-                    // finite iterate, or else a single vertex: each is a
-                    // point of the hull, so |v| stays an upper bound.
-                    backup_used = true;
-                    let best = match prev {
-                        Some((p, _)) => p,
-                        None => {
-                            let i = simplex.all.trailing_zeros().min(3) as usize;
-                            let mut lambda = [0.0; 4];
-                            lambda[i] = 1.0;
-                            Solution {
-                                mask: 1 << i,
-                                v: simplex.vertices[i].y,
-                                lambda,
-                            }
-                        }
-                    };
-                    return Run {
-                        inner: 0.0,
-                        sol: best,
-                        norm: best.v.norm(),
-                        lower,
-                        iterations,
-                        exit: Exit::Status(Status::ToleranceNotMet),
-                        backup_used,
-                    };
+            let v2 = sol.v.norm_squared();
+            let norm = v2.sqrt();
+            // Overflow (NaN fails the first test) and touching cores.
+            if !(norm > self.slack && norm.is_finite()) {
+                match self.step(simplex, options, cutoff, &mut st, sol, false, None) {
+                    Some(run) => return run,
+                    None => continue,
                 }
-                let finish = |exit, sol: Solution, lower: f64| {
-                    let norm = sol.v.norm();
-                    Run {
-                        inner: if norm <= self.slack {
-                            self.penetration(simplex, &sol)
-                        } else {
-                            0.0
-                        },
-                        sol,
-                        norm,
-                        lower,
-                        iterations,
-                        exit: Exit::Status(exit),
-                        backup_used,
-                    }
-                };
-                if norm <= self.slack {
-                    // v is the origin up to round-off: the cores touch or
-                    // intersect, and nothing finer can be certified.
-                    return finish(Status::Converged, sol, 0.0);
+            }
+            // Step (3).
+            let s = self.support(&-sol.v);
+            let vs = sol.v.dot(&s.y);
+            let lower = st.lower.max(vs / norm - self.single_slack);
+            let g = v2 - vs;
+            if g <= stop_d * norm || norm <= eps_d {
+                return self.finish(simplex, &st, Status::Converged, sol, lower);
+            }
+            // Anything but a plain descent by a new point, and every other
+            // way to end, is decided by `step`, from the start of step (3).
+            let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
+            let descends = match st.prev {
+                None => true,
+                Some((_, p2)) => v2 < p2,
+            };
+            let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
+            let margin_ends = options.margin.is_some_and(|m| {
+                lower_cert.max(0.0) > m
+                    || ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m
+            });
+            if repeat
+                || !descends
+                || sol.mask == 0b1111
+                || lower_cert > cutoff
+                || margin_ends
+                || st.iterations >= options.max_iterations
+            {
+                match self.step(simplex, options, cutoff, &mut st, sol, false, Some(s)) {
+                    Some(run) => return run,
+                    None => continue,
                 }
-                // Step (3): the stopping rule, and the bounds of Theorem 4.1.
-                let s = self.support(&-sol.v);
-                let vs = sol.v.dot(&s.y);
-                lower = lower.max(vs / norm - self.single_slack);
-                let g = v2 - vs;
-                // (6.2): g <= ε·D². Near contact that rule alone lets |v|
-                // exceed the distance by up to √ε·D (nearly parallel edges do
-                // this), so once it holds the run goes on while |v| still
-                // descends, and stops early only when the certified interval,
-                // of width g/|v|, is within ε·D. A support point already in V̂
-                // leaves nothing to add: g is then the error of v itself.
-                paper_met = g <= eps_d * self.d + self.single_slack * norm;
-                // The error of |v| is at most min(|v|, g/|v|): stop once that
-                // is within ε·D, or within the round-off allowance when the
-                // support point repeats a vertex of V̂. Beyond that, a repeat
-                // means the subalgorithm's v is off by more than round-off
-                // (a thin simplex: nearly parallel edges, or nearly collinear
-                // points of K at contact): refinement, then steps (4) to (6).
-                if g <= stop_d * norm || norm <= eps_d {
-                    return finish(Status::Converged, sol, lower);
-                }
-                let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
-                if repeat && g <= self.slack * norm {
-                    return finish(Status::Converged, sol, lower);
-                }
-                // Cutoff and margin are the world's: compared there.
-                let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
-                if lower_cert > cutoff {
-                    let mut run = finish(Status::Converged, sol, lower);
-                    run.exit = Exit::Pruned;
-                    return run;
-                }
-                if let Some(m) = options.margin {
-                    if lower_cert.max(0.0) > m {
-                        return finish(Status::Farther, sol, lower);
-                    }
-                    if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
-                        return finish(Status::Closer, sol, lower);
-                    }
-                }
-                if iterations >= options.max_iterations {
-                    let status = if paper_met {
-                        Status::Converged
-                    } else {
-                        Status::IterationCap
-                    };
-                    // The nearer of the last two iterates (see step 5).
-                    let best = match prev {
-                        Some((p, p2)) if p2 < v2 => p,
-                        _ => sol,
-                    };
-                    return finish(status, best, lower);
-                }
-                // Step (4): descend while |v| decreases and V̂ is not full. A
-                // step that only grows V̂ by a dimension, with |v| unchanged at
-                // round-off level, is also progress (nearly parallel edges give
-                // such steps); a few are allowed before step (5) takes over.
-                let mut not_down = false;
-                let descended = match prev {
-                    None => true,
-                    Some((_, p2)) if v2 < p2 => true,
-                    Some((p, p2)) => {
-                        let grew = sol.mask.count_ones() > p.mask.count_ones();
-                        let flat = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON);
-                        // |v| up by no more than its round-off while the new
-                        // support point, not yet in Y, lies beyond v's plane
-                        // by more than the tolerance: near contact, Johnson's
-                        // v of a new face can be εD worse than the refined v
-                        // of the last, and stopping there leaves |v| at
-                        // (6.2)'s √ε·D (nearly parallel edges touching).
-                        let level = norm <= p2.sqrt() + self.slack;
-                        not_down = true;
-                        (flat || level) && flat_steps < 4
-                    }
-                };
-                if descended && sol.mask.count_ones() <= 3 && !repeat {
-                    // Only a step taken counts against the budget: a repeat
-                    // refined within the iteration is the same step.
-                    flat_steps += not_down as u32;
-                    prev = Some((sol, v2));
-                    simplex.push(sol.mask, s);
-                    break;
-                }
-                // A repeat with g above round-off: v carries the error of a
-                // thin simplex's cofactors, or of the Backup Procedure's
-                // (which redoes them). One refinement step in V̂'s affine hull
-                // removes it, and the refined v goes back to step (3); the
-                // Backup Procedure comes after, if needed.
-                let refined_sol = if repeat && !refined {
-                    refined = true;
-                    simplex.refine(sol)
-                } else {
-                    None
-                };
-                // Step (5): round-off has the last word. The previous iterate,
-                // if nearer, is still valid: its vertices kept their slots.
-                // When (6.2) holds the paper would have stopped at step (3):
-                // no Backup Procedure is needed to confirm that, unless the
-                // support point repeats a point of Y (then (6.2) may hold
-                // for a v that is off by up to √ε·D) and refinement is left.
-                if refined_sol.is_none() && (by_backup || (paper_met && !repeat)) {
-                    let status = if paper_met {
-                        Status::Converged
-                    } else {
-                        Status::ToleranceNotMet
-                    };
-                    // A step that failed to descend (round-off in a
-                    // degenerate simplex) leaves the previous iterate, whose
-                    // slots the push kept, as the better upper bound.
-                    let best = match prev {
-                        Some((p, p2)) if p2 < v2 => p,
-                        _ => sol,
-                    };
-                    return finish(status, best, lower);
-                }
-                match refined_sol {
-                    Some(r) => sol = r,
+            }
+            // Step (4).
+            st.lower = lower;
+            st.prev = Some((sol, v2));
+            simplex.push(sol.mask, s);
+        }
+    }
+
+    /// A run's end: its bounds and, when the cores touch or intersect, the
+    /// penetration bound.
+    #[inline(always)]
+    fn finish(
+        &self,
+        simplex: &Simplex,
+        st: &RunState,
+        exit: Status,
+        sol: Solution,
+        lower: f64,
+    ) -> Run {
+        let norm = sol.v.norm();
+        Run {
+            inner: if norm <= self.slack {
+                self.penetration(simplex, &sol)
+            } else {
+                0.0
+            },
+            sol,
+            norm,
+            lower,
+            iterations: st.iterations,
+            exit: Exit::Status(exit),
+            backup_used: st.backup_used,
+        }
+    }
+
+    /// Steps (3) to (6) of the Numerical Algorithm for the subalgorithm's
+    /// `sol` (from the Backup Procedure when `by_backup`), in full: the ends,
+    /// repeats, flat steps, refinement and the Backup Procedure. `support`,
+    /// when given, is `s_K(-v)` already found for this `sol`. `None` once a
+    /// point has been added to the simplex (the next iteration begins),
+    /// `Some` when the run ends.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &self,
+        simplex: &mut Simplex,
+        options: &Options,
+        cutoff: f64,
+        st: &mut RunState,
+        mut sol: Solution,
+        mut by_backup: bool,
+        mut support: Option<Vertex>,
+    ) -> Option<Run> {
+        let eps_d = options.tolerance * self.d;
+        let stop_d = eps_d + self.single_slack;
+        let mut refined = false;
+        loop {
+            let v2 = sol.v.norm_squared();
+            let norm = v2.sqrt();
+            if !norm.is_finite() {
+                // The subalgorithm overflowed. Fuzzing found points
+                // ~1e108 apart whose cofactors exceeded f64 (before the
+                // run was scaled to sizes near 1; kept as a guard, see
+                // gjk/tests/fuzz_regressions.rs), and NaN weights would
+                // make every bound below meaningless. Keep the last
+                // finite iterate, or else a single vertex: each is a
+                // point of the hull, so |v| stays an upper bound.
+                st.backup_used = true;
+                let best = match st.prev {
+                    Some((p, _)) => p,
                     None => {
-                        // Step (6): redo v_k with the Backup Procedure.
-                        sol = simplex.backup();
-                        by_backup = true;
-                        backup_used = true;
+                        let i = simplex.all.trailing_zeros().min(3) as usize;
+                        let mut lambda = [0.0; 4];
+                        lambda[i] = 1.0;
+                        Solution {
+                            mask: 1 << i,
+                            v: simplex.vertices[i].y,
+                            lambda,
+                        }
                     }
+                };
+                return Some(Run {
+                    inner: 0.0,
+                    sol: best,
+                    norm: best.v.norm(),
+                    lower: st.lower,
+                    iterations: st.iterations,
+                    exit: Exit::Status(Status::ToleranceNotMet),
+                    backup_used: st.backup_used,
+                });
+            }
+            if norm <= self.slack {
+                // v is the origin up to round-off: the cores touch or
+                // intersect, and nothing finer can be certified.
+                return Some(self.finish(simplex, st, Status::Converged, sol, 0.0));
+            }
+            // Step (3): the stopping rule, and the bounds of Theorem 4.1.
+            let s = match support.take() {
+                Some(s) => s,
+                None => self.support(&-sol.v),
+            };
+            let vs = sol.v.dot(&s.y);
+            st.lower = st.lower.max(vs / norm - self.single_slack);
+            let lower = st.lower;
+            let g = v2 - vs;
+            // (6.2): g <= ε·D². Near contact that rule alone lets |v|
+            // exceed the distance by up to √ε·D (nearly parallel edges do
+            // this), so once it holds the run goes on while |v| still
+            // descends, and stops early only when the certified interval,
+            // of width g/|v|, is within ε·D. A support point already in V̂
+            // leaves nothing to add: g is then the error of v itself.
+            let paper_met = g <= eps_d * self.d + self.single_slack * norm;
+            // The error of |v| is at most min(|v|, g/|v|): stop once that
+            // is within ε·D, or within the round-off allowance when the
+            // support point repeats a vertex of V̂. Beyond that, a repeat
+            // means the subalgorithm's v is off by more than round-off
+            // (a thin simplex: nearly parallel edges, or nearly collinear
+            // points of K at contact): refinement, then steps (4) to (6).
+            if g <= stop_d * norm || norm <= eps_d {
+                return Some(self.finish(simplex, st, Status::Converged, sol, lower));
+            }
+            let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
+            if repeat && g <= self.slack * norm {
+                return Some(self.finish(simplex, st, Status::Converged, sol, lower));
+            }
+            // Cutoff and margin are the world's: compared there.
+            let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
+            if lower_cert > cutoff {
+                let mut run = self.finish(simplex, st, Status::Converged, sol, lower);
+                run.exit = Exit::Pruned;
+                return Some(run);
+            }
+            if let Some(m) = options.margin {
+                if lower_cert.max(0.0) > m {
+                    return Some(self.finish(simplex, st, Status::Farther, sol, lower));
+                }
+                if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
+                    return Some(self.finish(simplex, st, Status::Closer, sol, lower));
+                }
+            }
+            if st.iterations >= options.max_iterations {
+                let status = if paper_met {
+                    Status::Converged
+                } else {
+                    Status::IterationCap
+                };
+                // The nearer of the last two iterates (see step 5).
+                let best = match st.prev {
+                    Some((p, p2)) if p2 < v2 => p,
+                    _ => sol,
+                };
+                return Some(self.finish(simplex, st, status, best, lower));
+            }
+            // Step (4): descend while |v| decreases and V̂ is not full. A
+            // step that only grows V̂ by a dimension, with |v| unchanged at
+            // round-off level, is also progress (nearly parallel edges give
+            // such steps); a few are allowed before step (5) takes over.
+            let mut not_down = false;
+            let descended = match st.prev {
+                None => true,
+                Some((_, p2)) if v2 < p2 => true,
+                Some((p, p2)) => {
+                    let grew = sol.mask.count_ones() > p.mask.count_ones();
+                    let flat = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON);
+                    // |v| up by no more than its round-off while the new
+                    // support point, not yet in Y, lies beyond v's plane
+                    // by more than the tolerance: near contact, Johnson's
+                    // v of a new face can be εD worse than the refined v
+                    // of the last, and stopping there leaves |v| at
+                    // (6.2)'s √ε·D (nearly parallel edges touching).
+                    let level = norm <= p2.sqrt() + self.slack;
+                    not_down = true;
+                    (flat || level) && st.flat_steps < 4
+                }
+            };
+            if descended && sol.mask.count_ones() <= 3 && !repeat {
+                // Only a step taken counts against the budget: a repeat
+                // refined within the iteration is the same step.
+                st.flat_steps += not_down as u32;
+                st.prev = Some((sol, v2));
+                simplex.push(sol.mask, s);
+                return None;
+            }
+            // A repeat with g above round-off: v carries the error of a
+            // thin simplex's cofactors, or of the Backup Procedure's
+            // (which redoes them). One refinement step in V̂'s affine hull
+            // removes it, and the refined v goes back to step (3); the
+            // Backup Procedure comes after, if needed.
+            let refined_sol = if repeat && !refined {
+                refined = true;
+                simplex.refine(sol)
+            } else {
+                None
+            };
+            // Step (5): round-off has the last word. The previous iterate,
+            // if nearer, is still valid: its vertices kept their slots.
+            // When (6.2) holds the paper would have stopped at step (3):
+            // no Backup Procedure is needed to confirm that, unless the
+            // support point repeats a point of Y (then (6.2) may hold
+            // for a v that is off by up to √ε·D) and refinement is left.
+            if refined_sol.is_none() && (by_backup || (paper_met && !repeat)) {
+                let status = if paper_met {
+                    Status::Converged
+                } else {
+                    Status::ToleranceNotMet
+                };
+                // A step that failed to descend (round-off in a
+                // degenerate simplex) leaves the previous iterate, whose
+                // slots the push kept, as the better upper bound.
+                let best = match st.prev {
+                    Some((p, p2)) if p2 < v2 => p,
+                    _ => sol,
+                };
+                return Some(self.finish(simplex, st, status, best, lower));
+            }
+            match refined_sol {
+                Some(r) => sol = r,
+                None => {
+                    // Step (6): redo v_k with the Backup Procedure.
+                    sol = simplex.backup();
+                    by_backup = true;
+                    st.backup_used = true;
                 }
             }
         }

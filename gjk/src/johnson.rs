@@ -985,12 +985,17 @@ impl Simplex {
     }
 
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
+    #[inline(always)]
     pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
-        // Non-short-circuit: which slot matches is unpredictable, so a bit
-        // mask of matches costs less than the branches of `any`.
+        // Each pair as one 64-bit key (the two adjacent indices of a
+        // vertex load as one word), compared without short-circuit: which
+        // slot matches is unpredictable, so a bit mask of matches costs
+        // less than the branches of `any`.
+        let key = |a: u32, b: u32| u64::from(a) | u64::from(b) << 32;
+        let want = key(ia, ib);
         let mut hit = 0u8;
         for (i, v) in self.vertices.iter().enumerate() {
-            hit |= u8::from((v.ia == ia) & (v.ib == ib)) << i;
+            hit |= u8::from(key(v.ia, v.ib) == want) << i;
         }
         hit & mask != 0
     }

@@ -426,6 +426,22 @@ struct Pair<'s> {
     single_slack: f64,
 }
 
+/// `R·z`, each component `(r_i0·z_0 + r_i1·z_1) + r_i2·z_2`: nalgebra's
+/// product term for term and in its order, so bit for bit the same, written
+/// out so that the hot loop keeps it in scalar registers.
+#[inline(always)]
+fn rotate(r: &Matrix3<f64>, z: &Vector3<f64>) -> Vector3<f64> {
+    let row = |i: usize| (r[(i, 0)] * z.x + r[(i, 1)] * z.y) + r[(i, 2)] * z.z;
+    Vector3::new(row(0), row(1), row(2))
+}
+
+/// `Rᵀ·e`, as nalgebra's `tr_mul` (column dot products, in its order).
+#[inline(always)]
+fn rotate_back(r: &Matrix3<f64>, e: &Vector3<f64>) -> Vector3<f64> {
+    let col = |j: usize| (r[(0, j)] * e.x + r[(1, j)] * e.y) + r[(2, j)] * e.z;
+    Vector3::new(col(0), col(1), col(2))
+}
+
 /// Where a piece sits: its shape's pose and, for a compound's piece, its offset
 /// in the shape's body frame.
 #[derive(Clone, Copy)]
@@ -552,7 +568,7 @@ impl<'s> Pair<'s> {
     /// terms are small vectors relative to their centroids.
     #[inline(always)]
     fn vertex(&self, ia: usize, ib: usize) -> Vertex {
-        let (za, zb) = (self.a.local(ia), self.r * self.b.local(ib));
+        let (za, zb) = (self.a.local(ia), rotate(&self.r, &self.b.local(ib)));
         // k is 1 but for shapes beyond 2^±64 in size: skip the products
         // then. Each point is scaled after the rotation, not through a
         // scaled matrix, whose entries could be subnormal.
@@ -571,7 +587,7 @@ impl<'s> Pair<'s> {
     /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one scan of each vertex set.
     #[inline(always)]
     fn support(&self, eta: &Vector3<f64>) -> Vertex {
-        let eta_b = -self.r.tr_mul(eta);
+        let eta_b = -rotate_back(&self.r, eta);
         let (ia, ib) = if self.single {
             (
                 self.a.support_index_single(eta),

@@ -438,7 +438,14 @@ impl Convex {
     /// Vertex `i` relative to the centroid, as stored for the scan.
     #[inline]
     pub(crate) fn local(&self, i: usize) -> Vector3<f64> {
-        Vector3::new(self.xs[i], self.ys[i], self.zs[i])
+        // One bounds check for three loads: `new` builds and pads the three
+        // coordinate arrays together, to one length, and nothing changes
+        // them after.
+        let x = self.xs[i];
+        debug_assert!(self.ys.len() == self.xs.len() && self.zs.len() == self.xs.len());
+        // SAFETY: i < xs.len() (checked just above) == ys.len() == zs.len().
+        let (y, z) = unsafe { (*self.ys.get_unchecked(i), *self.zs.get_unchecked(i)) };
+        Vector3::new(x, y, z)
     }
 }
 

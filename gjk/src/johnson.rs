@@ -694,19 +694,24 @@ impl Simplex {
     fn holds_origin(&self) -> bool {
         let [a, b, c, d] = [0, 1, 2, 3].map(|i| self.vertices[i].y);
         let (ba, ca, da) = (b - a, c - a, d - a);
-        // Each volume p·(q×r) with its error bound 16ε|p||q||r|; the seven
-        // lengths involved are taken once.
-        let [na, nb, nc, nd, nba, nca, nda] = [a, b, c, d, ba, ca, da].map(|x| x.norm());
-        let e = 16.0 * f64::EPSILON;
+        // Each volume p·(q×r) against its error bound 16ε|p||q||r|, both
+        // squared, so no square root is taken: v² > (16ε)²|p|²|q|²|r|²,
+        // with 8ε of room for the rounding of the squares themselves. A
+        // bound that underflows needs a vertex within about 1e-140 of the
+        // origin in the run's frame (whose sizes are near 1), where calling
+        // the distance 0 is within the round-off allowance anyway.
+        let [na, nb, nc, nd, nba, nca, nda] =
+            [a, b, c, d, ba, ca, da].map(|x| x.norm_squared());
+        let e2 = (16.0 * f64::EPSILON) * (16.0 * f64::EPSILON) * (1.0 + 8.0 * f64::EPSILON);
         let vols = [
-            (b.dot(&c.cross(&d)), e * nb * nc * nd),
-            ((-a).dot(&ca.cross(&da)), e * na * nca * nda),
-            (ba.dot(&(-a).cross(&da)), e * nba * na * nda),
-            (ba.dot(&ca.cross(&(-a))), e * nba * nca * na),
+            (b.dot(&c.cross(&d)), nb * nc * nd),
+            ((-a).dot(&ca.cross(&da)), na * nca * nda),
+            (ba.dot(&(-a).cross(&da)), nba * na * nda),
+            (ba.dot(&ca.cross(&(-a))), nba * nca * na),
         ];
         let total = ba.dot(&ca.cross(&da));
         vols.iter()
-            .all(|&(v, err)| v.abs() > err && (v > 0.0) == (total > 0.0))
+            .all(|&(v, n3)| v * v > e2 * n3 && (v > 0.0) == (total > 0.0))
     }
 
     #[inline(always)]
@@ -874,18 +879,22 @@ impl Simplex {
     /// of `√ε` relative, too much for a bound that must stay below the truth.
     pub fn inner_radius(&self) -> f64 {
         debug_assert_eq!(self.all, 0b1111);
+        // The smallest squared distance (n·p)²/|n|² over the faces, then one
+        // square root: the four quotients are independent, and the one root
+        // rounds as the four would have (the caller's slack covers both).
         let mut best = f64::INFINITY;
         for face in [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]] {
             let [p, q, r] = face.map(|i| self.vertices[i].y);
             let n = (q - p).cross(&(r - p));
-            let len = n.norm();
-            if len.is_nan() || len == 0.0 {
+            let len2 = n.norm_squared();
+            if len2.is_nan() || len2 == 0.0 {
                 // A flat face: the tetrahedron is degenerate and proves nothing.
                 return 0.0;
             }
-            best = best.min(n.dot(&p).abs() / len);
+            let h = n.dot(&p);
+            best = best.min(h * h / len2);
         }
-        if best.is_finite() { best } else { 0.0 }
+        if best.is_finite() { best.sqrt() } else { 0.0 }
     }
 
     /// One step of iterative refinement of `sol` within the affine hull of

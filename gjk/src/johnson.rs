@@ -700,8 +700,7 @@ impl Simplex {
         // bound that underflows needs a vertex within about 1e-140 of the
         // origin in the run's frame (whose sizes are near 1), where calling
         // the distance 0 is within the round-off allowance anyway.
-        let [na, nb, nc, nd, nba, nca, nda] =
-            [a, b, c, d, ba, ca, da].map(|x| x.norm_squared());
+        let [na, nb, nc, nd, nba, nca, nda] = [a, b, c, d, ba, ca, da].map(|x| x.norm_squared());
         let e2 = (16.0 * f64::EPSILON) * (16.0 * f64::EPSILON) * (1.0 + 8.0 * f64::EPSILON);
         let vols = [
             (b.dot(&c.cross(&d)), nb * nc * nd),

@@ -385,7 +385,33 @@ impl Simplex {
         self.newest = Some(slot);
     }
 
+    /// [`push`](Self::push) with the update compiled for AVX2 and FMA: the
+    /// same cofactors bit for bit (see `query::distance_avx2`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    pub fn push_avx2(&mut self, keep: u8, p: Vertex) {
+        debug_assert!(keep.count_ones() <= 3);
+        self.all = keep;
+        let slot = (!keep).trailing_zeros() as u8;
+        self.insert_avx2(slot, p);
+        self.newest = Some(slot);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[inline(never)]
+    fn insert_avx2(&mut self, n: u8, p: Vertex) {
+        self.insert_inline(n, p);
+    }
+
+    #[inline(never)]
     fn insert(&mut self, n: u8, p: Vertex) {
+        self.insert_inline(n, p);
+    }
+
+    /// The body of [`insert`](Self::insert), inlined into each compiled form.
+    #[inline(always)]
+    fn insert_inline(&mut self, n: u8, p: Vertex) {
         let n_us = n as usize & 3;
         self.vertices[n_us] = p;
         // All four products, used slots or not: branch-free, and a stale slot's
@@ -753,6 +779,20 @@ impl Simplex {
     /// The Distance Subalgorithm: the first subset, in the order of Section 6,
     /// that passes Theorem 5.2, or `None` when round-off left none passing.
     pub fn solve(&self) -> Option<Solution> {
+        self.solve_inline()
+    }
+
+    /// [`solve`](Self::solve) compiled for AVX2 and FMA: the same answer bit
+    /// for bit (see `query::distance_avx2`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    pub fn solve_avx2(&self) -> Option<Solution> {
+        self.solve_inline()
+    }
+
+    /// The body of [`solve`](Self::solve), inlined into each compiled form.
+    #[inline(always)]
+    fn solve_inline(&self) -> Option<Solution> {
         let all = self.all as usize;
         match self.newest {
             Some(n) => by_shape!(n as usize, all, N, ALL => self.solve_of::<N, ALL>(), {
@@ -820,6 +860,7 @@ impl Simplex {
     }
 
     /// [`solution`](Self::solution), one specialised body per subset.
+    #[inline(always)]
     fn solution_by(&self, mask: usize) -> Solution {
         by_mask!(mask, M => self.solution(M))
     }

@@ -328,7 +328,7 @@ pub fn distance_in(
         // SAFETY: the CPU supports AVX2 and FMA, checked just above.
         return unsafe { distance_avx2(workspace, a, pose_a, b, pose_b, options, warm) };
     }
-    distance_of(workspace, a, pose_a, b, pose_b, options, warm)
+    distance_of::<false>(workspace, a, pose_a, b, pose_b, options, warm)
 }
 
 /// [`distance_of`] compiled for AVX2 and FMA: the same operations, each
@@ -347,12 +347,14 @@ fn distance_avx2(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
-    distance_of(workspace, a, pose_a, b, pose_b, options, warm)
+    distance_of::<true>(workspace, a, pose_a, b, pose_b, options, warm)
 }
 
-/// The body of [`distance_in`], inlined into each of its compiled forms.
+/// The body of [`distance_in`], inlined into each of its compiled forms;
+/// `AVX2` says which, so that the subalgorithm's out-of-line parts are
+/// called in the same form.
 #[inline(always)]
-fn distance_of(
+fn distance_of<const AVX2: bool>(
     workspace: &mut Workspace,
     a: &Shape,
     pose_a: &Isometry3<f64>,
@@ -391,10 +393,10 @@ fn distance_of(
                 offset: None,
             };
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let run = pair.solve_retrying(simplex, options, warm_pairs, f64::INFINITY);
+            let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
             pair.answer(&run, simplex, place, [0, 0])
         }
-        _ => compound(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
+        _ => compound::<AVX2>(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
     };
     if answer.lower > answer.upper {
         // The bounds contradict each other: round-off beyond the slack. The
@@ -478,6 +480,31 @@ fn rotate(r: &Matrix3<f64>, z: &Vector3<f64>) -> Vector3<f64> {
 fn rotate_back(r: &Matrix3<f64>, e: &Vector3<f64>) -> Vector3<f64> {
     let col = |j: usize| (r[(0, j)] * e.x + r[(1, j)] * e.y) + r[(2, j)] * e.z;
     Vector3::new(col(0), col(1), col(2))
+}
+
+/// Johnson's subalgorithm in the query's compiled form (see
+/// [`distance_avx2`]).
+#[inline(always)]
+fn subalgorithm<const AVX2: bool>(simplex: &Simplex) -> Option<Solution> {
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: AVX2 is true only below `distance_avx2`, which is entered
+        // after the CPU was found to support AVX2 and FMA.
+        return unsafe { simplex.solve_avx2() };
+    }
+    simplex.solve()
+}
+
+/// [`Simplex::push`] in the query's compiled form (see [`distance_avx2`]).
+#[inline(always)]
+fn push<const AVX2: bool>(simplex: &mut Simplex, keep: u8, p: Vertex) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: as in `subalgorithm`.
+        unsafe { simplex.push_avx2(keep, p) };
+        return;
+    }
+    simplex.push(keep, p);
 }
 
 /// Where a piece sits: its shape's pose and, for a compound's piece, its offset
@@ -640,14 +667,14 @@ impl<'s> Pair<'s> {
     /// The Numerical Algorithm, steps (1) to (6): one run, its lengths in the
     /// world's units (the simplex's points stay in the scaled frame).
     #[inline(always)]
-    fn solve(
+    fn solve<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> Run {
-        let mut run = self.solve_scaled(simplex, options, warm, cutoff);
+        let mut run = self.solve_scaled::<AVX2>(simplex, options, warm, cutoff);
         if self.inv_k != 1.0 {
             run.norm *= self.inv_k;
             run.lower *= self.inv_k;
@@ -667,7 +694,7 @@ impl<'s> Pair<'s> {
     /// Both take the same decisions on the same values, so the split changes
     /// the time of a query, never its answer.
     #[inline(always)]
-    fn solve_scaled(
+    fn solve_scaled<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
@@ -699,10 +726,10 @@ impl<'s> Pair<'s> {
         loop {
             st.iterations += 1;
             // Step (2).
-            let Some(sol) = simplex.solve() else {
+            let Some(sol) = subalgorithm::<AVX2>(simplex) else {
                 st.backup_used = true;
                 let sol = simplex.backup();
-                match self.step(simplex, options, cutoff, &mut st, sol, true, None) {
+                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, true, None) {
                     Some(run) => return run,
                     None => continue,
                 }
@@ -711,7 +738,7 @@ impl<'s> Pair<'s> {
             let norm = v2.sqrt();
             // Overflow (NaN fails the first test) and touching cores.
             if !(norm > self.slack && norm.is_finite()) {
-                match self.step(simplex, options, cutoff, &mut st, sol, false, None) {
+                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, None) {
                     Some(run) => return run,
                     None => continue,
                 }
@@ -743,7 +770,7 @@ impl<'s> Pair<'s> {
                 || margin_ends
                 || st.iterations >= options.max_iterations
             {
-                match self.step(simplex, options, cutoff, &mut st, sol, false, Some(s)) {
+                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, Some(s)) {
                     Some(run) => return run,
                     None => continue,
                 }
@@ -751,7 +778,7 @@ impl<'s> Pair<'s> {
             // Step (4).
             st.lower = lower;
             st.prev = Some((sol, v2));
-            simplex.push(sol.mask, s);
+            push::<AVX2>(simplex, sol.mask, s);
         }
     }
 
@@ -790,7 +817,7 @@ impl<'s> Pair<'s> {
     /// `Some` when the run ends.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    fn step(
+    fn step<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
@@ -927,7 +954,7 @@ impl<'s> Pair<'s> {
                 // refined within the iteration is the same step.
                 st.flat_steps += not_down as u32;
                 st.prev = Some((sol, v2));
-                simplex.push(sol.mask, s);
+                push::<AVX2>(simplex, sol.mask, s);
                 return None;
             }
             // A repeat with g above round-off: v carries the error of a
@@ -979,16 +1006,16 @@ impl<'s> Pair<'s> {
     /// pairs and a compound's piece pairs alike. A pruned run is left
     /// alone: it only had to prove that its pair cannot win.
     #[inline(always)]
-    fn solve_retrying(
+    fn solve_retrying<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> Run {
-        let run = self.solve(simplex, options, warm, cutoff);
+        let run = self.solve::<AVX2>(simplex, options, warm, cutoff);
         if warm.is_some() && run.exit != Exit::Pruned && self.loose(&run, options.tolerance) {
-            return self.cold_again(run, simplex, options, cutoff);
+            return self.cold_again::<AVX2>(run, simplex, options, cutoff);
         }
         run
     }
@@ -1009,8 +1036,14 @@ impl<'s> Pair<'s> {
     /// bound, certified too, still counts.
     #[cold]
     #[inline(never)]
-    fn cold_again(&self, warm: Run, simplex: &mut Simplex, options: &Options, cutoff: f64) -> Run {
-        let mut run = self.solve(simplex, options, None, cutoff);
+    fn cold_again<const AVX2: bool>(
+        &self,
+        warm: Run,
+        simplex: &mut Simplex,
+        options: &Options,
+        cutoff: f64,
+    ) -> Run {
+        let mut run = self.solve::<AVX2>(simplex, options, None, cutoff);
         run.lower = run.lower.max(warm.lower);
         run.iterations = run.iterations.saturating_add(warm.iterations);
         run.backup_used |= warm.backup_used;
@@ -1147,7 +1180,7 @@ impl<'s> Pair<'s> {
 /// first, then by a bounding-sphere lower bound; each runs with the best upper
 /// bound so far as its cutoff, so a pair that cannot win stops early.
 #[allow(clippy::too_many_arguments)]
-fn compound(
+fn compound<const AVX2: bool>(
     simplex: &mut Simplex,
     a: &Shape,
     pose_a: &Isometry3<f64>,
@@ -1215,7 +1248,7 @@ fn compound(
         let piece_rel = oa.inv_mul(&(rel * ob));
         let pair = Pair::new(ca, cb, &piece_rel, None, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
-        let run = pair.solve_retrying(simplex, options, warm_pairs, cutoff);
+        let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, cutoff);
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
         if pair_upper < kept[1].0 {
             let entry = (pair_upper, PieceSimplex::of(simplex, run.sol.mask, [i, j]));

@@ -1123,4 +1123,101 @@ pub(crate) mod tests {
             assert_eq!(c.support_index_single(&d), brute(&c, &d));
         }
     }
+
+    /// The scan's rule written out plainly, one vertex at a time: the first
+    /// vertex of largest dot product, computed as the support search computes
+    /// it on this machine (fused multiply-adds on the AVX2 path, which sets
+    /// of 8 or more vertices take when the CPU has AVX2 and FMA; plain
+    /// products and sums otherwise).
+    fn reference(c: &Convex, d: &Vector3<f64>) -> usize {
+        #[cfg(target_arch = "x86_64")]
+        let fused = c.len() >= 8
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        #[cfg(not(target_arch = "x86_64"))]
+        let fused = false;
+        reference_with(c, d, fused)
+    }
+
+    /// [`reference`] with the arithmetic chosen: fused or plain.
+    fn reference_with(c: &Convex, d: &Vector3<f64>, fused: bool) -> usize {
+        let (mut top, mut best) = (f64::NEG_INFINITY, 0);
+        for i in 0..c.len() {
+            let (x, y, z) = (c.xs[i], c.ys[i], c.zs[i]);
+            let dot = if fused {
+                z.mul_add(d.z, y.mul_add(d.y, x * d.x))
+            } else {
+                x * d.x + y * d.y + z * d.z
+            };
+            if dot > top {
+                (top, best) = (dot, i);
+            }
+        }
+        best
+    }
+
+    /// The support index is the reference's, vertex for vertex (and the
+    /// portable scan's is the plain reference's), for every
+    /// set size from 2 to 200 and past the vector steps' boundaries: sets
+    /// full of exact ties (grid points, duplicates, a repeated maximum in
+    /// every lane), near-ties that fused and plain arithmetic round apart,
+    /// and directions that are zero, signed zeros, tiny, huge enough to
+    /// overflow the dot products to infinity, or that make them NaN.
+    #[test]
+    fn support_index_is_the_plain_scans_first_maximum() {
+        let mut rng = Rng(0x5eed_0000_5ca1_0001);
+        let mut checked = 0;
+        for n in (2..=200).chain([255, 256, 257, 511]) {
+            for style in 0..4 {
+                let pts: Vec<Point3<f64>> = (0..n)
+                    .map(|i| match style {
+                        // A coarse grid: many exact ties, duplicates.
+                        0 => Point3::new(
+                            (rng.next() * 3.0).round(),
+                            (rng.next() * 3.0).round(),
+                            (rng.next() * 2.0).round(),
+                        ),
+                        // The same point again and again but for a few.
+                        1 if i % 7 != 3 => Point3::new(1.0, 2.0, 3.0),
+                        // Near-ties: a sphere of radius 1 + a few ulps.
+                        2 => {
+                            let v = Vector3::new(rng.next(), rng.next(), rng.next());
+                            Point3::from(v.normalize() * (1.0 + rng.next() * 1e-15))
+                        }
+                        _ => Point3::new(rng.next(), rng.next(), rng.next()),
+                    })
+                    .collect();
+                let c = Convex::new(pts, 0.0).unwrap();
+                if matches!(c.kind, Kind::Box | Kind::Point) {
+                    continue;
+                }
+                for k in 0..40 {
+                    let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
+                    match k % 10 {
+                        0 => d = d.map(|x| (x * 2.0).round()),
+                        1 => d = Vector3::new(0.0, -0.0, 0.0),
+                        2 => d = Vector3::new(-0.0, d.y, 0.0),
+                        3 => d *= 1e-310,
+                        4 => d *= 1e308,
+                        5 => d = Vector3::new(f64::INFINITY, d.y, d.z),
+                        6 => d = Vector3::new(f64::NAN, d.y, d.z),
+                        _ => {}
+                    }
+                    assert_eq!(
+                        c.support_index(&d),
+                        reference(&c, &d),
+                        "n {n} style {style} d {d:?}"
+                    );
+                    // The portable path, whatever this CPU has.
+                    assert_eq!(
+                        scan_top(&c.xs, &c.ys, &c.zs, &d).1,
+                        reference_with(&c, &d, false),
+                        "portable: n {n} style {style} d {d:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 30_000, "{checked}");
+    }
 }

@@ -857,11 +857,8 @@ unsafe fn scan_avx2(c: &Convex, d: &Vector3<f64>) -> usize {
     // added once after the loop: one step counter for both halves. Indices
     // are integers in 64-bit lanes, below 2^32 (the sets here are small).
     let mut at = [_mm256_setzero_si256(); 2];
-    let mut k = _mm256_setzero_si256();
-    let step = _mm256_set1_epi64x(8);
-    let mut i = 8;
-    while i < n {
-        k = _mm256_add_epi64(k, step);
+    // One step: vertices i to i + 7, `k` holding i.
+    let mut take = |i: usize, k: __m256i| {
         for h in 0..2 {
             let v = dot(i + 4 * h);
             let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(v, best[h]);
@@ -876,7 +873,25 @@ unsafe fn scan_avx2(c: &Convex, d: &Vector3<f64>) -> usize {
                 gt,
             ));
         }
+    };
+    // The other steps two at a time, an odd one out first: one loop test and
+    // two counter updates for 16 vertices (about 1 % of a family query).
+    let mut i = 8;
+    if n.is_multiple_of(16) {
+        take(i, _mm256_set1_epi64x(8));
         i += 8;
+    }
+    let (mut k, mut k2) = (
+        _mm256_set1_epi64x(i as i64),
+        _mm256_set1_epi64x(i as i64 + 8),
+    );
+    let step = _mm256_set1_epi64x(16);
+    while i < n {
+        take(i, k);
+        take(i + 8, k2);
+        k = _mm256_add_epi64(k, step);
+        k2 = _mm256_add_epi64(k2, step);
+        i += 16;
     }
     // Each lane holds its first index of its largest value (strict `>`
     // above), so the set's first index of the largest value is the lowest

@@ -107,8 +107,15 @@ enum Kind {
     /// taking `+` on axis `k` when bit `k` of `i` is set ([`Convex::cuboid`]'s
     /// order): the support index is the sign bits of the direction.
     Box,
-    /// Fewer than [`blocks::MIN_VERTICES`](crate::blocks::MIN_VERTICES)
-    /// vertices otherwise: the linear scan.
+    /// Two to seven vertices (a capsule's segment, a triangle): the scan's
+    /// scalar loop, inlined where the support is needed.
+    Few,
+    /// Eight vertices or more, fewer than
+    /// [`blocks::MIN_VERTICES`](crate::blocks::MIN_VERTICES), on a CPU with
+    /// AVX2 and FMA (checked once, here): the vector scan, called directly.
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
+    /// As [`Kind::Avx2`] on a CPU without them: the portable scan.
     Scan,
     /// Larger sets: the block search, exact and the scan's own choice, which
     /// skips blocks of vertices that cannot hold the support point.
@@ -203,12 +210,14 @@ impl Convex {
             Kind::Box
         } else if len >= crate::blocks::MIN_VERTICES {
             Kind::Blocks
+        } else if len < 8 {
+            Kind::Few
         } else {
-            Kind::Scan
+            scan_kind()
         };
         let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
         // Indices ride in i32 lanes in the f32 scan.
-        let single = if matches!(kind, Kind::Scan | Kind::Blocks)
+        let single = if !matches!(kind, Kind::Point | Kind::Box)
             && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
             && i32::try_from(xs.len()).is_ok()
             && size > 0.0
@@ -340,11 +349,21 @@ impl Convex {
             Kind::Box => {
                 usize::from(d.x > 0.0) | usize::from(d.y > 0.0) << 1 | usize::from(d.z > 0.0) << 2
             }
-            // One arm for both: the branch between them is taken out of
-            // line, where it costs the family's small shapes nothing
-            // measurable (a fourth arm here cost 1 %).
-            Kind::Scan | Kind::Blocks => self.search_index(d),
+            // A handful of products: cheaper here than a call.
+            Kind::Few => scan_few(&self.xs, &self.ys, &self.zs, d).1,
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: Kind::Avx2 is only chosen on a CPU with AVX2 and FMA.
+            Kind::Avx2 => unsafe { scan_avx2(self, d) },
+            Kind::Scan => self.scan_portable(d),
+            Kind::Blocks => self.search_index(d),
         }
+    }
+
+    /// [`scan_top`]'s index for [`Kind::Scan`], out of line: the query
+    /// inlines only the arms that need no call.
+    #[inline(never)]
+    fn scan_portable(&self, d: &Vector3<f64>) -> usize {
+        scan_top(&self.xs, &self.ys, &self.zs, d).1
     }
 
     /// [`support_index`](Self::support_index) by the block search when the
@@ -423,7 +442,7 @@ impl Convex {
                 && std::arch::is_x86_feature_detected!("fma")
             {
                 // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-                return unsafe { scan_avx2(&self.xs, &self.ys, &self.zs, d) };
+                return unsafe { scan_avx2_any(&self.xs, &self.ys, &self.zs, d) };
             }
         }
         scan_top(&self.xs, &self.ys, &self.zs, d).1
@@ -637,16 +656,7 @@ pub(crate) fn scan_top(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> 
     let (dx, dy, dz) = (d.x, d.y, d.z);
     if n < 2 * LANES {
         // Spheres, capsules, boxes: lane set-up would cost more than the scan.
-        let mut top = f64::NEG_INFINITY;
-        let mut idx = 0;
-        for i in 0..n {
-            let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
-            if dot > top {
-                top = dot;
-                idx = i;
-            }
-        }
-        return (top, idx);
+        return scan_few(xs, ys, zs, d);
     }
     let mut best = [f64::NEG_INFINITY; LANES];
     let mut best_i = [0.0f64; LANES];
@@ -683,6 +693,36 @@ pub(crate) fn scan_top(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> 
         }
     }
     (top, idx)
+}
+
+/// [`scan_top`] one vertex at a time, for the smallest sets: the largest
+/// dot product and its first index.
+#[inline(always)]
+fn scan_few(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize) {
+    let n = xs.len().min(ys.len()).min(zs.len());
+    let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+    let (dx, dy, dz) = (d.x, d.y, d.z);
+    let mut top = f64::NEG_INFINITY;
+    let mut idx = 0;
+    for i in 0..n {
+        let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
+        if dot > top {
+            top = dot;
+            idx = i;
+        }
+    }
+    (top, idx)
+}
+
+/// The kind of a set of 8 vertices or more that the block search leaves to
+/// the scan: [`Kind::Avx2`] if this CPU has AVX2 and FMA, the vector scan's
+/// requirements, else [`Kind::Scan`].
+fn scan_kind() -> Kind {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        return Kind::Avx2;
+    }
+    Kind::Scan
 }
 
 /// [`scan_top`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
@@ -775,14 +815,116 @@ pub(crate) unsafe fn scan_avx2_top(
     (top, idx)
 }
 
-/// [`scan_avx2_top`]'s index alone, its own function so that the query's
-/// plain scan returns one register, as it did before the block search
-/// needed the value too (1 % of a family query, measured).
+/// [`scan_avx2_top`]'s index alone, for any length, out of line.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn scan_avx2(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
+unsafe fn scan_avx2_any(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> usize {
     // SAFETY: this function's own target features are the callee's.
     unsafe { scan_avx2_top(xs, ys, zs, d).1 }
+}
+
+/// The support index of a whole padded set (8 or more vertices, a multiple
+/// of 8 in the arrays) by the vector scan: [`scan_avx2_top`]'s arithmetic and
+/// choice, with less around the loop, since this is most of a family query's
+/// support cost. The lengths are the shape's own, so nothing is checked; the
+/// first step takes its eight dot products as they are; the lanes are merged
+/// by a maximum, then the lowest index among the lanes that hold it.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn scan_avx2(c: &Convex, d: &Vector3<f64>) -> usize {
+    use std::arch::x86_64::*;
+    // The arrays are built together, padded to the same multiple of 8
+    // (at least 8 here), and never changed after construction.
+    let n = c.xs.len();
+    debug_assert!(n >= 8 && n.is_multiple_of(8) && c.ys.len() == n && c.zs.len() == n);
+    let (xs, ys, zs) = (c.xs.as_ptr(), c.ys.as_ptr(), c.zs.as_ptr());
+    let (dx, dy, dz) = (
+        _mm256_set1_pd(d.x),
+        _mm256_set1_pd(d.y),
+        _mm256_set1_pd(d.z),
+    );
+    // SAFETY: callers pass k + 4 <= n, the length of all three arrays.
+    let dot = |k: usize| unsafe {
+        let (x, y, z) = (
+            _mm256_loadu_pd(xs.add(k)),
+            _mm256_loadu_pd(ys.add(k)),
+            _mm256_loadu_pd(zs.add(k)),
+        );
+        _mm256_fmadd_pd(z, dz, _mm256_fmadd_pd(y, dy, _mm256_mul_pd(x, dx)))
+    };
+    // Step 0 without comparisons: a lane's first dot product is its best
+    // unless it is NaN, which `max` (second operand on NaN) turns into the
+    // -inf that the scan would have kept. Such a lane, or one at -inf,
+    // records its own index where the scan keeps 0; that matters only when
+    // every lane ends at -inf, and then lane 0 (index 0) is among the
+    // lowest-index candidates below, as in the scan.
+    let ninf = _mm256_set1_pd(f64::NEG_INFINITY);
+    let mut best = [_mm256_max_pd(dot(0), ninf), _mm256_max_pd(dot(4), ninf)];
+    // Each lane's index is its step's first index plus the lane's offset,
+    // added once after the loop: one step counter for both halves. Indices
+    // are integers in 64-bit lanes, below 2^32 (the sets here are small).
+    let mut at = [_mm256_setzero_si256(); 2];
+    // One step: vertices i to i + 7, `k` holding i.
+    let mut take = |i: usize, k: __m256i| {
+        for h in 0..2 {
+            let v = dot(i + 4 * h);
+            let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(v, best[h]);
+            // The blend of `v` into `best` by `gt`, bit for bit: `max` returns
+            // its second operand unless the first is larger (for NaN and for
+            // zeros of either sign too), and its result does not wait for
+            // the comparison.
+            best[h] = _mm256_max_pd(v, best[h]);
+            at[h] = _mm256_castpd_si256(_mm256_blendv_pd(
+                _mm256_castsi256_pd(at[h]),
+                _mm256_castsi256_pd(k),
+                gt,
+            ));
+        }
+    };
+    // The other steps two at a time, an odd one out first: one loop test and
+    // two counter updates for 16 vertices (about 1 % of a family query).
+    let mut i = 8;
+    if n.is_multiple_of(16) {
+        take(i, _mm256_set1_epi64x(8));
+        i += 8;
+    }
+    let (mut k, mut k2) = (
+        _mm256_set1_epi64x(i as i64),
+        _mm256_set1_epi64x(i as i64 + 8),
+    );
+    let step = _mm256_set1_epi64x(16);
+    while i < n {
+        take(i, k);
+        take(i + 8, k2);
+        k = _mm256_add_epi64(k, step);
+        k2 = _mm256_add_epi64(k2, step);
+        i += 16;
+    }
+    // Each lane holds its first index of its largest value (strict `>`
+    // above), so the set's first index of the largest value is the lowest
+    // index among the lanes equal to the maximum. No lane holds NaN.
+    let top = _mm256_max_pd(best[0], best[1]);
+    let top = _mm256_max_pd(top, _mm256_permute2f128_pd::<1>(top, top));
+    let top = _mm256_max_pd(top, _mm256_permute_pd::<0b0101>(top));
+    let lanes = [
+        _mm256_setr_epi64x(0, 1, 2, 3),
+        _mm256_setr_epi64x(4, 5, 6, 7),
+    ];
+    // A lane off the maximum offers u32::MAX (all ones); the minimum is
+    // taken on the low 32 bits of each lane, where the indices are.
+    let first = |h: usize| {
+        let tie = _mm256_cmp_pd::<_CMP_EQ_OQ>(best[h], top);
+        let index = _mm256_castsi256_pd(_mm256_or_si256(at[h], lanes[h]));
+        _mm256_castpd_si256(_mm256_blendv_pd(
+            _mm256_castsi256_pd(_mm256_set1_epi32(-1)),
+            index,
+            tie,
+        ))
+    };
+    let low = _mm256_min_epu32(first(0), first(1));
+    let low = _mm256_min_epu32(low, _mm256_permute2x128_si256::<1>(low, low));
+    let low = _mm256_min_epu32(low, _mm256_shuffle_epi32::<0b0100_1110>(low));
+    _mm256_cvtsi256_si32(low) as u32 as usize
 }
 
 /// The f32 support scan, portable: 8 lanes, any vertex of the largest dot
@@ -961,11 +1103,11 @@ pub(crate) mod tests {
         let mut skew = b.vertices().to_vec();
         skew[3].x += 1e-9;
         for (verts, kind) in [
-            (swapped, Kind::Scan),
-            (skew, Kind::Scan),
+            (swapped, scan_kind()),
+            (skew, scan_kind()),
             (shifted, Kind::Box),
             (b.vertices()[..1].to_vec(), Kind::Point),
-            (b.vertices()[..2].to_vec(), Kind::Scan),
+            (b.vertices()[..2].to_vec(), Kind::Few),
         ] {
             let c = Convex::new(verts, 0.0).unwrap();
             assert_eq!(c.kind, kind);
@@ -1129,5 +1271,102 @@ pub(crate) mod tests {
             let d = Vector3::new(0.3, -0.8, 0.1);
             assert_eq!(c.support_index_single(&d), brute(&c, &d));
         }
+    }
+
+    /// The scan's rule written out plainly, one vertex at a time: the first
+    /// vertex of largest dot product, computed as the support search computes
+    /// it on this machine (fused multiply-adds on the AVX2 path, which sets
+    /// of 8 or more vertices take when the CPU has AVX2 and FMA; plain
+    /// products and sums otherwise).
+    fn reference(c: &Convex, d: &Vector3<f64>) -> usize {
+        #[cfg(target_arch = "x86_64")]
+        let fused = c.len() >= 8
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        #[cfg(not(target_arch = "x86_64"))]
+        let fused = false;
+        reference_with(c, d, fused)
+    }
+
+    /// [`reference`] with the arithmetic chosen: fused or plain.
+    fn reference_with(c: &Convex, d: &Vector3<f64>, fused: bool) -> usize {
+        let (mut top, mut best) = (f64::NEG_INFINITY, 0);
+        for i in 0..c.len() {
+            let (x, y, z) = (c.xs[i], c.ys[i], c.zs[i]);
+            let dot = if fused {
+                z.mul_add(d.z, y.mul_add(d.y, x * d.x))
+            } else {
+                x * d.x + y * d.y + z * d.z
+            };
+            if dot > top {
+                (top, best) = (dot, i);
+            }
+        }
+        best
+    }
+
+    /// The support index is the reference's, vertex for vertex (and the
+    /// portable scan's is the plain reference's), for every
+    /// set size from 2 to 200 and past the vector steps' boundaries: sets
+    /// full of exact ties (grid points, duplicates, a repeated maximum in
+    /// every lane), near-ties that fused and plain arithmetic round apart,
+    /// and directions that are zero, signed zeros, tiny, huge enough to
+    /// overflow the dot products to infinity, or that make them NaN.
+    #[test]
+    fn support_index_is_the_plain_scans_first_maximum() {
+        let mut rng = Rng(0x5eed_0000_5ca1_0001);
+        let mut checked = 0;
+        for n in (2..=200).chain([255, 256, 257, 511]) {
+            for style in 0..4 {
+                let pts: Vec<Point3<f64>> = (0..n)
+                    .map(|i| match style {
+                        // A coarse grid: many exact ties, duplicates.
+                        0 => Point3::new(
+                            (rng.next() * 3.0).round(),
+                            (rng.next() * 3.0).round(),
+                            (rng.next() * 2.0).round(),
+                        ),
+                        // The same point again and again but for a few.
+                        1 if i % 7 != 3 => Point3::new(1.0, 2.0, 3.0),
+                        // Near-ties: a sphere of radius 1 + a few ulps.
+                        2 => {
+                            let v = Vector3::new(rng.next(), rng.next(), rng.next());
+                            Point3::from(v.normalize() * (1.0 + rng.next() * 1e-15))
+                        }
+                        _ => Point3::new(rng.next(), rng.next(), rng.next()),
+                    })
+                    .collect();
+                let c = Convex::new(pts, 0.0).unwrap();
+                if matches!(c.kind, Kind::Box | Kind::Point) {
+                    continue;
+                }
+                for k in 0..40 {
+                    let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
+                    match k % 10 {
+                        0 => d = d.map(|x| (x * 2.0).round()),
+                        1 => d = Vector3::new(0.0, -0.0, 0.0),
+                        2 => d = Vector3::new(-0.0, d.y, 0.0),
+                        3 => d *= 1e-310,
+                        4 => d *= 1e308,
+                        5 => d = Vector3::new(f64::INFINITY, d.y, d.z),
+                        6 => d = Vector3::new(f64::NAN, d.y, d.z),
+                        _ => {}
+                    }
+                    assert_eq!(
+                        c.support_index(&d),
+                        reference(&c, &d),
+                        "n {n} style {style} d {d:?}"
+                    );
+                    // The portable path, whatever this CPU has.
+                    assert_eq!(
+                        scan_top(&c.xs, &c.ys, &c.zs, &d).1,
+                        reference_with(&c, &d, false),
+                        "portable: n {n} style {style} d {d:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 30_000, "{checked}");
     }
 }

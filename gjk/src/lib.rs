@@ -30,6 +30,7 @@
 #![warn(missing_docs)]
 
 mod blocks;
+mod cones;
 mod dd;
 mod johnson;
 pub mod paper;

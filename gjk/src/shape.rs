@@ -9,6 +9,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::Error;
 use crate::blocks::Blocks;
+use crate::cones::{self, Cones};
 
 /// A convex object: the convex hull of a vertex set, grown by a radius `r >= 0`
 /// (the paper's r-spherical extension, Section 2).
@@ -57,6 +58,8 @@ pub struct Convex {
     single: Option<Box<Single>>,
     /// The block search's reordered copy, for [`Kind::Blocks`].
     blocks: Option<Box<Blocks>>,
+    /// The cube map of candidate lists, for [`Kind::Cones`].
+    cones: Option<Box<Cones>>,
 }
 
 /// How far a shape's vertices (or a compound's pieces) may reach from its
@@ -117,6 +120,12 @@ enum Kind {
     Avx2,
     /// As [`Kind::Avx2`] on a CPU without them: the portable scan.
     Scan,
+    /// [`CONES_MIN_VERTICES`] to 511 vertices: the cube map's few candidates
+    /// for the direction (see [`crate::cones`]), scanned with the arithmetic
+    /// of the scan the shape would otherwise use (fused when `fused`, the
+    /// [`Kind::Avx2`] scan's), so the same vertex; that scan for the
+    /// directions the map declines.
+    Cones { fused: bool },
     /// Larger sets: the block search, exact and the scan's own choice, which
     /// skips blocks of vertices that cannot hold the support point.
     Blocks,
@@ -216,6 +225,18 @@ impl Convex {
             scan_kind()
         };
         let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
+        // The scanned mid-sized sets get the cube map, unless their size is
+        // outside the range its margins are proved for.
+        let cones = if len >= CONES_MIN_VERTICES && (kind == Kind::Scan || is_avx2(kind)) {
+            Cones::new(&xs, &ys, &zs, len, size).map(Box::new)
+        } else {
+            None
+        };
+        let kind = match (&cones, kind) {
+            (Some(_), Kind::Scan) => Kind::Cones { fused: false },
+            (Some(_), _) => Kind::Cones { fused: true },
+            (None, k) => k,
+        };
         // Indices ride in i32 lanes in the f32 scan.
         let single = if !matches!(kind, Kind::Point | Kind::Box)
             && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
@@ -245,6 +266,7 @@ impl Convex {
             kind,
             single,
             blocks,
+            cones,
         })
     }
 
@@ -355,7 +377,29 @@ impl Convex {
             // SAFETY: Kind::Avx2 is only chosen on a CPU with AVX2 and FMA.
             Kind::Avx2 => unsafe { scan_avx2(self, d) },
             Kind::Scan => self.scan_portable(d),
+            Kind::Cones { fused } => self.cones_index(d, fused),
             Kind::Blocks => self.search_index(d),
+        }
+    }
+
+    /// [`support_index`](Self::support_index) for [`Kind::Cones`]: the
+    /// direction's candidates with the scan's arithmetic, or for a direction
+    /// the map declines, the scan itself.
+    #[inline(always)]
+    fn cones_index(&self, d: &Vector3<f64>, fused: bool) -> usize {
+        let Some(cones) = self.cones.as_deref() else {
+            return self.scan_portable(d);
+        };
+        #[cfg(target_arch = "x86_64")]
+        if fused {
+            // SAFETY: `fused` is only set on a CPU with AVX2 and FMA (it
+            // replaces Kind::Avx2).
+            return unsafe { cones_fused(self, cones, d) };
+        }
+        let _ = fused;
+        match cones.candidates(d) {
+            Some(c) => cones::first_max_plain(&self.xs, &self.ys, &self.zs, c, d),
+            None => self.scan_portable(d),
         }
     }
 
@@ -712,6 +756,36 @@ fn scan_few(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize
         }
     }
     (top, idx)
+}
+
+/// Sets with fewer vertices keep the scan. Measured on the paper's family
+/// (`paper_compare`, one run each way): with the map from 32 vertices, pairs
+/// with its 40- to 60-vertex polytopes took up to 10 % longer (a query's
+/// directions cluster at face normals, where a cell lists a whole face) and
+/// the 100-vertex pairs 12 % less; from 64, only the latter.
+pub(crate) const CONES_MIN_VERTICES: usize = 64;
+
+/// Whether `kind` is the AVX2 scan.
+fn is_avx2(kind: Kind) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if kind == Kind::Avx2 {
+        return true;
+    }
+    let _ = kind;
+    false
+}
+
+/// [`Convex::cones_index`] with fused multiply-adds, as [`scan_avx2`]
+/// computes its dot products, so the same vertex; the AVX2 scan for the
+/// directions the map declines.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn cones_fused(c: &Convex, cones: &Cones, d: &Vector3<f64>) -> usize {
+    match cones.candidates(d) {
+        Some(list) => cones::first_max_fused(&c.xs, &c.ys, &c.zs, list, d),
+        // SAFETY: this function's own target features are the callee's.
+        None => unsafe { scan_avx2(c, d) },
+    }
 }
 
 /// The kind of a set of 8 vertices or more that the block search leaves to

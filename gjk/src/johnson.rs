@@ -305,16 +305,36 @@ impl Simplex {
         }
     }
 
+    /// `Y = {p}`: the single-point start of Section 6, the common case,
+    /// inlined where it is asked for.
+    #[inline(always)]
+    pub fn start(&mut self, p: Vertex) {
+        self.vertices[0] = p;
+        self.dot[0][0] = p.y.norm_squared();
+        self.delta[1][0] = 1.0;
+        self.all = 1;
+        self.newest = Some(0);
+    }
+
     /// `Y = V0`, one to four points, all cofactors computed from scratch.
     pub fn reset(&mut self, points: &[Vertex]) {
+        self.reset_inline(points);
+    }
+
+    /// [`reset`](Self::reset) compiled for AVX2 and FMA: the same cofactors
+    /// bit for bit (see `query::distance_avx2`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    pub fn reset_avx2(&mut self, points: &[Vertex]) {
+        self.reset_inline(points);
+    }
+
+    /// The body of [`reset`](Self::reset), inlined into each compiled form.
+    #[inline(always)]
+    fn reset_inline(&mut self, points: &[Vertex]) {
         debug_assert!(!points.is_empty() && points.len() <= 4);
         if let [p] = points {
-            // The single-point start of Section 6, the common case.
-            self.vertices[0] = *p;
-            self.dot[0][0] = p.y.norm_squared();
-            self.delta[1][0] = 1.0;
-            self.all = 1;
-            self.newest = Some(0);
+            self.start(*p);
             return;
         }
         if (2..=4).contains(&points.len()) {
@@ -644,6 +664,7 @@ impl Simplex {
     /// Gram determinant of the edges from the first point (proof of Theorem
     /// 5.1), so its ratio to the product of the squared edge lengths is a
     /// product of squared sines, 1 for orthogonal edges and 0 for flat sets.
+    #[inline(always)]
     fn independent(&self) -> bool {
         by_mask!(self.all as usize, ALL => self.independent_in(ALL))
     }

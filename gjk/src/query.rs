@@ -495,6 +495,18 @@ fn subalgorithm<const AVX2: bool>(simplex: &Simplex) -> Option<Solution> {
     simplex.solve()
 }
 
+/// [`Simplex::reset`] in the query's compiled form (see [`distance_avx2`]).
+#[inline(always)]
+fn reset<const AVX2: bool>(simplex: &mut Simplex, points: &[Vertex]) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: as in `subalgorithm`.
+        unsafe { simplex.reset_avx2(points) };
+        return;
+    }
+    simplex.reset(points);
+}
+
 /// [`Simplex::push`] in the query's compiled form (see [`distance_avx2`]).
 #[inline(always)]
 fn push<const AVX2: bool>(simplex: &mut Simplex, keep: u8, p: Vertex) {
@@ -708,9 +720,9 @@ impl<'s> Pair<'s> {
                 for (p, &[i, j]) in pts.iter_mut().zip(pairs) {
                     *p = self.vertex(i as usize, j as usize);
                 }
-                simplex.reset(&pts[..pairs.len()]);
+                reset::<AVX2>(simplex, &pts[..pairs.len()]);
             }
-            None => simplex.reset(&[self.support(&self.t)]),
+            None => simplex.start(self.support(&self.t)),
         }
         let eps_d = options.tolerance * self.d;
         // What the support search may miss is added to every test of g, so

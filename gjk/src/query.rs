@@ -324,10 +324,49 @@ pub fn distance_in(
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if has_avx2_fma() {
         // SAFETY: the CPU supports AVX2 and FMA, checked just above.
         return unsafe { distance_avx2(workspace, a, pose_a, b, pose_b, options, warm) };
     }
+    distance_base(workspace, a, pose_a, b, pose_b, options, warm)
+}
+
+/// Whether this CPU has AVX2 and FMA: detected once, then one load. The
+/// standard macro's own cache costs two checks and a frame around its
+/// first-call path in every query.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn has_avx2_fma() -> bool {
+    use std::sync::atomic::{AtomicU8, Ordering};
+    /// 0: not yet known, 1: no, 2: yes.
+    static KNOWN: AtomicU8 = AtomicU8::new(0);
+    #[cold]
+    #[inline(never)]
+    fn detect() -> bool {
+        let yes = std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        KNOWN.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
+        yes
+    }
+    match KNOWN.load(Ordering::Relaxed) {
+        2 => true,
+        1 => false,
+        _ => detect(),
+    }
+}
+
+/// [`distance_of`] for any CPU, out of line, so that [`distance_in`] stays
+/// a few instructions of dispatch with no frame of its own.
+#[inline(never)]
+fn distance_base(
+    workspace: &mut Workspace,
+    a: &Shape,
+    pose_a: &Isometry3<f64>,
+    b: &Shape,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
     distance_of::<false>(workspace, a, pose_a, b, pose_b, options, warm)
 }
 
@@ -384,7 +423,7 @@ fn distance_of<const AVX2: bool>(
         // of 0, before shapes were held to MAX_REACH).
         return Err(Error::NonFinitePose);
     }
-    let mut answer = match (a, b) {
+    let answer = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)), options.precision);
             let simplex = &mut workspace.simplex;
@@ -398,6 +437,43 @@ fn distance_of<const AVX2: bool>(
         }
         _ => compound::<AVX2>(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
     };
+    // The answer goes out as it was built unless one of the two rare checks
+    // below needs to change it (kept out of line, so that the common path
+    // neither copies nor rewrites it).
+    if answer.lower > answer.upper || !is_finite(&answer) {
+        return repair(answer, workspace, a, pose_a, b, pose_b, options, warm);
+    }
+    Ok(answer)
+}
+
+/// Whether every number of `answer` is finite. x·0 is NaN exactly when x is
+/// infinite or NaN, and NaN survives the sums, whatever their order: a
+/// balanced tree of sums, whose four-wide halves the compiler can vectorise.
+#[inline(always)]
+fn is_finite(answer: &Answer) -> bool {
+    let z = |x: f64| x * 0.0;
+    let (pa, pb, n) = (&answer.point_a, &answer.point_b, &answer.normal);
+    let s1 = (z(answer.distance) + z(answer.lower)) + (z(answer.upper) + z(answer.penetration));
+    let s2 = (z(pa.x) + z(pa.y)) + (z(pa.z) + z(pb.x));
+    let s3 = (z(pb.y) + z(pb.z)) + (z(n.x) + z(n.y));
+    ((s1 + s2) + (s3 + z(n.z))) == 0.0
+}
+
+/// The rare ends of [`distance_of`]: bounds that contradict each other, or
+/// a number that overflowed.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn repair(
+    mut answer: Answer,
+    workspace: &mut Workspace,
+    a: &Shape,
+    pose_a: &Isometry3<f64>,
+    b: &Shape,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
     if answer.lower > answer.upper {
         // The bounds contradict each other: round-off beyond the slack. The
         // one case fuzzing found (NaN weights from overflowing cofactors)
@@ -412,27 +488,7 @@ fn distance_of<const AVX2: bool>(
         answer.distance = answer.distance.min(answer.upper);
         answer.status = Status::ToleranceNotMet;
     }
-    // x·0 is NaN exactly when x is infinite or NaN, and NaN survives the sum:
-    // one branch-free pass instead of a test per coordinate.
-    let poison = [
-        answer.distance,
-        answer.lower,
-        answer.upper,
-        answer.penetration,
-        answer.point_a.x,
-        answer.point_a.y,
-        answer.point_a.z,
-        answer.point_b.x,
-        answer.point_b.y,
-        answer.point_b.z,
-        answer.normal.x,
-        answer.normal.y,
-        answer.normal.z,
-    ]
-    .iter()
-    .fold(0.0, |acc, &x| acc + x * 0.0);
-    let finite = poison == 0.0;
-    if !finite {
+    if !is_finite(&answer) {
         // Finite inputs whose combination overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }

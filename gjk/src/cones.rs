@@ -270,7 +270,7 @@ mod tests {
     /// collinear sets, duplicates, a point far off a tiny cluster.
     fn sets(rng: &mut Rng) -> Vec<Vec<Vector3<f64>>> {
         let mut out = Vec::new();
-        for n in [16, 20, 40, 100, 300, 511] {
+        for n in [16, 20, 40, 100, 300, 511, 1500, 4000] {
             out.push(
                 (0..n)
                     .map(|_| Vector3::new(rng.next(), rng.next(), rng.next()))

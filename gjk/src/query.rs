@@ -40,18 +40,18 @@ pub enum Precision {
     /// f64: the exact support point; the distance is exact to the tolerance.
     #[default]
     Double,
-    /// f32 for shapes of 16 to 1 023 vertices (twice the vector lanes;
-    /// smaller and closed-form shapes keep the exact support, and larger
-    /// ones the exact block search, which from there on keeps up with the
-    /// f32 scan of every vertex and soon beats it). The support point may then fall short of the true one by
-    /// 2⁻²⁰ of the shape's size, so the distance is exact to the tolerance
-    /// plus about `1e-6 × (size of A + size of B)`, and the lower bound is
-    /// lowered by that much.
-    ///
-    /// It pays on a few hundred vertices only: about 1.17× at 256 vertices
-    /// and 1.1× to 1.26× at 512 per shape, nothing measurable below 100 (see
-    /// `docs/speed-accuracy.md`). The f32 copy it scans is made when the
-    /// shape is built (12 bytes a vertex), whatever the queries ask for.
+    /// An f32 scan (twice the vector lanes) for shapes of 16 to 63
+    /// vertices, and of 64 to 1 023 whose size keeps them from the cube
+    /// map, on CPUs without AVX2 and FMA, where the exact search is the
+    /// portable scan of every vertex. Everywhere else the exact search is
+    /// used, since it is the faster: the AVX2 scan, the cube map of 64 to
+    /// 4 095 vertices and the block search all beat the f32 scan of every
+    /// vertex (measured: 0.86× at 16 vertices, 0.58× at 256, 0.4× at 512;
+    /// `docs/speed-accuracy.md`). Where the f32 scan is used, the support
+    /// point may fall short of the true one by 2⁻²⁰ of the shape's size, so
+    /// the distance is exact to the tolerance plus about 1e-6 times the two
+    /// sizes' sum, and the lower bound is lowered by that much. The f32 copy
+    /// it scans is made when the shape is built (12 bytes a vertex).
     Single,
 }
 

@@ -94,6 +94,28 @@ struct Single {
     zs: Vec<f32>,
 }
 
+impl Single {
+    /// The copy of centroid-relative arrays of a set of size `size`, each
+    /// coordinate divided by it; `None` where that cannot be done exactly
+    /// enough or the indices would not fit the scan's i32 lanes.
+    fn of(xs: &[f64], ys: &[f64], zs: &[f64], size: f64) -> Option<Box<Self>> {
+        if i32::try_from(xs.len()).is_err()
+            || size.is_nan()
+            || size <= 0.0
+            || !(1.0 / size).is_finite()
+        {
+            return None;
+        }
+        let inv = 1.0 / size;
+        let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
+        Some(Box::new(Single {
+            xs: to32(xs),
+            ys: to32(ys),
+            zs: to32(zs),
+        }))
+    }
+}
+
 /// How far the f32 scan's choice can fall short of the true support value,
 /// in units of `size · |d|`: each dot product is off by at most 5 units of
 /// f32 round-off (coordinates, direction, three fused terms), and the chosen
@@ -213,47 +235,43 @@ impl Convex {
                 coord.resize(padded, coord[0]);
             }
         }
-        let kind = if len == 1 {
+        let base = if len == 1 {
             Kind::Point
         } else if is_box(&xs, &ys, &zs) {
             Kind::Box
-        } else if len >= crate::blocks::MIN_VERTICES {
-            Kind::Blocks
         } else if len < 8 {
             Kind::Few
         } else {
             scan_kind()
         };
-        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
-        // The scanned mid-sized sets get the cube map, unless their size is
-        // outside the range its margins are proved for.
-        let cones = if len >= CONES_MIN_VERTICES && (kind == Kind::Scan || is_avx2(kind)) {
+        // Sets from CONES_MIN_VERTICES to below CONES_MAX_VERTICES get the
+        // cube map, unless their size is outside the range its margins are
+        // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
+        // the block search.
+        let scanned = base == Kind::Scan || is_avx2(base);
+        let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
             Cones::new(&xs, &ys, &zs, len, size).map(Box::new)
         } else {
             None
         };
-        let kind = match (&cones, kind) {
+        let kind = match (&cones, base) {
             (Some(_), Kind::Scan) => Kind::Cones { fused: false },
             (Some(_), _) => Kind::Cones { fused: true },
+            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => Kind::Blocks,
             (None, k) => k,
         };
-        // Indices ride in i32 lanes in the f32 scan.
-        let single = if !matches!(kind, Kind::Point | Kind::Box)
-            && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
-            && i32::try_from(xs.len()).is_ok()
-            && size > 0.0
-            && (1.0 / size).is_finite()
-        {
-            let inv = 1.0 / size;
-            let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
-            Some(Box::new(Single {
-                xs: to32(&xs),
-                ys: to32(&ys),
-                zs: to32(&zs),
-            }))
-        } else {
-            None
-        };
+        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
+        // The f32 scan only where the exact search is the portable scan of
+        // every vertex: against the AVX2 scan, the cube map and the block
+        // search it is slower at every size measured (0.86× at 16 vertices,
+        // 0.4× at 512, docs/speed-accuracy.md), and `Single` then takes the
+        // exact search. Indices ride in i32 lanes in the f32 scan.
+        let single =
+            if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
+                Single::of(&xs, &ys, &zs, size)
+            } else {
+                None
+            };
         Ok(Self {
             vertices,
             radius,
@@ -496,6 +514,13 @@ impl Convex {
     #[cfg(test)]
     pub(crate) fn blocks(&self) -> Option<&Blocks> {
         self.blocks.as_deref()
+    }
+
+    /// A block index of this shape whatever its kind, so that the block
+    /// search is tested on sets the cube map now takes.
+    #[cfg(test)]
+    pub(crate) fn block_index(&self) -> Blocks {
+        Blocks::new(&self.xs, &self.ys, &self.zs, self.len())
     }
 
     /// Vertex `i` relative to the centroid, as stored for the scan.
@@ -764,6 +789,10 @@ fn scan_few(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize
 /// directions cluster at face normals, where a cell lists a whole face) and
 /// the 100-vertex pairs 12 % less; from 64, only the latter.
 pub(crate) const CONES_MIN_VERTICES: usize = 64;
+
+/// Sets of this many vertices or more keep the block search: the map's
+/// construction grows with the vertices (about 17 ms at 4 096).
+pub(crate) const CONES_MAX_VERTICES: usize = 4096;
 
 /// Whether `kind` is the AVX2 scan.
 fn is_avx2(kind: Kind) -> bool {
@@ -1241,10 +1270,16 @@ pub(crate) mod tests {
                             )
                         })
                         .collect();
-                    let c = Convex::new(pts, 0.0).unwrap();
+                    let mut c = Convex::new(pts, 0.0).unwrap();
                     if offset * 1e-6 > scale {
                         // The vertices collapsed onto a few values.
                         continue;
+                    }
+                    // The f32 copy is only built where the exact search is
+                    // the portable scan; built here on any CPU, so that the
+                    // f32 path is tested everywhere.
+                    if c.single.is_none() {
+                        c.single = Single::of(&c.xs, &c.ys, &c.zs, c.size);
                     }
                     assert!(c.has_single(), "n {n} scale {scale:e}");
                     for k in 0..64 {
@@ -1302,7 +1337,7 @@ pub(crate) mod tests {
         assert!(worst > 0.0);
         // Directions whose largest component is near f64::MAX (1/m would be
         // subnormal) go to the exact scan.
-        let ring = Convex::new(
+        let mut ring = Convex::new(
             (0..40)
                 .map(|i| {
                     let a = f64::from(i) * 0.157;
@@ -1312,6 +1347,7 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
+        ring.single = Single::of(&ring.xs, &ring.ys, &ring.zs, ring.size);
         assert!(ring.has_single());
         for d in [
             Vector3::new(1.7e308, 3e307, -2e307),
@@ -1328,7 +1364,8 @@ pub(crate) mod tests {
         )
         .unwrap();
         let cube = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.0).unwrap();
-        // So do sets large enough for the block search, which is faster.
+        // So do sets large enough for the cube map or the block search,
+        // which are faster.
         let large = Convex::new(
             (0..SINGLE_MAX_VERTICES)
                 .map(|i| {
@@ -1339,7 +1376,7 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
-        assert_eq!(large.kind, Kind::Blocks);
+        assert!(matches!(large.kind, Kind::Blocks | Kind::Cones { .. }));
         for c in [small, cube, large] {
             assert!(!c.has_single());
             let d = Vector3::new(0.3, -0.8, 0.1);

@@ -176,9 +176,12 @@ impl Cones {
 }
 
 /// The first index of the largest `x·d` among `cands` (ascending), with the
-/// portable scan's arithmetic (`x·dx + y·dy + z·dz`, left to right).
+/// arithmetic of the scan it stands in for: with `FUSED` the AVX2 scan's,
+/// `fma(z, dz, fma(y, dy, x·dx))` each rounded once as `_mm256_fmadd_pd`
+/// does lane by lane; without, the portable scan's `x·dx + y·dy + z·dz`,
+/// left to right.
 #[inline(always)]
-pub(crate) fn first_max_plain(
+pub(crate) fn first_max<const FUSED: bool>(
     xs: &[f64],
     ys: &[f64],
     zs: &[f64],
@@ -199,40 +202,13 @@ pub(crate) fn first_max_plain(
                 *zs.get_unchecked(k),
             )
         };
-        let dot = x * d.x + y * d.y + z * d.z;
-        if dot > top {
-            (top, idx) = (dot, k);
-        }
-    }
-    idx
-}
-
-/// [`first_max_plain`] with the AVX2 scan's arithmetic: `fma(z, dz, fma(y,
-/// dy, x·dx))`, each rounded once, as `_mm256_fmadd_pd` does lane by lane.
-#[inline(always)]
-pub(crate) fn first_max_fused(
-    xs: &[f64],
-    ys: &[f64],
-    zs: &[f64],
-    cands: &[u32],
-    d: &Vector3<f64>,
-) -> usize {
-    let (mut top, mut idx) = (f64::NEG_INFINITY, 0);
-    debug_assert!(ys.len() == xs.len() && zs.len() == xs.len());
-    for &k in cands {
-        let k = k as usize;
-        debug_assert!(k < xs.len());
-        // SAFETY: as in `first_max_plain`.
-        let (x, y, z) = unsafe {
-            (
-                *xs.get_unchecked(k),
-                *ys.get_unchecked(k),
-                *zs.get_unchecked(k),
-            )
+        let value = if FUSED {
+            z.mul_add(d.z, y.mul_add(d.y, x * d.x))
+        } else {
+            x * d.x + y * d.y + z * d.z
         };
-        let dot = z.mul_add(d.z, y.mul_add(d.y, x * d.x));
-        if dot > top {
-            (top, idx) = (dot, k);
+        if value > top {
+            (top, idx) = (value, k);
         }
     }
     idx
@@ -247,9 +223,9 @@ mod tests {
     fn full(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>, fused: bool) -> usize {
         let all: Vec<u32> = (0..xs.len() as u32).collect();
         if fused {
-            first_max_fused(xs, ys, zs, &all, d)
+            first_max::<true>(xs, ys, zs, &all, d)
         } else {
-            first_max_plain(xs, ys, zs, &all, d)
+            first_max::<false>(xs, ys, zs, &all, d)
         }
     }
 
@@ -360,8 +336,8 @@ mod tests {
                         for fused in [false, true] {
                             let want = full(&xs, &ys, &zs, &d, fused);
                             let got = match cones.candidates(&d) {
-                                Some(c) if fused => first_max_fused(&xs, &ys, &zs, c, &d),
-                                Some(c) => first_max_plain(&xs, &ys, &zs, c, &d),
+                                Some(c) if fused => first_max::<true>(&xs, &ys, &zs, c, &d),
+                                Some(c) => first_max::<false>(&xs, &ys, &zs, c, &d),
                                 None => want,
                             };
                             assert_eq!(

@@ -398,11 +398,17 @@ impl Simplex {
     /// products and cofactors that involve it.
     #[inline(always)]
     pub fn push(&mut self, keep: u8, p: Vertex) {
-        debug_assert!(keep.count_ones() <= 3);
-        self.all = keep;
-        let slot = (!keep).trailing_zeros() as u8;
+        let slot = self.keep(keep);
         self.insert(slot, p);
         self.newest = Some(slot);
+    }
+
+    /// `Y = V̂` ahead of a push: the slot the new point goes to.
+    #[inline(always)]
+    fn keep(&mut self, keep: u8) -> u8 {
+        debug_assert!(keep.count_ones() <= 3);
+        self.all = keep;
+        (!keep).trailing_zeros() as u8
     }
 
     /// [`push`](Self::push) with the update compiled for AVX2 and FMA: the
@@ -410,9 +416,7 @@ impl Simplex {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     pub fn push_avx2(&mut self, keep: u8, p: Vertex) {
-        debug_assert!(keep.count_ones() <= 3);
-        self.all = keep;
-        let slot = (!keep).trailing_zeros() as u8;
+        let slot = self.keep(keep);
         self.insert_avx2(slot, p);
         self.newest = Some(slot);
     }

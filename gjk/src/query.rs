@@ -323,12 +323,32 @@ pub fn distance_in(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
+    let query = Query {
+        a,
+        pose_a,
+        b,
+        pose_b,
+        options,
+        warm,
+    };
     #[cfg(target_arch = "x86_64")]
     if has_avx2_fma() {
         // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-        return unsafe { distance_avx2(workspace, a, pose_a, b, pose_b, options, warm) };
+        return unsafe { distance_avx2(workspace, &query) };
     }
-    distance_base(workspace, a, pose_a, b, pose_b, options, warm)
+    distance_base(workspace, &query)
+}
+
+/// One query's inputs, handed whole between [`distance_in`]'s compiled
+/// forms.
+#[derive(Clone, Copy)]
+struct Query<'q> {
+    a: &'q Shape,
+    pose_a: &'q Isometry3<f64>,
+    b: &'q Shape,
+    pose_b: &'q Isometry3<f64>,
+    options: &'q Options,
+    warm: Option<&'q WarmStart>,
 }
 
 /// Whether this CPU has AVX2 and FMA: detected once, then one load. The
@@ -358,16 +378,8 @@ fn has_avx2_fma() -> bool {
 /// [`distance_of`] for any CPU, out of line, so that [`distance_in`] stays
 /// a few instructions of dispatch with no frame of its own.
 #[inline(never)]
-fn distance_base(
-    workspace: &mut Workspace,
-    a: &Shape,
-    pose_a: &Isometry3<f64>,
-    b: &Shape,
-    pose_b: &Isometry3<f64>,
-    options: &Options,
-    warm: Option<&WarmStart>,
-) -> Result<Answer, Error> {
-    distance_of::<false>(workspace, a, pose_a, b, pose_b, options, warm)
+fn distance_base(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
+    distance_of::<false>(workspace, query)
 }
 
 /// [`distance_of`] compiled for AVX2 and FMA: the same operations, each
@@ -377,16 +389,8 @@ fn distance_base(
 /// time on the paper's family, measured.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn distance_avx2(
-    workspace: &mut Workspace,
-    a: &Shape,
-    pose_a: &Isometry3<f64>,
-    b: &Shape,
-    pose_b: &Isometry3<f64>,
-    options: &Options,
-    warm: Option<&WarmStart>,
-) -> Result<Answer, Error> {
-    distance_of::<true>(workspace, a, pose_a, b, pose_b, options, warm)
+fn distance_avx2(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
+    distance_of::<true>(workspace, query)
 }
 
 /// The body of [`distance_in`], inlined into each of its compiled forms;
@@ -395,13 +399,16 @@ fn distance_avx2(
 #[inline(always)]
 fn distance_of<const AVX2: bool>(
     workspace: &mut Workspace,
-    a: &Shape,
-    pose_a: &Isometry3<f64>,
-    b: &Shape,
-    pose_b: &Isometry3<f64>,
-    options: &Options,
-    warm: Option<&WarmStart>,
+    query: &Query<'_>,
 ) -> Result<Answer, Error> {
+    let &Query {
+        a,
+        pose_a,
+        b,
+        pose_b,
+        options,
+        warm,
+    } = query;
     options.validate()?;
     if let Some(w) = warm
         && !(w.first.fits(a, b) && w.second.fits(a, b))
@@ -441,7 +448,7 @@ fn distance_of<const AVX2: bool>(
     // below needs to change it (kept out of line, so that the common path
     // neither copies nor rewrites it).
     if answer.lower > answer.upper || !is_finite(&answer) {
-        return repair(answer, workspace, a, pose_a, b, pose_b, options, warm);
+        return repair(answer, workspace, query);
     }
     Ok(answer)
 }
@@ -463,16 +470,10 @@ fn is_finite(answer: &Answer) -> bool {
 /// a number that overflowed.
 #[cold]
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 fn repair(
     mut answer: Answer,
     workspace: &mut Workspace,
-    a: &Shape,
-    pose_a: &Isometry3<f64>,
-    b: &Shape,
-    pose_b: &Isometry3<f64>,
-    options: &Options,
-    warm: Option<&WarmStart>,
+    query: &Query<'_>,
 ) -> Result<Answer, Error> {
     if answer.lower > answer.upper {
         // The bounds contradict each other: round-off beyond the slack. The
@@ -481,8 +482,9 @@ fn repair(
         // start is tried first; if that too is inconsistent, the lower
         // bound is given up (0) rather than returning an interval that
         // cannot hold.
-        if warm.is_some() {
-            return distance_in(workspace, a, pose_a, b, pose_b, options, None);
+        if query.warm.is_some() {
+            let q = query;
+            return distance_in(workspace, q.a, q.pose_a, q.b, q.pose_b, q.options, None);
         }
         answer.lower = 0.0;
         answer.distance = answer.distance.min(answer.upper);
@@ -608,6 +610,18 @@ struct RunState {
     backup_used: bool,
     /// Steps taken without a measurable descent (see step 4).
     flat_steps: u32,
+}
+
+impl RunState {
+    /// The nearer of `sol` (with `|v|² = v2`) and the last iterate that led
+    /// to a step, whose vertices the step kept in their slots.
+    #[inline(always)]
+    fn nearer(&self, sol: Solution, v2: f64) -> Solution {
+        match self.prev {
+            Some((p, p2)) if p2 < v2 => p,
+            _ => sol,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -989,10 +1003,7 @@ impl<'s> Pair<'s> {
                     Status::IterationCap
                 };
                 // The nearer of the last two iterates (see step 5).
-                let best = match st.prev {
-                    Some((p, p2)) if p2 < v2 => p,
-                    _ => sol,
-                };
+                let best = st.nearer(sol, v2);
                 return Some(self.finish(simplex, st, status, best, lower));
             }
             // Step (4): descend while |v| decreases and V̂ is not full. A
@@ -1051,10 +1062,7 @@ impl<'s> Pair<'s> {
                 // A step that failed to descend (round-off in a
                 // degenerate simplex) leaves the previous iterate, whose
                 // slots the push kept, as the better upper bound.
-                let best = match st.prev {
-                    Some((p, p2)) if p2 < v2 => p,
-                    _ => sol,
-                };
+                let best = st.nearer(sol, v2);
                 return Some(self.finish(simplex, st, status, best, lower));
             }
             match refined_sol {

@@ -416,7 +416,7 @@ impl Convex {
         }
         let _ = fused;
         match cones.candidates(d) {
-            Some(c) => cones::first_max_plain(&self.xs, &self.ys, &self.zs, c, d),
+            Some(c) => cones::first_max::<false>(&self.xs, &self.ys, &self.zs, c, d),
             None => self.scan_portable(d),
         }
     }
@@ -811,7 +811,7 @@ fn is_avx2(kind: Kind) -> bool {
 #[target_feature(enable = "avx2,fma")]
 fn cones_fused(c: &Convex, cones: &Cones, d: &Vector3<f64>) -> usize {
     match cones.candidates(d) {
-        Some(list) => cones::first_max_fused(&c.xs, &c.ys, &c.zs, list, d),
+        Some(list) => cones::first_max::<true>(&c.xs, &c.ys, &c.zs, list, d),
         // SAFETY: this function's own target features are the callee's.
         None => unsafe { scan_avx2(c, d) },
     }

@@ -760,8 +760,51 @@ impl Simplex {
             (ba.dot(&ca.cross(&(-a))), nba * nca * na),
         ];
         let total = ba.dot(&ca.cross(&da));
-        vols.iter()
-            .all(|&(v, n3)| v * v > e2 * n3 && (v > 0.0) == (total > 0.0))
+        let certain = vols.iter().all(|&(v, n3)| v * v > e2 * n3);
+        if certain {
+            return vols.iter().all(|&(v, _)| (v > 0.0) == (total > 0.0));
+        }
+        self.holds_origin_exactly()
+    }
+
+    /// [`holds_origin`](Self::holds_origin) when round-off leaves a volume's
+    /// sign in doubt: the four signs computed exactly (Shewchuk's adaptive
+    /// orientation predicate), the origin strictly inside when all four
+    /// agree. This is what a tetrahedron needs whose points lie within 1e-8
+    /// of a plane through the origin (a flat shape touching a needle-thin
+    /// one): the weights of two of its vertices are then below the error
+    /// bound of the floating-point volumes, and the run would otherwise end
+    /// on a face 1e-9 of the size from the origin while the origin is inside
+    /// (found by a hunt over sets of 64 to 511 vertices; the case is
+    /// `needle_touching_a_flat_polygon`). Coordinates outside 2^±300 leave
+    /// the predicate's products in danger of underflow or overflow: `false`
+    /// then, as before, and the faces decide. Out of line: it is rare.
+    #[cold]
+    #[inline(never)]
+    fn holds_origin_exactly(&self) -> bool {
+        let y = self.vertices.map(|v| v.y);
+        let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
+        if !y.iter().all(|p| p.iter().all(|&x| safe(x))) {
+            return false;
+        }
+        let point = |p: Vector3<f64>| robust::Coord3D {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        };
+        // The sign of det(q1 - q0, q2 - q0, q3 - q0), exactly: orient3d(pa,
+        // pb, pc, pd) is det(pa - pd, pb - pd, pc - pd).
+        let volume = |q: [Vector3<f64>; 4]| {
+            robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
+        };
+        let o = Vector3::zeros();
+        let signs = [
+            volume([o, y[1], y[2], y[3]]),
+            volume([y[0], o, y[2], y[3]]),
+            volume([y[0], y[1], o, y[3]]),
+            volume([y[0], y[1], y[2], o]),
+        ];
+        signs.iter().all(|&s| s > 0.0) || signs.iter().all(|&s| s < 0.0)
     }
 
     #[inline(always)]

@@ -141,9 +141,7 @@ impl Blocks {
         }
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
+            if crate::has_avx2_fma() {
                 // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                 return Some(unsafe { self.search_avx2(d, len) }.0);
             }

@@ -332,7 +332,7 @@ pub fn distance_in(
         warm,
     };
     #[cfg(target_arch = "x86_64")]
-    if has_avx2_fma() {
+    if crate::has_avx2_fma() {
         // SAFETY: the CPU supports AVX2 and FMA, checked just above.
         return unsafe { distance_avx2(workspace, &query) };
     }
@@ -349,30 +349,6 @@ struct Query<'q> {
     pose_b: &'q Isometry3<f64>,
     options: &'q Options,
     warm: Option<&'q WarmStart>,
-}
-
-/// Whether this CPU has AVX2 and FMA: detected once, then one load. The
-/// standard macro's own cache costs two checks and a frame around its
-/// first-call path in every query.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn has_avx2_fma() -> bool {
-    use std::sync::atomic::{AtomicU8, Ordering};
-    /// 0: not yet known, 1: no, 2: yes.
-    static KNOWN: AtomicU8 = AtomicU8::new(0);
-    #[cold]
-    #[inline(never)]
-    fn detect() -> bool {
-        let yes = std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma");
-        KNOWN.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
-        yes
-    }
-    match KNOWN.load(Ordering::Relaxed) {
-        2 => true,
-        1 => false,
-        _ => detect(),
-    }
 }
 
 /// [`distance_of`] for any CPU, out of line, so that [`distance_in`] stays
@@ -840,16 +816,10 @@ impl<'s> Pair<'s> {
                 None => true,
                 Some((_, p2)) => v2 < p2,
             };
-            let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
-            let margin_ends = options.margin.is_some_and(|m| {
-                lower_cert.max(0.0) > m
-                    || ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m
-            });
             if repeat
                 || !descends
                 || sol.mask == 0b1111
-                || lower_cert > cutoff
-                || margin_ends
+                || self.cut(lower, norm, cutoff, options.margin).is_some()
                 || st.iterations >= options.max_iterations
             {
                 match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, Some(s)) {
@@ -862,6 +832,28 @@ impl<'s> Pair<'s> {
             st.prev = Some((sol, v2));
             push::<AVX2>(simplex, sol.mask, s);
         }
+    }
+
+    /// The early ends decided on the bounds alone, compared in the world's
+    /// units: [`Exit::Pruned`] once the certified lower bound passes the
+    /// caller's `cutoff` (this pair cannot be a compound's nearest), then,
+    /// with a margin, [`Status::Farther`] or [`Status::Closer`] once the
+    /// bounds decide it. `lower` is the run's lower bound, `norm` its `|v|`,
+    /// both before slack and in the scaled frame.
+    #[inline(always)]
+    fn cut(&self, lower: f64, norm: f64, cutoff: f64, margin: Option<f64>) -> Option<Exit> {
+        let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
+        if lower_cert > cutoff {
+            return Some(Exit::Pruned);
+        }
+        let m = margin?;
+        if lower_cert.max(0.0) > m {
+            return Some(Exit::Status(Status::Farther));
+        }
+        if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
+            return Some(Exit::Status(Status::Closer));
+        }
+        None
     }
 
     /// A run's end: its bounds and, when the cores touch or intersect, the
@@ -982,19 +974,16 @@ impl<'s> Pair<'s> {
                 return Some(self.finish(simplex, st, Status::Converged, sol, lower));
             }
             // Cutoff and margin are the world's: compared there.
-            let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
-            if lower_cert > cutoff {
-                let mut run = self.finish(simplex, st, Status::Converged, sol, lower);
-                run.exit = Exit::Pruned;
-                return Some(run);
-            }
-            if let Some(m) = options.margin {
-                if lower_cert.max(0.0) > m {
-                    return Some(self.finish(simplex, st, Status::Farther, sol, lower));
+            match self.cut(lower, norm, cutoff, options.margin) {
+                Some(Exit::Pruned) => {
+                    let mut run = self.finish(simplex, st, Status::Converged, sol, lower);
+                    run.exit = Exit::Pruned;
+                    return Some(run);
                 }
-                if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
-                    return Some(self.finish(simplex, st, Status::Closer, sol, lower));
+                Some(Exit::Status(status)) => {
+                    return Some(self.finish(simplex, st, status, sol, lower));
                 }
+                None => {}
             }
             if st.iterations >= options.max_iterations {
                 let status = if paper_met {

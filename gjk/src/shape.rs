@@ -142,7 +142,7 @@ enum Kind {
     Avx2,
     /// As [`Kind::Avx2`] on a CPU without them: the portable scan.
     Scan,
-    /// [`CONES_MIN_VERTICES`] to 511 vertices: the cube map's few candidates
+    /// [`CONES_MIN_VERTICES`] to [`CONES_MAX_VERTICES`] (less one): the cube map's few candidates
     /// for the direction (see [`crate::cones`]), scanned with the arithmetic
     /// of the scan the shape would otherwise use (fused when `fused`, the
     /// [`Kind::Avx2`] scan's), so the same vertex; that scan for the
@@ -482,9 +482,7 @@ impl Convex {
         };
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
+            if crate::has_avx2_fma() {
                 // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                 return unsafe { scan_single_avx2(&s.xs, &s.ys, &s.zs, d32) };
             }
@@ -499,10 +497,7 @@ impl Convex {
     fn scan_index(&self, d: &Vector3<f64>) -> usize {
         #[cfg(target_arch = "x86_64")]
         {
-            if self.xs.len() >= 8
-                && std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
+            if self.xs.len() >= 8 && crate::has_avx2_fma() {
                 // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                 return unsafe { scan_avx2_any(&self.xs, &self.ys, &self.zs, d) };
             }
@@ -822,7 +817,7 @@ fn cones_fused(c: &Convex, cones: &Cones, d: &Vector3<f64>) -> usize {
 /// requirements, else [`Kind::Scan`].
 fn scan_kind() -> Kind {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if crate::has_avx2_fma() {
         return Kind::Avx2;
     }
     Kind::Scan

@@ -20,8 +20,13 @@
 //! the needle-on-a-polygon misses of `degenerate_contacts.rs` (about 30 in
 //! 200 000 placements before the exact orientation test, none after).
 
+mod common;
+mod sweep;
+
+use common::gap_along as gap;
 use gjk::{Convex, Options, Shape, Status, distance};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use sweep::Rng;
 
 type P = Point3<f64>;
 type V = Vector3<f64>;
@@ -33,37 +38,26 @@ fn env(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-struct Rng(u64);
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        // splitmix64
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-    fn pick<T: Copy>(&mut self, x: &[T]) -> T {
-        x[self.below(x.len())]
-    }
+/// The draws this hunt adds to the sweep's generator (`sweep::Rng`, the same
+/// SplitMix64 stream): its directions and rotations come from Gaussians, so
+/// a seed keeps the cases it found.
+trait Draws {
+    fn chance(&mut self, p: f64) -> bool;
+    fn normal(&mut self) -> f64;
+    fn gaussian_direction(&mut self) -> V;
+    fn gaussian_rotation(&mut self) -> UnitQuaternion<f64>;
+}
+
+impl Draws for Rng {
     fn chance(&mut self, p: f64) -> bool {
-        self.unit() < p
+        self.unit_interval() < p
     }
     fn normal(&mut self) -> f64 {
-        let u = self.unit().max(1e-300);
-        let v = self.unit();
+        let u = self.unit_interval().max(1e-300);
+        let v = self.unit_interval();
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
     }
-    fn direction(&mut self) -> V {
+    fn gaussian_direction(&mut self) -> V {
         loop {
             let v = V::new(self.normal(), self.normal(), self.normal());
             let n = v.norm();
@@ -72,16 +66,10 @@ impl Rng {
             }
         }
     }
-    fn rotation(&mut self) -> UnitQuaternion<f64> {
+    fn gaussian_rotation(&mut self) -> UnitQuaternion<f64> {
         let q =
             nalgebra::Quaternion::new(self.normal(), self.normal(), self.normal(), self.normal());
         UnitQuaternion::from_quaternion(q)
-    }
-    fn shuffle<T>(&mut self, x: &mut [T]) {
-        for i in (1..x.len()).rev() {
-            let j = self.below(i + 1);
-            x.swap(i, j);
-        }
     }
 }
 
@@ -125,7 +113,7 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
     match fam {
         0 => {
             for _ in 0..n {
-                out.push(P::from(rng.direction()));
+                out.push(P::from(rng.gaussian_direction()));
             }
         }
         1 => {
@@ -144,13 +132,13 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
                 rng.pick(&[1.0, 0.1, 1e-6, 0.0]),
             ];
             for _ in 0..n {
-                let d = rng.direction();
+                let d = rng.gaussian_direction();
                 out.push(P::new(d.x * ax[0], d.y * ax[1], d.z * ax[2]));
             }
         }
         3 => {
             for _ in 0..n {
-                let r = rng.unit().sqrt();
+                let r = rng.unit_interval().sqrt();
                 let t = rng.uniform(0.0, std::f64::consts::TAU);
                 out.push(P::new(r * t.cos(), r * t.sin(), 0.0));
             }
@@ -247,7 +235,7 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
             // 20..n distinct round points, the rest repeats.
             let distinct = 4 + rng.below(n / 2);
             for _ in 0..distinct {
-                out.push(P::from(rng.direction()));
+                out.push(P::from(rng.gaussian_direction()));
             }
             while out.len() < n {
                 let p = out[rng.below(distinct)];
@@ -255,7 +243,7 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
             }
         }
         11 => {
-            let d = rng.direction();
+            let d = rng.gaussian_direction();
             for _ in 0..n {
                 let t = if rng.chance(0.3) {
                     rng.pick(&[-1.0, 1.0, 0.0])
@@ -266,13 +254,13 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
             }
         }
         12 => {
-            let c = rng.direction() * 1e-9;
+            let c = rng.gaussian_direction() * 1e-9;
             for _ in 0..n - 1 {
                 out.push(P::from(
-                    c + rng.direction() * rng.pick(&[1e-9, 1e-12, 1e-7]),
+                    c + rng.gaussian_direction() * rng.pick(&[1e-9, 1e-12, 1e-7]),
                 ));
             }
-            out.push(P::from(rng.direction()));
+            out.push(P::from(rng.gaussian_direction()));
         }
         13 => {
             let e = V::new(1.0, rng.pick(&[1.0, 0.5, 1e-3]), rng.pick(&[1.0, 0.25]));
@@ -305,14 +293,16 @@ fn family_points(rng: &mut Rng, fam: usize, n: usize) -> Vec<P> {
             }
         }
         15 => {
-            let d = rng.direction();
+            let d = rng.gaussian_direction();
             for i in 0..n {
                 let c = if i % 2 == 0 { d } else { -d };
-                out.push(P::from(c + rng.direction() * rng.pick(&[0.1, 1e-3, 1e-9])));
+                out.push(P::from(
+                    c + rng.gaussian_direction() * rng.pick(&[0.1, 1e-3, 1e-9]),
+                ));
             }
         }
         16 => {
-            let p = P::from(rng.direction());
+            let p = P::from(rng.gaussian_direction());
             for _ in 0..n {
                 out.push(p);
             }
@@ -346,7 +336,7 @@ fn body(rng: &mut Rng, scale: f64, mid: bool) -> Body {
         (rng.pick(&[0, 1, 4, 7, 13, 17]), 1 + rng.below(63))
     };
     let mut verts = if !mid && n < 4 {
-        (0..n).map(|_| P::from(rng.direction())).collect()
+        (0..n).map(|_| P::from(rng.gaussian_direction())).collect()
     } else if !mid && (fam == 4 || fam == 5) {
         // lattices need room: fall back to a cloud
         family_points(rng, 1, n)
@@ -363,18 +353,18 @@ fn body(rng: &mut Rng, scale: f64, mid: bool) -> Body {
     let rot = match rng.below(3) {
         0 => UnitQuaternion::identity(),
         1 => axis_rotation(rng),
-        _ => rng.rotation(),
+        _ => rng.gaussian_rotation(),
     };
     let off = match rng.below(4) {
         0 | 1 => V::zeros(),
-        2 => rng.direction() * s * rng.pick(&[1.0, 10.0, 1e3]),
+        2 => rng.gaussian_direction() * s * rng.pick(&[1.0, 10.0, 1e3]),
         _ => {
             // an offset in the vertex coordinates, up to 1e6 (absolute)
             let m = rng.pick(&[1.0f64, 1e3, 1e6]).max(s);
             if rng.chance(0.5) {
                 V::new(m, 0.0, 0.0)
             } else {
-                rng.direction() * m
+                rng.gaussian_direction() * m
             }
         }
     };
@@ -430,80 +420,13 @@ fn argmax(ps: &[P], n: &V, o: &P) -> usize {
     best.1
 }
 
-/// `min_q n·(q-o) - max_p n·(p-o)` by scanning every vertex.
-fn gap(ps: &[P], qs: &[P], n: &V, o: &P) -> f64 {
-    let mp = ps
-        .iter()
-        .map(|p| n.dot(&(p - o)))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let mq = qs
-        .iter()
-        .map(|q| n.dot(&(q - o)))
-        .fold(f64::INFINITY, f64::min);
-    mq - mp
-}
-
+/// The test crate's nearest point of a segment or triangle, to the origin.
 fn closest_on_segment(a: &V, b: &V) -> V {
-    let e = b - a;
-    let ee = e.norm_squared();
-    if ee == 0.0 {
-        return *a;
-    }
-    let t = (-a.dot(&e) / ee).clamp(0.0, 1.0);
-    a + e * t
+    common::closest_on_segment(&P::origin(), &P::from(*a), &P::from(*b)).coords
 }
 
-/// Point of triangle abc nearest the origin (Ericson's region tests).
 fn closest_on_triangle(a: &V, b: &V, c: &V) -> V {
-    let p = V::zeros();
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = ab.dot(&ap);
-    let d2 = ac.dot(&ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return *a;
-    }
-    let bp = p - b;
-    let d3 = ab.dot(&bp);
-    let d4 = ac.dot(&bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return *b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let d5 = ab.dot(&cp);
-    let d6 = ac.dot(&cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return *c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    if !denom.is_finite() {
-        // degenerate: the best of the edges
-        let cands = [
-            closest_on_segment(a, b),
-            closest_on_segment(b, c),
-            closest_on_segment(a, c),
-        ];
-        return *cands
-            .iter()
-            .min_by(|x, y| x.norm().total_cmp(&y.norm()))
-            .unwrap();
-    }
-    let v = vb * denom;
-    let w = vc * denom;
-    a + ab * v + ac * w
+    common::closest_on_triangle(&P::origin(), &P::from(*a), &P::from(*b), &P::from(*c)).coords
 }
 
 /// Distance from the origin to conv(ws), |ws| <= 4, by every sub-simplex.
@@ -569,7 +492,7 @@ fn cones_hunt() {
     let pairs = env("CONES_PAIRS", 40) as usize;
     let poses = env("CONES_POSES", 4) as usize;
     let seed = env("CONES_SEED", 1);
-    let mut rng = Rng(seed.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ 0x000c_04e5);
+    let mut rng = Rng::new(seed.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ 0x000c_04e5);
     let mut st = Stats::default();
     let eps = f64::EPSILON;
     let t0 = std::time::Instant::now();
@@ -592,7 +515,7 @@ fn cones_hunt() {
             let rel_rot = match rng.below(4) {
                 0 => UnitQuaternion::identity(),
                 1 => axis_rotation(&mut rng),
-                _ => rng.rotation(),
+                _ => rng.gaussian_rotation(),
             };
             let n = match rng.below(4) {
                 0 => {
@@ -600,7 +523,7 @@ fn cones_hunt() {
                     e[rng.below(3)] = if rng.chance(0.5) { 1.0 } else { -1.0 };
                     e
                 }
-                _ => rng.direction(),
+                _ => rng.gaussian_direction(),
             };
             let ca = P::from(
                 a.verts.iter().fold(V::zeros(), |s, p| s + p.coords) / a.verts.len() as f64,
@@ -631,9 +554,9 @@ fn cones_hunt() {
             let ra = match rng.below(3) {
                 0 => UnitQuaternion::identity(),
                 1 => axis_rotation(&mut rng),
-                _ => rng.rotation(),
+                _ => rng.gaussian_rotation(),
             };
-            let pa = Isometry3::from_parts(Translation3::from(rng.direction() * off), ra);
+            let pa = Isometry3::from_parts(Translation3::from(rng.gaussian_direction() * off), ra);
             let pb = pa * rel;
             let o = Options::default();
             if std::env::var("CONES_DUMP").ok().as_deref() == Some(&format!("{pair}:{k}")) {
@@ -674,7 +597,7 @@ fn cones_hunt() {
                  w: Option<&gjk::WarmStart>| distance(sa, &pa, sb, pb, o, w);
             let cold = ask(&a.shape, &b.shape, &pb, &o, None);
             let dupc = ask(&a.dup, &b.dup, &pb, &o, None);
-            let nudge = Translation3::from(rng.direction() * (0.01 * size));
+            let nudge = Translation3::from(rng.gaussian_direction() * (0.01 * size));
             let near = nudge * pb;
             let warm = ask(&a.shape, &b.shape, &near, &o, None)
                 .and_then(|prev| ask(&a.shape, &b.shape, &pb, &o, Some(&prev.warm_start)));

@@ -764,13 +764,20 @@ impl Simplex {
         if certain {
             return vols.iter().all(|&(v, _)| (v > 0.0) == (total > 0.0));
         }
-        self.holds_origin_exactly()
+        self.holds_origin_exactly(&vols.map(|(v, n3)| (v, v * v > e2 * n3)))
     }
 
-    /// [`holds_origin`](Self::holds_origin) when round-off leaves a volume's
-    /// sign in doubt: the four signs computed exactly (Shewchuk's adaptive
-    /// orientation predicate), the origin strictly inside when all four
-    /// agree. This is what a tetrahedron needs whose points lie within 1e-8
+    /// [`holds_origin`](Self::holds_origin) when round-off leaves the sign
+    /// of some of the volumes in doubt (`vols` holds each volume and whether
+    /// its sign is certain): those signs
+    /// computed exactly (Shewchuk's adaptive orientation predicate), the
+    /// origin strictly inside when all four agree. A certain volume's sign
+    /// is already its exact sign, so two certain volumes of opposite signs
+    /// settle it without exact arithmetic; near a touching contact this is
+    /// the usual case (the origin near one face, the other three volumes
+    /// clear), and only the volumes in doubt are recomputed.
+    ///
+    /// This is what a tetrahedron needs whose points lie within 1e-8
     /// of a plane through the origin (a flat shape touching a needle-thin
     /// one): the weights of two of its vertices are then below the error
     /// bound of the floating-point volumes, and the run would otherwise end
@@ -781,7 +788,17 @@ impl Simplex {
     /// then, as before, and the faces decide. Out of line: it is rare.
     #[cold]
     #[inline(never)]
-    fn holds_origin_exactly(&self) -> bool {
+    fn holds_origin_exactly(&self, vols: &[(f64, bool); 4]) -> bool {
+        let (mut pos, mut neg) = (false, false);
+        for &(v, c) in vols {
+            if c {
+                pos |= v > 0.0;
+                neg |= v < 0.0;
+            }
+        }
+        if pos && neg {
+            return false;
+        }
         let y = self.vertices.map(|v| v.y);
         let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
         if !y.iter().all(|p| p.iter().all(|&x| safe(x))) {
@@ -792,19 +809,24 @@ impl Simplex {
             y: p.y,
             z: p.z,
         };
-        // The sign of det(q1 - q0, q2 - q0, q3 - q0), exactly: orient3d(pa,
-        // pb, pc, pd) is det(pa - pd, pb - pd, pc - pd).
+        // The sign of det(q1 - q0, q2 - q0, q3 - q0), exactly, the float
+        // volumes' own orientation: orient3d(pa, pb, pc, pd) is det(pa - pd,
+        // pb - pd, pc - pd).
         let volume = |q: [Vector3<f64>; 4]| {
             robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
         };
         let o = Vector3::zeros();
-        let signs = [
-            volume([o, y[1], y[2], y[3]]),
-            volume([y[0], o, y[2], y[3]]),
-            volume([y[0], y[1], o, y[3]]),
-            volume([y[0], y[1], y[2], o]),
-        ];
-        signs.iter().all(|&s| s > 0.0) || signs.iter().all(|&s| s < 0.0)
+        for (l, _) in vols.iter().enumerate().filter(|(_, (_, c))| !*c) {
+            let mut q = y;
+            q[l] = o;
+            let s = volume(q);
+            pos |= s > 0.0;
+            neg |= s < 0.0;
+            if s == 0.0 || (pos && neg) {
+                return false;
+            }
+        }
+        true
     }
 
     #[inline(always)]
@@ -1172,6 +1194,42 @@ mod tests {
         assert!(sol.v.norm() < 1e-15);
         // Regular tetrahedron with circumradius √3: inradius √3/3.
         assert!((s.inner_radius() - 3f64.sqrt() / 3.0).abs() < 1e-14);
+    }
+
+    /// The origin a hair from one face (far below the float volumes' error
+    /// bound): that face's sign is in doubt and decided exactly, the other
+    /// three are clear. Inside, on and outside the face must all come out
+    /// as the exact geometry says; so must a tetrahedron whose clear
+    /// volumes already disagree.
+    #[test]
+    fn origin_next_to_a_face_is_decided_exactly() {
+        let at = |h: f64| {
+            let mut s = Simplex::empty();
+            s.reset(&[
+                vtx(0.3, 0.2, 1.0),
+                vtx(-1.0, -1.0, -h),
+                vtx(2.0, -1.0, -h),
+                vtx(-1.0, 2.0, -h),
+            ]);
+            s
+        };
+        for (h, inside) in [(1e-60, true), (1e-17, true), (0.0, false), (-1e-60, false)] {
+            let s = at(h);
+            // The face b, c, d: its volume is in doubt, the rest are not.
+            let b = s.vertices[1].y;
+            let vol = b.dot(&s.vertices[2].y.cross(&s.vertices[3].y));
+            assert!(vol.abs() < 1e-12, "h = {h}: the face is not in doubt");
+            assert_eq!(s.holds_origin(), inside, "h = {h}");
+        }
+        // Clear volumes of both signs: the origin beyond an edge, far out.
+        let mut s = Simplex::empty();
+        s.reset(&[
+            vtx(5.0, 5.0, 1.0),
+            vtx(4.0, 4.0, 0.0),
+            vtx(7.0, 4.0, 0.0),
+            vtx(4.0, 7.0, 0.0),
+        ]);
+        assert!(!s.holds_origin());
     }
 
     #[test]

@@ -1068,8 +1068,13 @@ impl<'s> Pair<'s> {
 
     /// [`solve`](Self::solve), then, when a warm start ended with a loose
     /// interval, once more cold ([`cold_again`](Self::cold_again)): single
-    /// pairs and a compound's piece pairs alike. A pruned run is left
-    /// alone: it only had to prove that its pair cannot win.
+    /// pairs and a compound's piece pairs alike. Only a run that meant to
+    /// converge is asked again. A pruned run only had to prove that its pair
+    /// cannot win; an early exit on the margin and the iteration cap end
+    /// with a wide interval by the caller's own choice, and a cold run would
+    /// spend a second budget to end as loose (warm queries with a margin took
+    /// longer than without one, and came back with the cold run's coarser
+    /// distance).
     #[inline(always)]
     fn solve_retrying<const AVX2: bool>(
         &self,
@@ -1079,7 +1084,11 @@ impl<'s> Pair<'s> {
         cutoff: f64,
     ) -> Run {
         let run = self.solve::<AVX2>(simplex, options, warm, cutoff);
-        if warm.is_some() && run.exit != Exit::Pruned && self.loose(&run, options.tolerance) {
+        let meant_to_converge = matches!(
+            run.exit,
+            Exit::Status(Status::Converged | Status::ToleranceNotMet)
+        );
+        if warm.is_some() && meant_to_converge && self.loose(&run, options.tolerance) {
             return self.cold_again::<AVX2>(run, simplex, options, cutoff);
         }
         run

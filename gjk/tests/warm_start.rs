@@ -268,3 +268,36 @@ fn warm_start_at_the_same_pose_is_idempotent() {
         assert_eq!(ignored, first, "step {k}");
     }
 }
+
+/// A warm query that ends early on its margin keeps that early end: its
+/// interval is wide by the caller's choice, and running it again cold (as a
+/// warm run that meant to converge and ended loose is) would only spend the
+/// time twice. After a jump the stale simplex decides the margin in one
+/// iteration; the decision, the bounds and the iteration count are checked.
+#[test]
+fn warm_start_with_a_margin_ends_at_the_margin() {
+    let a: Shape = mover(0.0).into();
+    let b: Shape = truncated_cone().into();
+    let pose_b = Isometry3::identity();
+    let s = sweep(&a, &b, &pose_b, |k| motion(k, 1.9, 0.0), 100);
+    let jump = Isometry3::from_parts(
+        Translation3::new(100.0, -50.0, 20.0),
+        UnitQuaternion::from_euler_angles(3.0, 0.1, -1.0),
+    );
+    let truth = shape_distance(&a, &jump, &b, &pose_b).distance;
+    assert!(truth > 100.0, "{truth}");
+    for (margin, want) in [(1.0, Status::Farther), (1e3, Status::Closer)] {
+        let options = Options {
+            margin: Some(margin),
+            ..Options::default()
+        };
+        let ans = distance(&a, &jump, &b, &pose_b, &options, Some(&s.last_warm)).unwrap();
+        assert_eq!(ans.status, want, "margin {margin}: {ans:?}");
+        assert!(ans.lower <= truth && truth <= ans.upper, "{ans:?}");
+        assert!(
+            ans.upper - ans.lower > 1e-6,
+            "decided without a wide interval: {ans:?}"
+        );
+        assert_eq!(ans.iterations, 1, "margin {margin}: {ans:?}");
+    }
+}

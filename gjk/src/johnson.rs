@@ -1007,11 +1007,29 @@ impl Simplex {
     /// Computed from each face's normal rather than through (5.10): that
     /// formula gives the squared distance, whose square root carries an error
     /// of `√ε` relative, too much for a bound that must stay below the truth.
-    pub fn inner_radius(&self) -> f64 {
+    pub fn inner_radius(&self, delta: f64) -> f64 {
         debug_assert_eq!(self.all, 0b1111);
-        // The smallest squared distance (n·p)²/|n|² over the faces, then one
-        // square root: the four quotients are independent, and the one root
-        // rounds as the four would have (the caller's slack covers both).
+        // The distance to a face's plane is |V|/|n|, V = det(p, q, r) = n·p
+        // and n = (q - p) × (r - p). Each point may be off the true geometry
+        // by up to `delta` (the pair's slack: rotation and centroid shift),
+        // which moves V by up to δ(3M² + 3δM + δ²) (det is trilinear, M the
+        // largest |y|) and |n| by up to 8δM. On a face of normal shape that
+        // is about δ of distance; on a sliver face (nearly parallel edges of
+        // A and B, |n| far below M²) it is far more. So
+        // each face counts only what survives its own error:
+        // (|V| - δ(3M² + …))⁺ / (|n| + 8δM), squared, with |n| ≤ 4M² putting the
+        // denominator under len2 + 64δM³ + 64δ²M². The exact orientation
+        // test can certify the origin inside such a tetrahedron by a hair;
+        // without this, a hunt found a bound of 1.8e-18 on objects of size
+        // 1.7e-9 touching (depth 0) edge to nearly parallel edge.
+        // |y|², kept since each point came in.
+        let m2 = (self.dot[0][0].max(self.dot[1][1])).max(self.dot[2][2].max(self.dot[3][3]));
+        let m = m2.sqrt();
+        let shrink = delta * (3.0 * m2 + delta * (3.0 * m + delta));
+        let widen = 64.0 * delta * m2 * (m + delta);
+        // The smallest squared distance over the faces, then one square
+        // root: the four quotients are independent, and the one root rounds
+        // as the four would have (the caller's slack covers both).
         let mut best = f64::INFINITY;
         for face in [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]] {
             let [p, q, r] = face.map(|i| self.vertices[i].y);
@@ -1021,8 +1039,8 @@ impl Simplex {
                 // A flat face: the tetrahedron is degenerate and proves nothing.
                 return 0.0;
             }
-            let h = n.dot(&p);
-            best = best.min(h * h / len2);
+            let h = (n.dot(&p).abs() - shrink).max(0.0);
+            best = best.min(h * h / (len2 + widen));
         }
         if best.is_finite() { best.sqrt() } else { 0.0 }
     }
@@ -1193,7 +1211,7 @@ mod tests {
         assert_eq!(sol.mask, 0b1111);
         assert!(sol.v.norm() < 1e-15);
         // Regular tetrahedron with circumradius √3: inradius √3/3.
-        assert!((s.inner_radius() - 3f64.sqrt() / 3.0).abs() < 1e-14);
+        assert!((s.inner_radius(0.0) - 3f64.sqrt() / 3.0).abs() < 1e-14);
     }
 
     /// The origin a hair from one face (far below the float volumes' error

@@ -1135,7 +1135,7 @@ impl<'s> Pair<'s> {
     #[cold]
     fn penetration(&self, simplex: &Simplex, sol: &Solution) -> f64 {
         let inner = if sol.mask == 0b1111 {
-            simplex.inner_radius()
+            simplex.inner_radius(self.slack)
         } else if sol.v != Vector3::zeros() {
             0.0
         } else {
@@ -1154,7 +1154,7 @@ impl<'s> Pair<'s> {
                 if let Some(s) = tetra.solve()
                     && s.mask == 0b1111
                 {
-                    best = best.max(tetra.inner_radius());
+                    best = best.max(tetra.inner_radius(self.slack));
                 }
             }
             best

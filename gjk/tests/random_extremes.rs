@@ -559,6 +559,89 @@ fn boxes_with_nearly_parallel_edges_far_out() {
     found(&a, &pa, &b, &pb, 0.004372421954476569, 4.372421806096142e6);
 }
 
+/// A triangle touching a segment edge to nearly parallel edge (depth 0),
+/// objects of size 1.7e-9 placed 1e3 from the origin, found by
+/// `unions_of_many_pieces_keep_the_truth` (seed 8101) as the near pieces of
+/// two unions. The run ended on a tetrahedron that the exact orientation
+/// test certified around the origin by a hair; one face is a sliver (the
+/// nearly parallel edges), whose plane the points' own round-off tilts by
+/// far more than their error, and (5.9) gave 1.8e-18, 1.04e-9 of the size,
+/// as a lower bound on a depth of 0. Now each face's distance counts only
+/// what survives its points' error.
+#[test]
+fn sliver_face_claims_no_depth() {
+    let triangle = [
+        [
+            -5.000440516057298e-10,
+            -4.1321515385692906e-10,
+            -1.084766494823939e-9,
+        ],
+        [
+            -1.2441848034083318e-9,
+            2.209712532305841e-10,
+            -2.6173372525718884e-11,
+        ],
+        [
+            -3.634613851341574e-10,
+            6.924985894558014e-10,
+            -9.929001411692818e-10,
+        ],
+    ];
+    let segment = [
+        [
+            -3.6755799187316664e-10,
+            3.6311515262365487e-10,
+            3.3540536485799435e-10,
+        ],
+        [
+            3.676029813670469e-10,
+            -3.630815126113073e-10,
+            -3.3539855802777885e-10,
+        ],
+    ];
+    let pa = pose(
+        [
+            0.22028724266176294,
+            0.24343508388802526,
+            0.8702829791438178,
+            0.3671790120165759,
+        ],
+        [-756.0389583475436, 508.1304920379476, 412.56332425705796],
+    );
+    let pb = pose(
+        [
+            0.09769593597531984,
+            -0.20643675778803128,
+            0.892806996281733,
+            -0.3882461030303608,
+        ],
+        [-756.038958347714, 508.1304920369476, 412.56332425672764],
+    );
+    let size = 1.7344307045736313e-9;
+    let (a, b) = (points(&triangle), points(&segment));
+    let union = |p: &[[f64; 3]]| -> gjk::Shape {
+        let piece = gjk::Convex::new(
+            p.iter()
+                .map(|&c| nalgebra::Point3::from(c))
+                .collect::<Vec<_>>(),
+            0.0,
+        )
+        .unwrap();
+        gjk::Compound::new(vec![(nalgebra::Isometry3::identity(), piece)])
+            .unwrap()
+            .into()
+    };
+    for (how, a, b) in [
+        ("convex", a.clone(), b.clone()),
+        ("union", union(&triangle), union(&segment)),
+    ] {
+        let ans = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
+        assert!(ans.distance <= 1e-9 * size, "{how}: {ans:?}");
+        assert_eq!(ans.lower, 0.0, "{how}: {ans:?}");
+        assert!(ans.penetration <= 1e-9 * size, "{how}: {ans:?}");
+    }
+}
+
 /// Two copies of a coplanar set (a rectangle's corners, each twice, and six
 /// points inside), the copy turned 1e-8 rad about the normal of an edge and
 /// touching the original along it (truth 0). Warm from the answer at a pose

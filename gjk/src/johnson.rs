@@ -1015,14 +1015,13 @@ impl Simplex {
         // which moves V by up to δ(3M² + 3δM + δ²) (det is trilinear, M the
         // largest |y|) and |n| by up to 8δM. On a face of normal shape that
         // is about δ of distance; on a sliver face (nearly parallel edges of
-        // A and B, |n| far below M²) it is far more. So
-        // each face counts only what survives its own error:
-        // (|V| - δ(3M² + …))⁺ / (|n| + 8δM), squared, with |n| ≤ 4M² putting the
-        // denominator under len2 + 64δM³ + 64δ²M². The exact orientation
-        // test can certify the origin inside such a tetrahedron by a hair;
-        // without this, a hunt found a bound of 1.8e-18 on objects of size
-        // 1.7e-9 touching (depth 0) edge to nearly parallel edge.
-        // |y|², kept since each point came in.
+        // A and B, |n| far below M²) it is far more. So each face counts only
+        // what survives its own error, (|V| - δ(3M² + …))⁺ / (|n| + 8δM),
+        // squared, with |n| ≤ 4M² putting the denominator under
+        // len2 + 64δM³ + 64δ²M². The exact orientation test can certify the
+        // origin inside such a tetrahedron by a hair; without this, a hunt
+        // found a bound of 1.8e-18 on objects of size 1.7e-9 touching (depth
+        // 0) edge to nearly parallel edge. M² from the kept |y|² products.
         let m2 = (self.dot[0][0].max(self.dot[1][1])).max(self.dot[2][2].max(self.dot[3][3]));
         let m = m2.sqrt();
         let shrink = delta * (3.0 * m2 + delta * (3.0 * m + delta));

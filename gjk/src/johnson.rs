@@ -1002,6 +1002,55 @@ impl Simplex {
         v.norm_squared()
     }
 
+    /// The origin as a point of the tetrahedron `Y`, decided and weighed by
+    /// exact orientation tests alone, for when round-off in the cofactors
+    /// has sent the subalgorithm to a face. A nearly flat tetrahedron (a
+    /// collinear set touching a face) can have cofactors of the wrong sign
+    /// while the origin is inside it: the run then stops on a face 1e-10 of
+    /// the size from the origin, the support point repeating the vertex the
+    /// subalgorithm dropped. The weights are the four signed volumes with
+    /// the origin in place of each vertex, over their sum; their signs are
+    /// exact and, being of one sign, the weights are in `[0, 1]`. Closed:
+    /// the origin on a face counts, since the distance is then 0 as well.
+    /// `None` when the origin is outside, when the tetrahedron is flat
+    /// through it (all four volumes 0), or when a coordinate is outside the
+    /// predicate's safe range.
+    #[cold]
+    #[inline(never)]
+    pub fn origin_weights(&self) -> Option<[f64; 4]> {
+        if self.all != 0b1111 {
+            return None;
+        }
+        let y = self.vertices.map(|v| v.y);
+        let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
+        if !y.iter().all(|p| p.iter().all(|&x| safe(x))) {
+            return None;
+        }
+        let point = |p: Vector3<f64>| robust::Coord3D {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        };
+        // det(q1 - q0, q2 - q0, q3 - q0) with the origin as q_l: as in
+        // `holds_origin_exactly`, orient3d(pa, pb, pc, pd) = det(pa - pd,
+        // pb - pd, pc - pd).
+        let vols = [0, 1, 2, 3].map(|l| {
+            let mut q = y;
+            q[l] = Vector3::zeros();
+            robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
+        });
+        let pos = vols.iter().any(|&v| v > 0.0);
+        let neg = vols.iter().any(|&v| v < 0.0);
+        if pos == neg {
+            return None;
+        }
+        let sum: f64 = vols.iter().map(|v| v.abs()).sum();
+        if !(sum > 0.0 && sum.is_finite()) {
+            return None;
+        }
+        Some(vols.map(|v| v.abs() / sum))
+    }
+
     /// (5.9): for a tetrahedron holding the origin, the distance from the
     /// origin to the nearest face plane, a lower bound on penetration depth.
     /// Computed from each face's normal rather than through (5.10): that
@@ -1247,6 +1296,57 @@ mod tests {
             vtx(4.0, 7.0, 0.0),
         ]);
         assert!(!s.holds_origin());
+    }
+
+    #[test]
+    fn origin_weights_come_from_exact_volumes() {
+        // A tetrahedron 1e-12 thick around the origin, whose weights are
+        // known: the origin is 0.1, 0.2, 0.3 and 0.4 of its vertices.
+        let h = 1e-12;
+        let corners = [
+            Vector3::new(4.0, -1.0, 3.0 * h),
+            Vector3::new(-2.0, 3.0, -h),
+            Vector3::new(-1.0, -2.0, -h),
+            Vector3::zeros(),
+        ];
+        let want = [0.1, 0.2, 0.3, 0.4];
+        // The last corner is placed so that Σ w_i y_i = 0.
+        let rest = corners[..3]
+            .iter()
+            .zip(want)
+            .fold(Vector3::zeros(), |s, (c, w)| s + c * w);
+        let last = -rest / want[3];
+        let pts = [corners[0], corners[1], corners[2], last].map(|c| vtx(c.x, c.y, c.z));
+        // As a run builds it, by a push: `new` would keep a flat set to
+        // its independent points.
+        let four = |p: &[Vertex; 4]| {
+            let mut s = Simplex::new(&p[..3]);
+            s.push(0b111, p[3]);
+            s
+        };
+        let s = four(&pts);
+        let got = s.origin_weights().expect("the origin is inside");
+        let sum: f64 = got.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-15, "{got:?}");
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12, "{got:?}");
+        }
+        let v = (0..4).fold(Vector3::zeros(), |a, i| a + s.vertices[i].y * got[i]);
+        // Round-off of the points' size (about 4), not of a flat cofactor.
+        assert!(v.amax() < 32.0 * f64::EPSILON, "{v:?}");
+        // Lifted by ten times its thickness: the origin is just below it.
+        let off = pts.map(|p| vtx(p.y.x, p.y.y, p.y.z + 10.0 * h));
+        assert_eq!(four(&off).origin_weights(), None);
+        // Flat through the origin (all four volumes exactly 0): undecided.
+        let flat = [
+            vtx(1.0, 0.0, 0.0),
+            vtx(0.0, 1.0, 0.0),
+            vtx(-1.0, -1.0, 0.0),
+            vtx(2.0, 2.0, 0.0),
+        ];
+        assert_eq!(four(&flat).origin_weights(), None);
+        // Fewer than four points: not asked.
+        assert_eq!(Simplex::new(&pts[..3]).origin_weights(), None);
     }
 
     #[test]

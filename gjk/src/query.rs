@@ -904,6 +904,7 @@ impl<'s> Pair<'s> {
         let eps_d = options.tolerance * self.d;
         let stop_d = eps_d + self.single_slack;
         let mut refined = false;
+        let mut inside_asked = false;
         loop {
             let v2 = sol.v.norm_squared();
             let norm = v2.sqrt();
@@ -1024,6 +1025,23 @@ impl<'s> Pair<'s> {
                 st.prev = Some((sol, v2));
                 push::<AVX2>(simplex, sol.mask, s);
                 return None;
+            }
+            // Stuck with four points and a face chosen: a nearly flat
+            // tetrahedron's cofactors can reject it while it holds the
+            // origin (a collinear set touching a face ended at 3.5e-10 on
+            // objects of size 2, the support point repeating the dropped
+            // vertex). Refinement and the Backup Procedure work from the same
+            // cofactors; the exact orientation tests do not. Asked once.
+            if simplex.all == 0b1111 && sol.mask != 0b1111 && !inside_asked {
+                inside_asked = true;
+                if let Some(lambda) = simplex.origin_weights() {
+                    let origin = Solution {
+                        mask: 0b1111,
+                        v: Vector3::zeros(),
+                        lambda,
+                    };
+                    return Some(self.finish(simplex, st, Status::Converged, origin, lower));
+                }
             }
             // A repeat with g above round-off: v carries the error of a
             // thin simplex's cofactors, or of the Backup Procedure's

@@ -19,7 +19,16 @@
 use gjk::{Convex, Options, distance};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-include!("data/needle_on_polygon.rs");
+mod needle {
+    include!("data/needle_on_polygon.rs");
+}
+mod collinear {
+    include!("data/collinear_on_cluster.rs");
+}
+
+fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
+    v.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect()
+}
 
 fn pose(p: ([f64; 4], [f64; 3])) -> Isometry3<f64> {
     let q = UnitQuaternion::new_unchecked(Quaternion::new(p.0[0], p.0[1], p.0[2], p.0[3]));
@@ -52,10 +61,8 @@ fn vertex_to_segments(a: &[Point3<f64>], b: &[Point3<f64>], rel: &Isometry3<f64>
 
 #[test]
 fn needle_touching_a_flat_polygon() {
-    let pts = |v: &[[f64; 3]]| -> Vec<Point3<f64>> {
-        v.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect()
-    };
-    let (a, b) = (pts(A), pts(B));
+    use needle::{A, B, PA, PB, RA, RB};
+    let (a, b) = (points(A), points(B));
     let (pa, pb) = (pose(PA), pose(PB));
     let (ca, cb) = (
         Convex::new(a.clone(), RA).unwrap(),
@@ -77,4 +84,40 @@ fn needle_touching_a_flat_polygon() {
         ans.upper,
         ans.status
     );
+}
+
+/// The same weakness from the other side: a collinear set touching a cluster
+/// (seed 8204). The run's last tetrahedron held the origin, but it was so
+/// flat that its cofactors had the wrong signs, so the subalgorithm kept a
+/// face 3.5e-10 from the origin and the support point repeated the vertex it
+/// had dropped. Refinement and the Backup Procedure work from the same
+/// cofactors and ended there too: `Converged` (the paper's rule held) at
+/// 3.5e-10 in [0, 3.5e-10], 60 times the truth's upper bound. The exact
+/// orientation tests now settle a stuck tetrahedron before they run.
+#[test]
+fn collinear_set_touching_a_cluster() {
+    use collinear::{A, B, PA, PB, RA, RB};
+    let (a, b) = (points(A), points(B));
+    let (pa, pb) = (pose(PA), pose(PB));
+    let (ca, cb) = (
+        Convex::new(a.clone(), RA).unwrap(),
+        Convex::new(b.clone(), RB).unwrap(),
+    );
+    let size = ca.size().max(cb.size());
+    let ans = distance(&ca.into(), &pa, &cb.into(), &pb, &Options::default(), None).unwrap();
+    let truth_at_most = (vertex_to_segments(&b, &a, &pb.inv_mul(&pa)) - RA - RB).max(0.0);
+    assert!(truth_at_most < 1e-11, "{truth_at_most:e}");
+    assert!(ans.lower <= truth_at_most, "bounds: {ans:?}");
+    assert!(
+        ans.distance <= truth_at_most + 1e-12 * size,
+        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of at most {truth_at_most:e}",
+        ans.distance,
+        ans.lower,
+        ans.upper,
+        ans.status
+    );
+    assert!(ans.upper - ans.lower <= 1e-12 * size, "{ans:?}");
+    assert_eq!(ans.status, gjk::Status::Converged);
+    // Both nearest points are the one point of contact.
+    assert!((ans.point_a - ans.point_b).norm() <= ans.upper + 1e-12 * size);
 }

@@ -767,6 +767,15 @@ impl Simplex {
         self.holds_origin_exactly(&vols.map(|(v, n3)| (v, v * v > e2 * n3)))
     }
 
+    /// The four points for the exact orientation predicate, or `None` when a
+    /// coordinate is outside 2^±300, where its products could underflow or
+    /// overflow.
+    fn predicate_points(&self) -> Option<[Vector3<f64>; 4]> {
+        let y = self.vertices.map(|v| v.y);
+        let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
+        y.iter().all(|p| p.iter().all(|&x| safe(x))).then_some(y)
+    }
+
     /// [`holds_origin`](Self::holds_origin) when round-off leaves the sign
     /// of some of the volumes in doubt (`vols` holds each volume and whether
     /// its sign is certain): those signs
@@ -799,27 +808,11 @@ impl Simplex {
         if pos && neg {
             return false;
         }
-        let y = self.vertices.map(|v| v.y);
-        let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
-        if !y.iter().all(|p| p.iter().all(|&x| safe(x))) {
+        let Some(y) = self.predicate_points() else {
             return false;
-        }
-        let point = |p: Vector3<f64>| robust::Coord3D {
-            x: p.x,
-            y: p.y,
-            z: p.z,
         };
-        // The sign of det(q1 - q0, q2 - q0, q3 - q0), exactly, the float
-        // volumes' own orientation: orient3d(pa, pb, pc, pd) is det(pa - pd,
-        // pb - pd, pc - pd).
-        let volume = |q: [Vector3<f64>; 4]| {
-            robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
-        };
-        let o = Vector3::zeros();
         for (l, _) in vols.iter().enumerate().filter(|(_, (_, c))| !*c) {
-            let mut q = y;
-            q[l] = o;
-            let s = volume(q);
+            let s = exact_volume_without(&y, l);
             pos |= s > 0.0;
             neg |= s < 0.0;
             if s == 0.0 || (pos && neg) {
@@ -1021,24 +1014,8 @@ impl Simplex {
         if self.all != 0b1111 {
             return None;
         }
-        let y = self.vertices.map(|v| v.y);
-        let safe = |x: f64| x == 0.0 || (x.abs() >= 4.9e-91 && x.abs() <= 2.0e90);
-        if !y.iter().all(|p| p.iter().all(|&x| safe(x))) {
-            return None;
-        }
-        let point = |p: Vector3<f64>| robust::Coord3D {
-            x: p.x,
-            y: p.y,
-            z: p.z,
-        };
-        // det(q1 - q0, q2 - q0, q3 - q0) with the origin as q_l: as in
-        // `holds_origin_exactly`, orient3d(pa, pb, pc, pd) = det(pa - pd,
-        // pb - pd, pc - pd).
-        let vols = [0, 1, 2, 3].map(|l| {
-            let mut q = y;
-            q[l] = Vector3::zeros();
-            robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
-        });
+        let y = self.predicate_points()?;
+        let vols = [0, 1, 2, 3].map(|l| exact_volume_without(&y, l));
         let pos = vols.iter().any(|&v| v > 0.0);
         let neg = vols.iter().any(|&v| v < 0.0);
         if pos == neg {
@@ -1204,6 +1181,21 @@ impl Simplex {
         }
         hit & mask != 0
     }
+}
+
+/// The signed volume of the tetrahedron `y` with the origin in place of
+/// vertex `l`, det(q1 - q0, q2 - q0, q3 - q0), with its sign exact (Shewchuk's
+/// adaptive predicate): the float volumes' own orientation, since
+/// orient3d(pa, pb, pc, pd) is det(pa - pd, pb - pd, pc - pd).
+fn exact_volume_without(y: &[Vector3<f64>; 4], l: usize) -> f64 {
+    let point = |p: Vector3<f64>| robust::Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    };
+    let mut q = *y;
+    q[l] = Vector3::zeros();
+    robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
 }
 
 #[cfg(test)]

@@ -59,18 +59,32 @@ fn vertex_to_segments(a: &[Point3<f64>], b: &[Point3<f64>], rel: &Isometry3<f64>
     best
 }
 
-#[test]
-fn needle_touching_a_flat_polygon() {
-    use needle::{A, B, PA, PB, RA, RB};
-    let (a, b) = (points(A), points(B));
-    let (pa, pb) = (pose(PA), pose(PB));
+/// A dumped case asked once with the default options: the answer, an upper
+/// bound on the truth by [`vertex_to_segments`] both ways round, and the size.
+fn ask(
+    (a, ra, pa): (&[[f64; 3]], f64, ([f64; 4], [f64; 3])),
+    (b, rb, pb): (&[[f64; 3]], f64, ([f64; 4], [f64; 3])),
+) -> (gjk::Answer, f64, f64) {
+    let (a, b) = (points(a), points(b));
+    let (pa, pb) = (pose(pa), pose(pb));
     let (ca, cb) = (
-        Convex::new(a.clone(), RA).unwrap(),
-        Convex::new(b.clone(), RB).unwrap(),
+        Convex::new(a.clone(), ra).unwrap(),
+        Convex::new(b.clone(), rb).unwrap(),
     );
     let size = ca.size().max(cb.size());
     let ans = distance(&ca.into(), &pa, &cb.into(), &pb, &Options::default(), None).unwrap();
-    let truth_at_most = (vertex_to_segments(&a, &b, &pa.inv_mul(&pb)) - RA - RB).max(0.0);
+    let nearest = vertex_to_segments(&a, &b, &pa.inv_mul(&pb)).min(vertex_to_segments(
+        &b,
+        &a,
+        &pb.inv_mul(&pa),
+    ));
+    (ans, (nearest - ra - rb).max(0.0), size)
+}
+
+#[test]
+fn needle_touching_a_flat_polygon() {
+    use needle::{A, B, PA, PB, RA, RB};
+    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
     assert!(truth_at_most < 1e-12, "{truth_at_most:e}");
     assert!(ans.lower <= truth_at_most, "bounds: {ans:?}");
     // Before the exact orientation test: distance 3.076e-9 in [0, 3.076e-9],
@@ -97,15 +111,7 @@ fn needle_touching_a_flat_polygon() {
 #[test]
 fn collinear_set_touching_a_cluster() {
     use collinear::{A, B, PA, PB, RA, RB};
-    let (a, b) = (points(A), points(B));
-    let (pa, pb) = (pose(PA), pose(PB));
-    let (ca, cb) = (
-        Convex::new(a.clone(), RA).unwrap(),
-        Convex::new(b.clone(), RB).unwrap(),
-    );
-    let size = ca.size().max(cb.size());
-    let ans = distance(&ca.into(), &pa, &cb.into(), &pb, &Options::default(), None).unwrap();
-    let truth_at_most = (vertex_to_segments(&b, &a, &pb.inv_mul(&pa)) - RA - RB).max(0.0);
+    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
     assert!(truth_at_most < 1e-11, "{truth_at_most:e}");
     assert!(ans.lower <= truth_at_most, "bounds: {ans:?}");
     assert!(

@@ -30,7 +30,7 @@ fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
     v.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect()
 }
 
-fn pose(p: ([f64; 4], [f64; 3])) -> Isometry3<f64> {
+fn pose(p: Printed) -> Isometry3<f64> {
     let q = UnitQuaternion::new_unchecked(Quaternion::new(p.0[0], p.0[1], p.0[2], p.0[3]));
     Isometry3::from_parts(Translation3::new(p.1[0], p.1[1], p.1[2]), q)
 }
@@ -59,12 +59,15 @@ fn vertex_to_segments(a: &[Point3<f64>], b: &[Point3<f64>], rel: &Isometry3<f64>
     best
 }
 
+/// A pose as the dumps print it: (w, i, j, k) quaternion, translation.
+type Printed = ([f64; 4], [f64; 3]);
+
+/// One body of a dumped case: its vertices, radius and pose.
+type Body<'a> = (&'a [[f64; 3]], f64, Printed);
+
 /// A dumped case asked once with the default options: the answer, an upper
 /// bound on the truth by [`vertex_to_segments`] both ways round, and the size.
-fn ask(
-    (a, ra, pa): (&[[f64; 3]], f64, ([f64; 4], [f64; 3])),
-    (b, rb, pb): (&[[f64; 3]], f64, ([f64; 4], [f64; 3])),
-) -> (gjk::Answer, f64, f64) {
+fn ask((a, ra, pa): Body<'_>, (b, rb, pb): Body<'_>) -> (gjk::Answer, f64, f64) {
     let (a, b) = (points(a), points(b));
     let (pa, pb) = (pose(pa), pose(pb));
     let (ca, cb) = (

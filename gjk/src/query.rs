@@ -794,8 +794,13 @@ impl<'s> Pair<'s> {
             };
             let v2 = sol.v.norm_squared();
             let norm = v2.sqrt();
-            // Overflow (NaN fails the first test) and touching cores.
+            // Overflow (NaN fails the first test) and touching cores. The
+            // cores' meeting, the end of every intersecting query, is taken
+            // here as `step` would take it, without its call.
             if !(norm > self.slack && norm.is_finite()) {
+                if norm <= self.slack {
+                    return self.finish(simplex, &st, Status::Converged, sol, 0.0);
+                }
                 match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, None) {
                     Some(run) => return run,
                     None => continue,

@@ -343,24 +343,12 @@ impl Simplex {
             // every prefix (Fischer's inequality bounds a Gram determinant by
             // its leading minor times the last squared edge), and the
             // incremental pass below would have kept every point.
-            let k = points.len();
-            for (slot, p) in self.vertices.iter_mut().zip(points) {
-                *slot = *p;
-            }
-            for i in 0..k {
-                for j in 0..=i {
-                    let d = self.vertices[i].y.dot(&self.vertices[j].y);
-                    self.dot[i][j] = d;
-                    self.dot[j][i] = d;
-                }
-            }
-            self.all = ((1u32 << k) - 1) as u8;
-            match k {
-                2 => self.fill::<0b11>(),
-                3 => self.fill::<0b111>(),
-                _ => self.fill::<0b1111>(),
-            }
-            if self.independent() {
+            let independent = match points.len() {
+                2 => self.load::<2, 0b11>(points),
+                3 => self.load::<3, 0b111>(points),
+                _ => self.load::<4, 0b1111>(points),
+            };
+            if independent {
                 self.newest = None;
                 return;
             }
@@ -379,6 +367,24 @@ impl Simplex {
             }
         }
         self.newest = None;
+    }
+
+    /// `Y` = the `K` points, `ALL` their slots: every dot product and
+    /// cofactor, unrolled for the size (a warm start's usual path), and
+    /// whether the set is independent.
+    #[inline(always)]
+    fn load<const K: usize, const ALL: usize>(&mut self, points: &[Vertex]) -> bool {
+        self.vertices[..K].copy_from_slice(&points[..K]);
+        for i in 0..K {
+            for j in 0..=i {
+                let d = self.vertices[i].y.dot(&self.vertices[j].y);
+                self.dot[i][j] = d;
+                self.dot[j][i] = d;
+            }
+        }
+        self.all = ALL as u8;
+        self.fill::<ALL>();
+        self.independent_in(ALL)
     }
 
     /// The cofactors of every subset of `ALL`, smallest first, unrolled.

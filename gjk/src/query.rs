@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
 use crate::Error;
 use crate::johnson::{Simplex, Solution, Vertex};
-use crate::shape::{Convex, Shape, shift_is_in_range};
+use crate::shape::{Convex, Shape, robust_norm, shift_is_in_range};
 
 /// How hard to work, and when to stop early.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,6 +160,8 @@ impl PieceSimplex {
 /// For a compound it also keeps the runner-up piece pair's simplex, so that
 /// along a motion both the nearest pair and the one most likely to take over
 /// start warm (the paper warm-starts every convex pair of its Section 8 scene).
+/// A runner-up that the nearest pair's normal proved farther without a run
+/// has no simplex to keep; it starts cold on the query where it is run again.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct WarmStart {
     first: PieceSimplex,
@@ -1273,9 +1275,51 @@ impl<'s> Pair<'s> {
     }
 }
 
+/// A certified lower bound on the distance between piece `ca` placed by `oa`
+/// and piece `cb` placed by `ob`, both in A's body frame: their gap along the
+/// unit axis `n` (from A towards B), one support search on each, less what
+/// round-off may hide. Any axis gives a lower bound (a separating plane); the
+/// best pair's normal is a good one for the pieces beside it, and costs two
+/// support searches where running the pair costs a set-up and an iteration
+/// at least. `-inf` when nothing can be certified.
+fn axis_gap(
+    ca: &Convex,
+    oa: &Isometry3<f64>,
+    cb: &Convex,
+    ob: &Isometry3<f64>,
+    n: &Vector3<f64>,
+) -> f64 {
+    let da = oa.rotation.inverse_transform_vector(n);
+    let db = ob.rotation.inverse_transform_vector(n);
+    let (ia, ib) = (ca.support_index(&da), cb.support_index(&-db));
+    let top_a =
+        (da.dot(&ca.centroid().coords) + da.dot(&ca.local(ia))) + n.dot(&oa.translation.vector);
+    let bottom_b =
+        (db.dot(&cb.centroid().coords) + db.dot(&cb.local(ib))) + n.dot(&ob.translation.vector);
+    let gap = (bottom_b - top_a) - (ca.radius() + cb.radius());
+    // Each product and sum above errs by a few ε of the magnitudes involved,
+    // the rotated axes by a few ε of their length 1, and a support search may
+    // miss the maximum by a near-tie's last bit: 64 ε of every magnitude, as
+    // a pair's own slack. `n` is unit to a few ε, which scales the gap.
+    let scale = ca.reach()
+        + cb.reach()
+        + robust_norm(&oa.translation.vector)
+        + robust_norm(&ob.translation.vector)
+        + ca.radius()
+        + cb.radius();
+    let certified = (gap - 64.0 * f64::EPSILON * scale) * (1.0 - 8.0 * f64::EPSILON);
+    if certified.is_nan() {
+        f64::NEG_INFINITY
+    } else {
+        certified
+    }
+}
+
 /// (2.3), (2.8): the minimum over piece pairs. Pairs are visited warm pair
 /// first, then by a bounding-sphere lower bound; each runs with the best upper
-/// bound so far as its cutoff, so a pair that cannot win stops early.
+/// bound so far as its cutoff, so a pair that cannot win stops early, and a
+/// pair proved beyond the cutoff before its run (by its sphere gap, or by its
+/// gap along the best pair's normal, [`axis_gap`]) does not run at all.
 #[allow(clippy::too_many_arguments)]
 fn compound<const AVX2: bool>(
     simplex: &mut Simplex,
@@ -1334,6 +1378,9 @@ fn compound<const AVX2: bool>(
     let mut trouble: Option<Status> = None;
     // The two piece pairs with the smallest upper bounds, for the warm start.
     let mut kept: [(f64, PieceSimplex); 2] = [(f64::INFINITY, PieceSimplex::default()); 2];
+    // The best pair's normal in A's body frame, once the best pair is
+    // separated: a separating axis that may prove the next pairs farther.
+    let mut axis: Option<Vector3<f64>> = None;
     for (k, &(gap, i, j)) in order.iter().enumerate() {
         let cutoff = best.map_or(f64::INFINITY, |b| b.upper);
         // The sphere bound is rough (no slack): only skip on a clear margin.
@@ -1342,7 +1389,13 @@ fn compound<const AVX2: bool>(
         }
         let (oa, ca) = a.piece(i as usize).expect("index below piece_count");
         let (ob, cb) = b.piece(j as usize).expect("index below piece_count");
-        let piece_rel = oa.inv_mul(&(rel * ob));
+        let ob = rel * ob;
+        if let Some(n) = &axis
+            && axis_gap(ca, &oa, cb, &ob, n) > cutoff * (1.0 + 1e-9)
+        {
+            continue;
+        }
+        let piece_rel = oa.inv_mul(&ob);
         let pair = Pair::new(ca, cb, &piece_rel, None, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
         let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, cutoff);
@@ -1380,7 +1433,7 @@ fn compound<const AVX2: bool>(
         // Only a pair that becomes the best is turned into an answer.
         let better = best.is_none_or(|b| (pair_upper, pair_distance) < (b.upper, b.distance));
         if better || status == Status::Closer {
-            best = Some(pair.answer(
+            let answer = pair.answer(
                 &run,
                 simplex,
                 Place {
@@ -1388,7 +1441,10 @@ fn compound<const AVX2: bool>(
                     offset: Some(&oa),
                 },
                 [i, j],
-            ));
+            );
+            axis = (answer.normal != Vector3::zeros())
+                .then(|| pose_a.rotation.inverse_transform_vector(&answer.normal));
+            best = Some(answer);
         }
         if status == Status::Closer {
             // The pairs not visited still bound the union's distance from

@@ -540,6 +540,44 @@ fn compound_reports_the_realising_pieces() {
     assert_eq!(ans.pieces, [0, 2]);
 }
 
+/// Two long bars side by side, a small box beside the first: the bars'
+/// bounding spheres both overlap the box's, so only a run, or the nearest
+/// pair's normal as a separating axis, shows the second bar to be farther.
+/// The axis proves it with two support searches: the union costs exactly the
+/// iterations of its nearest pair alone (before, the second pair ran until
+/// its own lower bound passed the first's distance). Far from the origin and
+/// turned, as a scene would place it.
+#[test]
+fn compound_piece_behind_the_nearest_costs_no_iteration() {
+    let bar = Convex::cuboid(v(0.1, 5.0, 0.1), 0.0).unwrap();
+    let bars: Shape = Compound::new(vec![
+        (iso(0., 0., 0.), bar.clone()),
+        (iso(1., 0., 0.), bar.clone()),
+    ])
+    .unwrap()
+    .into();
+    let probe: Shape = Convex::cuboid(v(0.1, 0.1, 0.1), 0.0).unwrap().into();
+    let turn = UnitQuaternion::from_euler_angles(0.3, -0.2, 0.7);
+    let place = |x: f64| {
+        Isometry3::from_parts(Translation3::new(1e3, -2e3, 5e2), turn)
+            * Isometry3::translation(x, 0.3, 0.0)
+    };
+    let (pa, pb) = (place(0.0) * iso(0., -0.3, 0.), place(-1.0));
+    let ans = query(&bars, &pa, &probe, &pb);
+    assert_distance(&ans, 0.8, 1e-12);
+    assert_eq!(ans.pieces, [0, 0]);
+    // The first bar alone, at the same place: the same run.
+    let alone = query(&bar.into(), &pa, &probe, &pb);
+    assert_distance(&alone, 0.8, 1e-12);
+    assert_eq!(ans.iterations, alone.iterations, "{ans:?}\n{alone:?}");
+    // Put the probe between the bars: neither can be proven farther by the
+    // other's axis, both pairs run, and the nearer (the second) is named.
+    let between = place(0.6);
+    let ans = query(&bars, &pa, &probe, &between);
+    assert_distance(&ans, 0.2, 1e-12);
+    assert_eq!(ans.pieces, [1, 0]);
+}
+
 // ---------------------------------------------------------------------------
 // Penetration
 

@@ -752,25 +752,31 @@ impl Simplex {
         let [a, b, c, d] = [0, 1, 2, 3].map(|i| self.vertices[i].y);
         let (ba, ca, da) = (b - a, c - a, d - a);
         // Each volume p·(q×r) against its error bound 16ε|p||q||r|, both
-        // squared, so no square root is taken: v² > (16ε)²|p|²|q|²|r|²,
-        // with 8ε of room for the rounding of the squares themselves. A
-        // bound that underflows needs a vertex within about 1e-140 of the
-        // origin in the run's frame (whose sizes are near 1), where calling
-        // the distance 0 is within the round-off allowance anyway.
-        let [na, nb, nc, nd, nba, nca, nda] = [a, b, c, d, ba, ca, da].map(|x| x.norm_squared());
-        let e2 = (16.0 * f64::EPSILON) * (16.0 * f64::EPSILON) * (1.0 + 8.0 * f64::EPSILON);
+        // squared, so no square root is taken: v² > (16ε)²|p|²|q|²|r|². One
+        // bound serves all four: with M the largest |y_i| (from the kept
+        // y_i·y_i), every factor is a point (at most M) or an edge from `a`
+        // (at most 2M), so |p||q||r| <= 4M³, and 16ε of room covers the
+        // rounding of the edges, of M² and of its powers. A looser bound only
+        // sends more volumes to the exact test, which gives the same signs;
+        // it saves the seven norms. A bound that underflows needs every
+        // vertex within about 1e-50 of the origin in the run's frame (whose
+        // sizes are near 1), where calling the distance 0 is within the
+        // round-off allowance anyway.
+        let m2 = (self.dot[0][0].max(self.dot[1][1])).max(self.dot[2][2].max(self.dot[3][3]));
+        let e2 = (16.0 * f64::EPSILON) * (16.0 * f64::EPSILON) * (1.0 + 16.0 * f64::EPSILON);
+        let bound = e2 * (16.0 * (m2 * m2) * m2);
         let vols = [
-            (b.dot(&c.cross(&d)), nb * nc * nd),
-            ((-a).dot(&ca.cross(&da)), na * nca * nda),
-            (ba.dot(&(-a).cross(&da)), nba * na * nda),
-            (ba.dot(&ca.cross(&(-a))), nba * nca * na),
+            b.dot(&c.cross(&d)),
+            (-a).dot(&ca.cross(&da)),
+            ba.dot(&(-a).cross(&da)),
+            ba.dot(&ca.cross(&(-a))),
         ];
         let total = ba.dot(&ca.cross(&da));
-        let certain = vols.iter().all(|&(v, n3)| v * v > e2 * n3);
+        let certain = vols.iter().all(|&v| v * v > bound);
         if certain {
-            return vols.iter().all(|&(v, _)| (v > 0.0) == (total > 0.0));
+            return vols.iter().all(|&v| (v > 0.0) == (total > 0.0));
         }
-        self.holds_origin_exactly(&vols.map(|(v, n3)| (v, v * v > e2 * n3)))
+        self.holds_origin_exactly(&vols.map(|v| (v, v * v > bound)))
     }
 
     /// The four points for the exact orientation predicate, or `None` when a

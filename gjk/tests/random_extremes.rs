@@ -619,21 +619,18 @@ fn sliver_face_claims_no_depth() {
     );
     let size = 1.7344307045736313e-9;
     let (a, b) = (points(&triangle), points(&segment));
-    let union = |p: &[[f64; 3]]| -> gjk::Shape {
-        let piece = gjk::Convex::new(
-            p.iter()
-                .map(|&c| nalgebra::Point3::from(c))
-                .collect::<Vec<_>>(),
-            0.0,
-        )
-        .unwrap();
-        gjk::Compound::new(vec![(nalgebra::Isometry3::identity(), piece)])
+    // The same convex set as a union of one piece.
+    let union = |s: &gjk::Shape| -> gjk::Shape {
+        let gjk::Shape::Convex(piece) = s else {
+            unreachable!("points() builds a convex shape")
+        };
+        gjk::Compound::new(vec![(nalgebra::Isometry3::identity(), piece.clone())])
             .unwrap()
             .into()
     };
     for (how, a, b) in [
         ("convex", a.clone(), b.clone()),
-        ("union", union(&triangle), union(&segment)),
+        ("union", union(&a), union(&b)),
     ] {
         let ans = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
         assert!(ans.distance <= 1e-9 * size, "{how}: {ans:?}");

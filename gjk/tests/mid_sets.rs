@@ -426,48 +426,10 @@ fn closest_on_segment(a: &V, b: &V) -> V {
 }
 
 /// A point of triangle `abc` near the origin, as an upper bound: a convex
-/// combination of the vertices, so that it lies in the triangle up to the
-/// rounding of its own sum whatever the error of its weights. A plane
-/// projection does not: a thin triangle's plane is tilted by round-off
-/// (relative error ε/θ at an angle θ), and its projection can land nearer the
-/// origin than any point of the triangle. Seed 8204 found an upper bound 0.8 %
-/// below the certified lower bound of a 4e-14 gap, and seed 8401 one 5 %
-/// below the truth (exact rational arithmetic: 7.7527e-12) on a sliver of
-/// sine 2.6e-6 whose far vertex was 0.54 from the origin. The weights come
-/// from the 2 × 2 normal equations with the vertex nearest the origin as the
-/// base, which keeps the sum's cancellation small; the edges are candidates
-/// too, and the nearest candidate is returned.
+/// combination of the vertices ([`common::closest_on_triangle`]).
 fn closest_on_triangle(a: &V, b: &V, c: &V) -> V {
-    let mut best = [
-        closest_on_segment(a, b),
-        closest_on_segment(b, c),
-        closest_on_segment(c, a),
-    ]
-    .into_iter()
-    .fold(*a, |best, q| {
-        if q.norm_squared() < best.norm_squared() {
-            q
-        } else {
-            best
-        }
-    });
-    let mut v = [*a, *b, *c];
-    v.sort_by(|x, y| x.norm_squared().total_cmp(&y.norm_squared()));
-    let (base, e1, e2) = (v[0], v[1] - v[0], v[2] - v[0]);
-    let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-    let (r1, r2) = (-base.dot(&e1), -base.dot(&e2));
-    let det = g11 * g22 - g12 * g12;
-    if det > 0.0 {
-        let s = (g22 * r1 - g12 * r2) / det;
-        let t = (g11 * r2 - g12 * r1) / det;
-        if s >= 0.0 && t >= 0.0 && s + t <= 1.0 {
-            let p = base + e1 * s + e2 * t;
-            if p.norm_squared() < best.norm_squared() {
-                best = p;
-            }
-        }
-    }
-    best
+    let (a, b, c) = (P::from(*a), P::from(*b), P::from(*c));
+    common::closest_on_triangle(&P::origin(), &a, &b, &c).coords
 }
 
 /// Distance from the origin to conv(ws), |ws| <= 4, by every sub-simplex.

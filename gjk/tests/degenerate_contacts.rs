@@ -11,6 +11,10 @@
 //! such a case with exact orientation predicates. The code of 1ac9cba gave
 //! the same wrong answers, so the weakness was older than that day's speed
 //! work.
+//!
+//! On 2026-11-25 the same hunt found a cluster touching a lattice surface
+//! whose run stopped on the paper's rule (6.2) alone, 1e4 times the truth
+//! away: see [`cluster_touching_a_lattice_surface`].
 
 // The cases' poses are data printed to the last bit, not approximations of
 // named constants.
@@ -24,6 +28,9 @@ mod needle {
 }
 mod collinear {
     include!("data/collinear_on_cluster.rs");
+}
+mod lattice {
+    include!("data/cluster_on_lattice.rs");
 }
 
 fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
@@ -129,4 +136,32 @@ fn collinear_set_touching_a_cluster() {
     assert_eq!(ans.status, gjk::Status::Converged);
     // Both nearest points are the one point of contact.
     assert!((ans.point_a - ans.point_b).norm() <= ans.upper + 1e-12 * size);
+}
+
+/// A cluster touching a lattice surface (seed 8526): the truth is
+/// 1.8092623753351855e-17 (rational arithmetic), but the run stopped at
+/// 1.59e-13 in [0, 1.59e-13], `Converged`, 1.4 times the requirement. There
+/// `|v|` is 1e9 times below the points of the simplex, so the true descent of
+/// a step was below `v`'s round-off and the steps stopped, while the
+/// paper's rule (6.2) held: it allows `v` to be up to `√ε·D` off near
+/// contact. Such a run now takes the Backup Procedure's subset before it
+/// stops, which leads on to the truth.
+#[test]
+fn cluster_touching_a_lattice_surface() {
+    use lattice::{A, B, PA, PB, RA, RB};
+    let truth = 1.8092623753351855e-17;
+    // `ask`'s brute-force bound works in A's frame, whose coordinates near 1
+    // round by 1e-16: too coarse for this truth, which is exact.
+    let (ans, _, size) = ask((A, RA, PA), (B, RB, PB));
+    assert!(ans.lower <= truth && truth <= ans.upper, "bounds: {ans:?}");
+    assert!(
+        (ans.distance - truth).abs() <= 1e-9 * size,
+        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of {truth:e}",
+        ans.distance,
+        ans.lower,
+        ans.upper,
+        ans.status
+    );
+    // The bounds prove the shapes apart, as they are.
+    assert!(ans.lower > 0.0, "{ans:?}");
 }

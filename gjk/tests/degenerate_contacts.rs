@@ -14,7 +14,9 @@
 //!
 //! On 2026-11-25 the same hunt found a cluster touching a lattice surface
 //! whose run stopped on the paper's rule (6.2) alone, 1e4 times the truth
-//! away: see [`cluster_touching_a_lattice_surface`].
+//! away: see [`cluster_touching_a_lattice_surface`]; and a cluster beside a
+//! box surface whose run stopped on the Backup Procedure's unrefined `v`:
+//! see [`cluster_beside_a_box_surface`].
 
 // The cases' poses are data printed to the last bit, not approximations of
 // named constants.
@@ -31,6 +33,9 @@ mod collinear {
 }
 mod lattice {
     include!("data/cluster_on_lattice.rs");
+}
+mod boxed {
+    include!("data/cluster_on_box.rs");
 }
 
 fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
@@ -164,5 +169,32 @@ fn cluster_touching_a_lattice_surface() {
         ans.status
     );
     // The bounds prove the shapes apart, as they are.
+    assert!(ans.lower > 0.0, "{ans:?}");
+}
+
+/// A cluster beside a box surface (seed 8531): the truth is
+/// 4.82360817954941e-11 (rational arithmetic), but the run stopped at 4.74e-9
+/// in [0, 4.74e-9], `Converged`. Stuck on a face (the support point repeated
+/// a vertex of the simplex), the run refined its `v`, then took the Backup
+/// Procedure's subset, a thin triangle whose `v` carried the error of its
+/// cofactors, and stopped there. That `v` is now refined once too, and leads
+/// on to the truth.
+#[test]
+fn cluster_beside_a_box_surface() {
+    use boxed::{A, B, PA, PB, RA, RB};
+    let truth = 4.82360817954941e-11;
+    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
+    assert!(truth <= truth_at_most * (1.0 + 1e-12), "{truth_at_most:e}");
+    assert!(ans.lower <= truth && truth <= ans.upper, "bounds: {ans:?}");
+    assert!(
+        (ans.distance - truth).abs() <= 1e-12 * size,
+        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of {truth:e}",
+        ans.distance,
+        ans.lower,
+        ans.upper,
+        ans.status
+    );
+    // Within the round-off allowance of coordinates near 50, and apart.
+    assert!(ans.upper - ans.lower <= 1e-12 * size, "{ans:?}");
     assert!(ans.lower > 0.0, "{ans:?}");
 }

@@ -143,6 +143,21 @@ fn collinear_set_touching_a_cluster() {
     assert!((ans.point_a - ans.point_b).norm() <= ans.upper + 1e-12 * size);
 }
 
+/// For shapes apart by an exactly known `truth`: the bounds hold it and prove
+/// the shapes apart, and the distance is within `within` of it.
+fn assert_apart_at(ans: &gjk::Answer, truth: f64, within: f64) {
+    assert!(ans.lower <= truth && truth <= ans.upper, "bounds: {ans:?}");
+    assert!(ans.lower > 0.0, "{ans:?}");
+    assert!(
+        (ans.distance - truth).abs() <= within,
+        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of {truth:e}",
+        ans.distance,
+        ans.lower,
+        ans.upper,
+        ans.status
+    );
+}
+
 /// A cluster touching a lattice surface (seed 8526): the truth is
 /// 1.8092623753351855e-17 (rational arithmetic), but the run stopped at
 /// 1.59e-13 in [0, 1.59e-13], `Converged`: 1.35 times the requirement as the
@@ -159,17 +174,7 @@ fn cluster_touching_a_lattice_surface() {
     // `ask`'s brute-force bound works in A's frame, whose coordinates near 1
     // round by 1e-16: too coarse for this truth, which is exact.
     let (ans, _, size) = ask((A, RA, PA), (B, RB, PB));
-    assert!(ans.lower <= truth && truth <= ans.upper, "bounds: {ans:?}");
-    assert!(
-        (ans.distance - truth).abs() <= 1e-9 * size,
-        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of {truth:e}",
-        ans.distance,
-        ans.lower,
-        ans.upper,
-        ans.status
-    );
-    // The bounds prove the shapes apart, as they are.
-    assert!(ans.lower > 0.0, "{ans:?}");
+    assert_apart_at(&ans, truth, 1e-9 * size);
 }
 
 /// A cluster beside a box surface (seed 8531): the truth is
@@ -185,16 +190,7 @@ fn cluster_beside_a_box_surface() {
     let truth = 4.82360817954941e-11;
     let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
     assert!(truth <= truth_at_most * (1.0 + 1e-12), "{truth_at_most:e}");
-    assert!(ans.lower <= truth && truth <= ans.upper, "bounds: {ans:?}");
-    assert!(
-        (ans.distance - truth).abs() <= 1e-12 * size,
-        "distance {:e} (interval [{:e}, {:e}], {:?}) against a truth of {truth:e}",
-        ans.distance,
-        ans.lower,
-        ans.upper,
-        ans.status
-    );
-    // Within the round-off allowance of coordinates near 50, and apart.
+    assert_apart_at(&ans, truth, 1e-12 * size);
+    // Within the round-off allowance of coordinates near 50.
     assert!(ans.upper - ans.lower <= 1e-12 * size, "{ans:?}");
-    assert!(ans.lower > 0.0, "{ans:?}");
 }

@@ -1152,6 +1152,34 @@ impl Simplex {
         })
     }
 
+    /// When the support point `(ia, ib)` repeats a vertex `y_j` of `Y` that
+    /// the subalgorithm dropped from `sol`, the nearest point of
+    /// `aff(V̂ ∪ {y_j})` by one refinement step from `sol`, if it lies in
+    /// their hull. In exact arithmetic that cannot happen with `g > 0`: a
+    /// dropped vertex satisfies `v·y_j >= |v|²`. When it does, the
+    /// cofactors lost `y_j`'s weight in round-off: a far vertex (1e5 away)
+    /// whose weight (1e-16) moves `v` across the set by more than `v`'s own
+    /// round-off while `|v|` changes by less. A needle lying along a prism's
+    /// edge, the support search then tied between the edge's two faces by
+    /// the sign of that sideways error, stopped at 5.6e-5 of a truth of
+    /// 1.6e-11 (`mid_sets` seed 8554, pair 164). `None` when `y_j` is not a
+    /// dropped vertex, when the grown subset would be the whole tetrahedron
+    /// (see [`origin_weights`](Self::origin_weights)), or when
+    /// [`refine`](Self::refine) declines.
+    #[cold]
+    #[inline(never)]
+    pub fn regrow(&self, sol: Solution, ia: u32, ib: u32) -> Option<Solution> {
+        let dropped = self.all & !sol.mask;
+        let j = (0..4).find(|&i| {
+            dropped & (1 << i) != 0 && self.vertices[i].ia == ia && self.vertices[i].ib == ib
+        })?;
+        let mask = sol.mask | (1 << j);
+        if mask.count_ones() > 3 {
+            return None;
+        }
+        self.refine(Solution { mask, ..sol })
+    }
+
     /// For a tetrahedron holding the origin, its weights refined by one step
     /// so that `Σ λ_i y_i` is the origin to round-off of the points, not to
     /// that of the cofactors: `λ' = λ - δ`, `E δ = Σ λ_i y_i` with `E` the
@@ -1248,6 +1276,57 @@ mod tests {
         assert!((s.total(0b1111) - vol * vol).abs() < 1e-12 * vol * vol);
         let a = e1.cross(&e2).norm_squared();
         assert!((s.total(0b0111) - a).abs() < 1e-12 * a);
+    }
+
+    /// The triangle of `mid_sets` seed 8554 (see `regrow`): a needle's edge
+    /// of K 5.55e-5 from the origin and a vertex 1.3e5 away whose weight in
+    /// the nearest point is about 1e-16.
+    #[test]
+    fn regrow_restores_a_far_vertex_lost_to_round_off() {
+        let mut pts = [
+            vtx(
+                9.166550882371626e-12,
+                5.365944365714793e-5,
+                -61997.68103873958,
+            ),
+            vtx(
+                -22760.413943159896,
+                8.154773311155362e-12,
+                131071.99999999999,
+            ),
+            vtx(
+                -5.385364345995226e-12,
+                6.0975361175549454e-5,
+                181151.45797131996,
+            ),
+        ];
+        pts[1].ia = 57;
+        pts[1].ib = 10;
+        let s = Simplex::new(&pts);
+        let edge = s.solve().unwrap();
+        // The subalgorithm drops the far vertex, although it lies 2.3e-3
+        // beyond the plane through the edge's v normal to v.
+        assert_eq!(edge.mask, 0b101);
+        let beyond = |v: &Vector3<f64>| v.norm_squared() - v.dot(&pts[1].y);
+        assert!(beyond(&edge.v) > 1e-7, "{:e}", beyond(&edge.v));
+        assert!(s.regrow(edge, 1, 1).is_none(), "not a vertex of Y");
+        let tri = s.regrow(edge, 57, 10).unwrap();
+        assert_eq!(tri.mask, 0b111);
+        assert!(tri.lambda.iter().all(|l| (0.0..=1.0).contains(l)));
+        assert!(tri.lambda[1] > 0.0);
+        // Optimality in the triangle's plane: v normal to both edges, to
+        // within the round-off of a dot product of 1e5-long vectors; the
+        // edge's v misses the first by 1.3e-7.
+        for j in [1, 2] {
+            let e = pts[j].y - pts[0].y;
+            let off = tri.v.dot(&e);
+            assert!(off.abs() < 1e-15 * e.norm() * 1e-4, "{off:e}");
+        }
+        assert!(tri.v.norm_squared() <= edge.v.norm_squared() * (1.0 + 8.0 * f64::EPSILON));
+        // The sideways component that steered the support search changes
+        // sign: the support point then is the vertex next to the needle.
+        assert!(edge.v.x > 0.0 && tri.v.x < 0.0, "{:?} {:?}", edge.v, tri.v);
+        assert!(s.regrow(tri, 57, 10).is_none(), "not dropped");
     }
 
     #[test]

@@ -912,6 +912,7 @@ impl<'s> Pair<'s> {
         let stop_d = eps_d + self.single_slack;
         let mut refined = false;
         let mut inside_asked = false;
+        let mut regrown = false;
         loop {
             let v2 = sol.v.norm_squared();
             let norm = v2.sqrt();
@@ -1048,6 +1049,21 @@ impl<'s> Pair<'s> {
                         lambda,
                     };
                     return Some(self.finish(simplex, st, Status::Converged, origin, lower));
+                }
+            }
+            // The support point repeats a vertex the subalgorithm dropped,
+            // which exact arithmetic rules out while g > 0: its weight was
+            // lost to round-off (see `Simplex::regrow`). The grown subset's
+            // v goes back to step (3) if it is no farther than round-off
+            // allows; its support point then leads on. Asked once.
+            if repeat && !regrown {
+                regrown = true;
+                if let Some(r) = simplex.regrow(sol, s.ia, s.ib) {
+                    let r2 = r.v.norm_squared();
+                    if r2 <= v2 * (1.0 + 8.0 * f64::EPSILON) {
+                        sol = r;
+                        continue;
+                    }
                 }
             }
             // A repeat with g above round-off: v carries the error of a

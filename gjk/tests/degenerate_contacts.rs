@@ -16,7 +16,8 @@
 //! whose run stopped on the paper's rule (6.2) alone, 1e4 times the truth
 //! away: see [`cluster_touching_a_lattice_surface`]; and a cluster beside a
 //! box surface whose run stopped on the Backup Procedure's unrefined `v`:
-//! see [`cluster_beside_a_box_surface`].
+//! see [`cluster_beside_a_box_surface`]. Later, a needle along a prism's
+//! edge whose run lost a far vertex's weight: see [`needle_along_a_prism_edge`].
 
 // The cases' poses are data printed to the last bit, not approximations of
 // named constants.
@@ -36,6 +37,9 @@ mod lattice {
 }
 mod boxed {
     include!("data/cluster_on_box.rs");
+}
+mod prism {
+    include!("data/needle_on_prism.rs");
 }
 
 fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
@@ -192,4 +196,22 @@ fn cluster_beside_a_box_surface() {
     assert_apart_at(&ans, truth, 1e-12 * size);
     // Within the round-off allowance of coordinates near 50.
     assert!(ans.upper - ans.lower <= 1e-12 * size, "{ans:?}");
+}
+
+/// A needle along a prism's edge (seed 8554): the truth is at most 1.6e-11,
+/// but the run stopped at 5.55e-5 in [0, 5.55e-5], `Converged`, 0.6 of the
+/// requirement. `v` lay on a needle's edge of K, its sideways component
+/// (5.5e-12) the rotation's round-off; the support point was a far vertex
+/// (1.3e5 away) across the prism's top face, and the triangle it made held a
+/// nearer point only by a weight of 1e-16, which the cofactors lost, so the
+/// support point repeated the vertex the subalgorithm had dropped. That
+/// triangle's point, refined, swings `v`'s sideways component across zero,
+/// and the support point then is the prism's vertex 7, next to the needle's.
+#[test]
+fn needle_along_a_prism_edge() {
+    use prism::{A, B, PA, PB, RA, RB};
+    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
+    assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
+    assert_touching(&ans, truth_at_most, 1e-12 * size);
+    assert_eq!(ans.status, gjk::Status::Converged);
 }

@@ -295,9 +295,14 @@ impl Simplex {
 
     /// A simplex with no points, to be [`reset`](Self::reset) before use. One
     /// per query, reused across a compound's piece pairs.
-    pub fn empty() -> Self {
+    pub const fn empty() -> Self {
+        const ORIGIN: Vertex = Vertex {
+            y: Vector3::new(0.0, 0.0, 0.0),
+            ia: 0,
+            ib: 0,
+        };
         Simplex {
-            vertices: [Vertex::default(); 4],
+            vertices: [ORIGIN; 4],
             all: 0,
             dot: [[0.0; 4]; 4],
             delta: [[0.0; 4]; 16],

@@ -1029,6 +1029,24 @@ impl<'s> Pair<'s> {
                 let best = st.nearer(sol, v2);
                 return Some(self.finish(simplex, st, status, best, lower));
             }
+            // A step that does not descend refines v before it is taken or
+            // given up (as a repeat does, above). Along a long thin edge of
+            // K, v's error along the edge (ε times its length) can outweigh
+            // v itself in the support search, and on a face of K normal to
+            // v, whose points all tie, it alone picks the support point: a
+            // needle of length 1.7 touching a lattice's face cycled between
+            // two such points, each step level, and ended at 4.2e-10 against
+            // a truth below 1.6e-17 (mid_sets seed 8593, pair 1844). The
+            // refined v picks the point a step in exact arithmetic would.
+            if !refined
+                && !repeat
+                && matches!(st.prev, Some((_, p2)) if v2 >= p2)
+                && let Some(r) = simplex.refine(sol)
+            {
+                refined = true;
+                sol = r;
+                continue;
+            }
             // Step (4): descend while |v| decreases and V̂ is not full. A
             // step that only grows V̂ by a dimension, with |v| unchanged at
             // round-off level, is also progress (nearly parallel edges give

@@ -17,7 +17,9 @@
 //! away: see [`cluster_touching_a_lattice_surface`]; and a cluster beside a
 //! box surface whose run stopped on the Backup Procedure's unrefined `v`:
 //! see [`cluster_beside_a_box_surface`]. Later, a needle along a prism's
-//! edge whose run lost a far vertex's weight: see [`needle_along_a_prism_edge`].
+//! edge whose run lost a far vertex's weight: see [`needle_along_a_prism_edge`];
+//! and a needle on a lattice's face whose run cycled between two of the face's
+//! points: see [`needle_on_a_lattice_face`].
 
 // The cases' poses are data printed to the last bit, not approximations of
 // named constants.
@@ -40,6 +42,9 @@ mod boxed {
 }
 mod prism {
     include!("data/needle_on_prism.rs");
+}
+mod lattice_face {
+    include!("data/needle_on_lattice.rs");
 }
 
 fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
@@ -210,6 +215,23 @@ fn cluster_beside_a_box_surface() {
 #[test]
 fn needle_along_a_prism_edge() {
     use prism::{A, B, PA, PB, RA, RB};
+    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
+    assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
+    assert_touching(&ans, truth_at_most, 1e-12 * size);
+    assert_eq!(ans.status, gjk::Status::Converged);
+}
+
+/// A needle touching a lattice's face (seed 8593): the truth is below
+/// 1.6e-17, but the run ended `Converged` at 4.2e-10 in [0, 4.2e-10] after 12
+/// iterations, 0.098 of the requirement. On an edge of K 3.8 long and 4.2e-10
+/// from the origin, `v`'s round-off along the edge chose between the face's
+/// points, all tied in the direction of `v`: the run swapped two of them in
+/// and out, each step level, until step (5) ended it. A step that does not
+/// descend now refines `v` first, and the refined `v` leads on in 5
+/// iterations.
+#[test]
+fn needle_on_a_lattice_face() {
+    use lattice_face::{A, B, PA, PB, RA, RB};
     let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
     assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
     assert_touching(&ans, truth_at_most, 1e-12 * size);

@@ -55,6 +55,17 @@ fn points(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
     v.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect()
 }
 
+/// A vertex list repeated up to 512 points or more, as `mid_sets` asks each
+/// case again (its `dup` shapes): the same hull, other indices, and the
+/// support search's path for larger sets.
+fn repeated(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
+    let mut out = Vec::new();
+    while out.len() < 512 {
+        out.extend(points(v));
+    }
+    out
+}
+
 fn pose(p: Printed) -> Isometry3<f64> {
     let q = UnitQuaternion::new_unchecked(Quaternion::new(p.0[0], p.0[1], p.0[2], p.0[3]));
     Isometry3::from_parts(Translation3::new(p.1[0], p.1[1], p.1[2]), q)
@@ -216,6 +227,12 @@ fn cluster_beside_a_box_surface() {
 /// support point repeated the vertex the subalgorithm had dropped. That
 /// triangle's point, refined, swings `v`'s sideways component across zero,
 /// and the support point then is the prism's vertex 7, next to the needle's.
+///
+/// With the vertex lists repeated (`mid_sets`' second form of each case) the
+/// same run grew back the prism's other far corner instead, and stopped at
+/// 5.55e-5 again: its interval, [0, 5.55e-5], 1 600 times wider than the
+/// tolerance allows, now brings a second opinion with A and B swapped, whose
+/// frame rounds the other way, and that run ends at 1.5e-11.
 #[test]
 fn needle_along_a_prism_edge() {
     use prism::{A, B, PA, PB, RA, RB};
@@ -223,6 +240,38 @@ fn needle_along_a_prism_edge() {
     assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
     assert_touching(&ans, truth_at_most, 1e-12 * size);
     assert_eq!(ans.status, gjk::Status::Converged);
+    let (a, b) = (
+        Convex::new(repeated(A), RA).unwrap(),
+        Convex::new(repeated(B), RB).unwrap(),
+    );
+    let options = Options::default();
+    let twice = distance(&a.into(), &pose(PA), &b.into(), &pose(PB), &options, None).unwrap();
+    assert_touching(&twice, truth_at_most, 1e-12 * size);
+    // The nearest points, normal and warm start are the swapped run's,
+    // placed back: the query asked the other way round gives them mirrored.
+    let (a, b) = (
+        Convex::new(repeated(A), RA).unwrap(),
+        Convex::new(repeated(B), RB).unwrap(),
+    );
+    let mirror = distance(&b.into(), &pose(PB), &a.into(), &pose(PA), &options, None).unwrap();
+    assert_eq!(
+        (twice.point_a, twice.point_b),
+        (mirror.point_b, mirror.point_a)
+    );
+    assert_eq!(twice.normal, -mirror.normal);
+    assert_eq!(twice.upper, mirror.upper);
+    let flipped: Vec<[u32; 2]> = mirror
+        .warm_start
+        .pairs()
+        .iter()
+        .map(|&[i, j]| [j, i])
+        .collect();
+    assert_eq!(twice.warm_start.pairs(), &flipped[..]);
+    let gap = twice.point_b - twice.point_a;
+    assert!(
+        (gap.norm() - twice.distance).abs() <= 1e-12 * size,
+        "{twice:?}"
+    );
 }
 
 /// A needle touching a lattice's face (seed 8593): the truth is below
@@ -255,13 +304,6 @@ fn needle_on_a_lattice_face() {
 fn ellipsoid_beside_a_disk() {
     use disk::{A, B, PA, PB, RA, RB};
     let truth = 1.533506903797388e-3;
-    let repeated = |v: &[[f64; 3]]| {
-        let mut out = Vec::new();
-        while out.len() < 512 {
-            out.extend(points(v));
-        }
-        out
-    };
     let (a, b) = (
         Convex::new(repeated(A), RA).unwrap(),
         Convex::new(repeated(B), RB).unwrap(),

@@ -511,6 +511,11 @@ fn second_opinion<const AVX2: bool>(
         return first;
     };
     let lower = first.lower.max(second.lower);
+    if lower > first.upper.min(second.upper) {
+        // The two contradict each other (round-off beyond the slack):
+        // neither is trusted over the other, and the first stands.
+        return first;
+    }
     let mut best = if second.upper < first.upper {
         Answer {
             point_a: second.point_b,
@@ -1124,7 +1129,7 @@ impl<'s> Pair<'s> {
                 return Some(self.finish(simplex, st, status, best, lower));
             }
             // A step that does not descend refines v before it is taken or
-            // given up (as a repeat does, above). Along a long thin edge of
+            // given up (as a repeat does, below). Along a long thin edge of
             // K, v's error along the edge (ε times its length) can outweigh
             // v itself in the support search, and on a face of K normal to
             // v, whose points all tie, it alone picks the support point: a
@@ -1145,7 +1150,6 @@ impl<'s> Pair<'s> {
             // step that only grows V̂ by a dimension, with |v| unchanged at
             // round-off level, is also progress (nearly parallel edges give
             // such steps); a few are allowed before step (5) takes over.
-            let mut not_down = false;
             // The budget counts level steps since |v|² last fell by more
             // than 2⁻²⁰ (far above round-off) from one level step to the
             // next. On a curved set far larger than |v| (an ellipsoid of 451
@@ -1160,6 +1164,7 @@ impl<'s> Pair<'s> {
             } else {
                 st.flat_steps
             };
+            let mut not_down = false;
             let descended = match st.prev {
                 None => true,
                 Some((_, p2)) if v2 < p2 => true,

@@ -135,6 +135,17 @@ fn assert_touching(ans: &gjk::Answer, truth_at_most: f64, within: f64) {
     );
 }
 
+/// A dumped case of shapes that touch (a brute-force bound on the truth
+/// below 2e-11), asked with the default options: `Converged`, the distance
+/// within 1e-12 of the size above the bound. The bound and the size.
+fn assert_touching_closely(a: Body<'_>, b: Body<'_>) -> (f64, f64) {
+    let (ans, truth_at_most, size) = ask(a, b);
+    assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
+    assert_touching(&ans, truth_at_most, 1e-12 * size);
+    assert_eq!(ans.status, gjk::Status::Converged);
+    (truth_at_most, size)
+}
+
 /// For shapes apart by an exactly known `truth`: the bounds hold it and prove
 /// the shapes apart, and the distance is within `within` of it.
 fn assert_apart_at(ans: &gjk::Answer, truth: f64, within: f64) {
@@ -236,10 +247,7 @@ fn cluster_beside_a_box_surface() {
 #[test]
 fn needle_along_a_prism_edge() {
     use prism::{A, B, PA, PB, RA, RB};
-    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
-    assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
-    assert_touching(&ans, truth_at_most, 1e-12 * size);
-    assert_eq!(ans.status, gjk::Status::Converged);
+    let (truth_at_most, size) = assert_touching_closely((A, RA, PA), (B, RB, PB));
     let (a, b) = (
         Convex::new(repeated(A), RA).unwrap(),
         Convex::new(repeated(B), RB).unwrap(),
@@ -285,10 +293,7 @@ fn needle_along_a_prism_edge() {
 #[test]
 fn needle_on_a_lattice_face() {
     use lattice_face::{A, B, PA, PB, RA, RB};
-    let (ans, truth_at_most, size) = ask((A, RA, PA), (B, RB, PB));
-    assert!(truth_at_most < 2e-11, "{truth_at_most:e}");
-    assert_touching(&ans, truth_at_most, 1e-12 * size);
-    assert_eq!(ans.status, gjk::Status::Converged);
+    assert_touching_closely((A, RA, PA), (B, RB, PB));
 }
 
 /// An ellipsoid beside a disk (seed 8574), 1.533506903797388e-3 apart (by the

@@ -1174,11 +1174,11 @@ impl Simplex {
     #[cold]
     #[inline(never)]
     pub fn regrow(&self, sol: Solution, ia: u32, ib: u32) -> Option<Solution> {
-        let dropped = self.all & !sol.mask;
-        let j = (0..4).find(|&i| {
-            dropped & (1 << i) != 0 && self.vertices[i].ia == ia && self.vertices[i].ib == ib
-        })?;
-        let mask = sol.mask | (1 << j);
+        let dropped = self.pair_slots(ia, ib) & self.all & !sol.mask;
+        if dropped == 0 {
+            return None;
+        }
+        let mask = sol.mask | (dropped & dropped.wrapping_neg());
         if mask.count_ones() > 3 {
             return None;
         }
@@ -1223,6 +1223,12 @@ impl Simplex {
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.
     #[inline(always)]
     pub fn has_pair(&self, mask: u8, ia: u32, ib: u32) -> bool {
+        self.pair_slots(ia, ib) & mask != 0
+    }
+
+    /// The slots whose vertex pair is `(ia, ib)`, as a bit mask.
+    #[inline(always)]
+    fn pair_slots(&self, ia: u32, ib: u32) -> u8 {
         // Each pair as one 64-bit key (the two adjacent indices of a
         // vertex load as one word), compared without short-circuit: which
         // slot matches is unpredictable, so a bit mask of matches costs
@@ -1233,7 +1239,7 @@ impl Simplex {
         for (i, v) in self.vertices.iter().enumerate() {
             hit |= u8::from(key(v.ia, v.ib) == want) << i;
         }
-        hit & mask != 0
+        hit
     }
 }
 

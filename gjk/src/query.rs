@@ -1314,18 +1314,25 @@ impl<'s> Pair<'s> {
     #[inline(always)]
     fn loose(&self, run: &Run, tolerance: f64) -> bool {
         let (lower, upper, _) = self.bounds(run);
-        upper - lower > 2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k
+        upper - lower > self.tight_width(tolerance)
+    }
+
+    /// The widest interval, in the world's units, that the tolerance allows
+    /// a converged run: the slack at both ends and the 4 ε·D of step (5).
+    #[inline(always)]
+    fn tight_width(&self, tolerance: f64) -> f64 {
+        2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k
     }
 
     /// The interval width so much beyond what the tolerance allows (100
-    /// times [`loose`](Self::loose)'s) that a second opinion is worth a
+    /// times [`tight_width`](Self::tight_width)) that a second opinion is worth a
     /// second run: a stuck run, not one that (6.2) ended a few round-offs
     /// short. At 1 time that width, 4.5 % of the randomised sweep's runs
     /// and 3 % of the paper's family's would be asked again; from 10 times
     /// on, none of the family's.
     #[inline(always)]
     fn stuck_width(&self, tolerance: f64) -> f64 {
-        100.0 * (2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k)
+        100.0 * self.tight_width(tolerance)
     }
 
     /// A warm run that ended with a loose interval (the warm simplex can sit

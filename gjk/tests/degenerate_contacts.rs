@@ -26,7 +26,7 @@
 // named constants.
 #![allow(clippy::approx_constant)]
 
-use gjk::{Convex, Options, distance};
+use gjk::{Convex, Options, Shape, distance};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 mod needle {
@@ -64,6 +64,14 @@ fn repeated(v: &[[f64; 3]]) -> Vec<Point3<f64>> {
         out.extend(points(v));
     }
     out
+}
+
+/// Both bodies of a dumped case with their vertex lists [`repeated`].
+fn repeated_shapes(a: &[[f64; 3]], ra: f64, b: &[[f64; 3]], rb: f64) -> (Shape, Shape) {
+    (
+        Convex::new(repeated(a), ra).unwrap().into(),
+        Convex::new(repeated(b), rb).unwrap().into(),
+    )
 }
 
 fn pose(p: Printed) -> Isometry3<f64> {
@@ -248,20 +256,13 @@ fn cluster_beside_a_box_surface() {
 fn needle_along_a_prism_edge() {
     use prism::{A, B, PA, PB, RA, RB};
     let (truth_at_most, size) = assert_touching_closely((A, RA, PA), (B, RB, PB));
-    let (a, b) = (
-        Convex::new(repeated(A), RA).unwrap(),
-        Convex::new(repeated(B), RB).unwrap(),
-    );
+    let (a, b) = repeated_shapes(A, RA, B, RB);
     let options = Options::default();
-    let twice = distance(&a.into(), &pose(PA), &b.into(), &pose(PB), &options, None).unwrap();
+    let twice = distance(&a, &pose(PA), &b, &pose(PB), &options, None).unwrap();
     assert_touching(&twice, truth_at_most, 1e-12 * size);
     // The nearest points, normal and warm start are the swapped run's,
     // placed back: the query asked the other way round gives them mirrored.
-    let (a, b) = (
-        Convex::new(repeated(A), RA).unwrap(),
-        Convex::new(repeated(B), RB).unwrap(),
-    );
-    let mirror = distance(&b.into(), &pose(PB), &a.into(), &pose(PA), &options, None).unwrap();
+    let mirror = distance(&b, &pose(PB), &a, &pose(PA), &options, None).unwrap();
     assert_eq!(
         (twice.point_a, twice.point_b),
         (mirror.point_b, mirror.point_a)
@@ -309,19 +310,8 @@ fn needle_on_a_lattice_face() {
 fn ellipsoid_beside_a_disk() {
     use disk::{A, B, PA, PB, RA, RB};
     let truth = 1.533506903797388e-3;
-    let (a, b) = (
-        Convex::new(repeated(A), RA).unwrap(),
-        Convex::new(repeated(B), RB).unwrap(),
-    );
-    let ans = distance(
-        &a.into(),
-        &pose(PA),
-        &b.into(),
-        &pose(PB),
-        &Options::default(),
-        None,
-    )
-    .unwrap();
+    let (a, b) = repeated_shapes(A, RA, B, RB);
+    let ans = distance(&a, &pose(PA), &b, &pose(PB), &Options::default(), None).unwrap();
     assert_apart_at(&ans, truth, 1e-6 * truth);
     assert_eq!(ans.status, gjk::Status::Converged);
 }

@@ -450,8 +450,8 @@ fn distance_of<const AVX2: bool>(
         // of 0, before shapes were held to MAX_REACH).
         return Err(Error::NonFinitePose);
     }
-    // `stuck`: the interval width beyond which a convex pair's answer is
-    // asked again the other way round (see `second_opinion`).
+    // `stuck`: the interval width beyond which the answer is asked again
+    // the other way round (see `second_opinion`).
     let (answer, stuck) = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
             let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)), options.precision);
@@ -469,10 +469,11 @@ fn distance_of<const AVX2: bool>(
             };
             (pair.answer(&run, simplex, place, [0, 0]), stuck)
         }
-        _ => (
-            compound::<AVX2>(&mut workspace.simplex, a, pose_a, b, &rel, options, warm),
-            f64::INFINITY,
-        ),
+        _ => {
+            let (answer, stuck) =
+                compound::<AVX2>(&mut workspace.simplex, a, pose_a, b, &rel, options, warm);
+            (answer, if swapped { f64::INFINITY } else { stuck })
+        }
     };
     // The answer goes out as it was built unless one of the three rare
     // checks below needs to change it (kept out of line, so that the common
@@ -483,14 +484,16 @@ fn distance_of<const AVX2: bool>(
     Ok(answer)
 }
 
-/// A run of two convex shapes that ended with an interval wider than the
-/// tolerance (stuck, its support point tied between far points by `v`'s
-/// round-off), asked once more with the shapes swapped: B's frame rounds
-/// differently, and a needle along a prism's edge (`mid_sets` seed 8554,
-/// pair 164, vertex lists repeated) that stopped at 5.55e-5 of a truth below
-/// 1.6e-11 gives 1.5e-11 that way. Both answers are certified, so the
-/// nearer upper bound wins and the lower bounds combine. Cold, as a warm
-/// start names the pairs the other way round; rare, so out of line.
+/// A query that ended with an interval wider than the tolerance (stuck,
+/// its support point tied between far points by `v`'s round-off), asked
+/// once more with the shapes swapped: B's frame rounds differently, and a
+/// needle along a prism's edge (`mid_sets` seed 8554, pair 164, vertex
+/// lists repeated) that stopped at 5.55e-5 of a truth below 1.6e-11 gives
+/// 1.5e-11 that way. Unions too: their piece pairs run the same way, and
+/// the needle as a union's piece stopped where it did alone. Both answers
+/// are certified, so the nearer upper bound wins and the lower bounds
+/// combine. Cold, as a warm start names the pairs the other way round;
+/// rare, so out of line.
 #[cold]
 #[inline(never)]
 fn second_opinion<const AVX2: bool>(
@@ -550,8 +553,8 @@ fn is_finite(answer: &Answer) -> bool {
 }
 
 /// The rare ends of [`distance_of`]: bounds that contradict each other, a
-/// number that overflowed ([`repair`]), or a convex pair's run stuck with an
-/// interval wider than `stuck` ([`second_opinion`]).
+/// number that overflowed ([`repair`]), or a run stuck with an interval
+/// wider than `stuck` ([`second_opinion`]).
 #[cold]
 #[inline(never)]
 fn rare<const AVX2: bool>(
@@ -1523,6 +1526,8 @@ fn axis_gap(
 /// bound so far as its cutoff, so a pair that cannot win stops early, and a
 /// pair proved beyond the cutoff before its run (by its sphere gap, or by its
 /// gap along the best pair's normal, [`axis_gap`]) does not run at all.
+/// With the answer, the interval width beyond which it counts as stuck (see
+/// [`second_opinion`]).
 #[allow(clippy::too_many_arguments)]
 fn compound<const AVX2: bool>(
     simplex: &mut Simplex,
@@ -1532,7 +1537,7 @@ fn compound<const AVX2: bool>(
     rel: &Isometry3<f64>,
     options: &Options,
     warm: Option<&WarmStart>,
-) -> Answer {
+) -> (Answer, f64) {
     let (na, nb) = (a.piece_count(), b.piece_count());
     // Piece pairs with their sphere gaps: on the stack for the usual few
     // pieces, so a query allocates nothing.
@@ -1579,6 +1584,10 @@ fn compound<const AVX2: bool>(
     let mut backup_used = false;
     let mut penetration = 0.0f64;
     let mut trouble: Option<Status> = None;
+    // The widest interval a pair run to its end may have before the union's
+    // answer is called stuck: the largest `stuck_width` among those pairs,
+    // since every one of them may bound the union from below.
+    let mut stuck = 0.0f64;
     // The two piece pairs with the smallest upper bounds, for the warm start.
     let mut kept: [(f64, PieceSimplex); 2] = [(f64::INFINITY, PieceSimplex::default()); 2];
     // The best pair's normal in A's body frame, once the best pair is
@@ -1627,6 +1636,7 @@ fn compound<const AVX2: bool>(
             Exit::Pruned => continue,
             Exit::Status(s) => s,
         };
+        stuck = stuck.max(pair.stuck_width(options.tolerance));
         if matches!(status, Status::IterationCap | Status::ToleranceNotMet)
             && trouble != Some(Status::ToleranceNotMet)
         {
@@ -1680,5 +1690,5 @@ fn compound<const AVX2: bool>(
             None => out.status,
         },
     };
-    out
+    (out, stuck)
 }

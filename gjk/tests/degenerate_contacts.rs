@@ -315,3 +315,49 @@ fn ellipsoid_beside_a_disk() {
     assert_apart_at(&ans, truth, 1e-6 * truth);
     assert_eq!(ans.status, gjk::Status::Converged);
 }
+
+/// The needle along a prism's edge, repeated lists, each body a piece of a
+/// union beside a far sphere: the piece pair stuck as the convex pair did
+/// (5.55e-5 in [0, 5.55e-5], 0.6 of the requirement) until a union's stuck
+/// answer was asked again the other way round too.
+#[test]
+fn needle_along_a_prism_edge_in_unions() {
+    use prism::{A, B, PA, PB, RA, RB};
+    let (truth_at_most, size) = assert_touching_closely((A, RA, PA), (B, RB, PB));
+    let (na, nb) = (
+        Convex::new(repeated(A), RA).unwrap(),
+        Convex::new(repeated(B), RB).unwrap(),
+    );
+    let far = Isometry3::translation(0.0, 0.0, 1e7);
+    let ball = Convex::sphere(1.0).unwrap();
+    let union = |pieces: Vec<(Isometry3<f64>, Convex)>| -> Shape {
+        gjk::Compound::new(pieces).unwrap().into()
+    };
+    let (convex_a, convex_b): (Shape, Shape) = (na.clone().into(), nb.clone().into());
+    let union_a = union(vec![(Isometry3::identity(), na), (far, ball.clone())]);
+    let union_b = union(vec![(far, ball), (Isometry3::identity(), nb)]);
+    let options = Options::default();
+    let alone = distance(&convex_a, &pose(PA), &convex_b, &pose(PB), &options, None).unwrap();
+    for (a, b, pieces) in [
+        (&union_a, &convex_b, [0, 0]),
+        (&convex_a, &union_b, [0, 1]),
+        (&union_a, &union_b, [0, 1]),
+    ] {
+        let ans = distance(a, &pose(PA), b, &pose(PB), &options, None).unwrap();
+        assert_touching(&ans, truth_at_most, 1e-12 * size);
+        assert_eq!(ans.status, gjk::Status::Converged);
+        assert_eq!(ans.pieces, pieces);
+        assert_eq!(ans.warm_start.pieces(), pieces);
+        // The same piece pair's answer as the convex pair's, placed back.
+        assert_eq!((ans.upper, ans.distance), (alone.upper, alone.distance));
+        assert_eq!(ans.warm_start.pairs(), alone.warm_start.pairs());
+        assert!(
+            ((ans.point_a - alone.point_a).norm()) <= 1e-12 * size,
+            "{ans:?}"
+        );
+        assert!(
+            ((ans.point_b - alone.point_b).norm()) <= 1e-12 * size,
+            "{ans:?}"
+        );
+    }
+}

@@ -1122,7 +1122,13 @@ impl<'s> Pair<'s> {
                 None => {}
             }
             if st.iterations >= options.max_iterations {
-                let status = if paper_met {
+                // Converged only where step (5) below would end the run
+                // too: (6.2) alone holds for a |v| up to √ε·D off, which
+                // a run without the cap goes on to remove (nearly parallel
+                // edges 6.19e-6 apart, capped at 2 iterations, stopped at
+                // 6.23e-6 called converged).
+                let tight = norm - lower <= 4.0 * stop_d;
+                let status = if paper_met && tight {
                     Status::Converged
                 } else {
                     Status::IterationCap

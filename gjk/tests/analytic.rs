@@ -703,6 +703,58 @@ fn margin_early_exits() {
     assert_eq!(ans.iterations, 1, "{ans:?}");
 }
 
+/// An iteration cap never ends a run `Converged` short of the tolerance.
+/// Two triangles with nearly parallel edges, exactly `h` apart: A's vertices
+/// have y <= 0 and B's y >= h, and the edges (-1, 0, 0)–(1, 0, 0) and
+/// (-1, h, 0.1)–(1, h, -0.1) cross at x = 0. After 2 iterations the
+/// paper's rule (6.2) holds, which near contact allows |v| up to √ε·D off:
+/// the run stopped there at 1.0000000050e-8 in [9.93e-9, 1.000005e-8] and
+/// said `Converged`, where a run without the cap goes on to the truth.
+#[test]
+fn an_iteration_cap_never_claims_convergence_short_of_the_tolerance() {
+    let a = convex(&[p(-1., 0., 0.), p(1., 0., 0.), p(0., -1., 0.3)], 0.0);
+    let b = convex(&[p(-1., 0., 0.1), p(1., 0., -0.1), p(0.2, 1., 0.)], 0.0);
+    for h in [1e-6, 1e-8] {
+        let pb = iso(0., h, 0.);
+        let full = query(&a, &iso(0., 0., 0.), &b, &pb);
+        // ε·D is 5e-14 here (D, the size bound of (6.4), about 2.4).
+        assert_distance(&full, h, 1e-13);
+        assert_eq!(full.status, Status::Converged);
+        for max_iterations in 1..=full.iterations + 1 {
+            let opt = Options {
+                max_iterations,
+                ..Options::default()
+            };
+            let ans = distance(&a, &iso(0., 0., 0.), &b, &pb, &opt, None).unwrap();
+            assert!(ans.lower <= h && h <= ans.upper, "{ans:?}");
+            if ans.status == Status::Converged {
+                // Within the tolerance's own interval (2 slack + 4 ε·D,
+                // about 3e-13 here), not just (6.2)'s.
+                assert!(
+                    ans.upper - ans.lower <= 1e-12,
+                    "cap {max_iterations}: {ans:?}"
+                );
+                assert_distance(&ans, h, 1e-13);
+            } else {
+                assert_eq!(ans.status, Status::IterationCap, "{ans:?}");
+            }
+        }
+        let ans = distance(
+            &a,
+            &iso(0., 0., 0.),
+            &b,
+            &pb,
+            &Options {
+                max_iterations: 2,
+                ..Options::default()
+            },
+            None,
+        )
+        .unwrap();
+        assert_eq!(ans.status, Status::IterationCap, "{ans:?}");
+    }
+}
+
 /// The distance after radii is never negative, so no negative margin can be
 /// "Closer" (the doc: Closer = "the upper bound proved the distance at most
 /// this margin"). A rounded cube (half extent 1, radius 1) and a unit sphere at

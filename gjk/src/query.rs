@@ -1556,13 +1556,15 @@ fn compound<const AVX2: bool>(
         large.resize(na * nb, (0.0, 0, 0));
         &mut large
     };
+    // B's pieces outside, so that each centre is placed in A's frame once;
+    // the sort below orders the pairs the same whichever way they come.
     let mut slot = order.iter_mut();
-    for i in 0..na {
-        let (oa, ca) = a.piece(i).expect("index below piece_count");
-        let centre_a = oa * ca.centroid();
-        for j in 0..nb {
-            let (ob, cb) = b.piece(j).expect("index below piece_count");
-            let centre_b = rel * (ob * cb.centroid());
+    for j in 0..nb {
+        let cb = b.convex_piece(j).expect("index below piece_count");
+        let centre_b = rel * b.piece_centre(j).expect("index below piece_count");
+        for i in 0..na {
+            let ca = a.convex_piece(i).expect("index below piece_count");
+            let centre_a = a.piece_centre(i).expect("index below piece_count");
             let gap = crate::shape::robust_norm(&(centre_b - centre_a))
                 - (ca.size() + ca.radius())
                 - (cb.size() + cb.radius());
@@ -1600,7 +1602,7 @@ fn compound<const AVX2: bool>(
     // separated: a separating axis that may prove the next pairs farther.
     let mut axis: Option<Vector3<f64>> = None;
     for (k, &(gap, i, j)) in order.iter().enumerate() {
-        let cutoff = best.map_or(f64::INFINITY, |b| b.upper);
+        let cutoff = best.as_ref().map_or(f64::INFINITY, |b| b.upper);
         // The sphere bound is rough (no slack): only skip on a clear margin.
         if gap > cutoff * (1.0 + 1e-9) + f64::MIN_POSITIVE {
             continue;
@@ -1650,7 +1652,9 @@ fn compound<const AVX2: bool>(
             trouble = Some(status);
         }
         // Only a pair that becomes the best is turned into an answer.
-        let better = best.is_none_or(|b| (pair_upper, pair_distance) < (b.upper, b.distance));
+        let better = best
+            .as_ref()
+            .is_none_or(|b| (pair_upper, pair_distance) < (b.upper, b.distance));
         if better || status == Status::Closer {
             let answer = pair.answer(
                 &run,

@@ -554,6 +554,10 @@ impl Convex {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Compound {
     pieces: Vec<(Isometry3<f64>, Convex)>,
+    /// Each piece's centroid in the compound's body frame (its offset applied),
+    /// for the sphere bounds that order a query's piece pairs: computed once
+    /// here instead of on every query.
+    centres: Vec<Point3<f64>>,
 }
 
 impl Compound {
@@ -582,7 +586,8 @@ impl Compound {
         {
             return Err(Error::NonFinitePose);
         }
-        Ok(Self { pieces })
+        let centres = pieces.iter().map(|(o, c)| o * c.centroid()).collect();
+        Ok(Self { pieces, centres })
     }
 
     /// The pieces with their offsets, in the order given; the answer's piece
@@ -607,6 +612,16 @@ impl Shape {
         match self {
             Shape::Convex(_) => 1,
             Shape::Compound(c) => c.pieces.len(),
+        }
+    }
+
+    /// Piece `i`'s centroid in the shape's body frame: its offset applied,
+    /// the same point, bit for bit, as `offset * centroid` (computed once).
+    #[inline]
+    pub(crate) fn piece_centre(&self, i: usize) -> Option<Point3<f64>> {
+        match self {
+            Shape::Convex(c) => (i == 0).then(|| c.centroid()),
+            Shape::Compound(c) => c.centres.get(i).copied(),
         }
     }
 

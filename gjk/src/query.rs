@@ -470,8 +470,7 @@ fn distance_of<const AVX2: bool>(
             (pair.answer(&run, simplex, place, [0, 0]), stuck)
         }
         _ => {
-            let (answer, stuck) =
-                compound::<AVX2>(&mut workspace.simplex, a, pose_a, b, &rel, options, warm);
+            let (answer, stuck) = compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
             (answer, if swapped { f64::INFINITY } else { stuck })
         }
     };
@@ -1499,6 +1498,7 @@ impl<'s> Pair<'s> {
 /// best pair's normal is a good one for the pieces beside it, and costs two
 /// support searches where running the pair costs a set-up and an iteration
 /// at least. NaN (from a NaN axis) passes no cutoff, so it skips nothing.
+#[inline(always)]
 fn axis_gap(
     ca: &Convex,
     oa: &Isometry3<f64>,
@@ -1534,16 +1534,66 @@ fn axis_gap(
 /// gap along the best pair's normal, [`axis_gap`]) does not run at all.
 /// With the answer, the interval width beyond which it counts as stuck (see
 /// [`second_opinion`]).
-#[allow(clippy::too_many_arguments)]
+///
+/// Out of line, in the query's compiled form (see [`distance_avx2`]): a
+/// function of its own is compiled for the baseline CPU unless it carries
+/// the target features itself, and the piece pairs' runs inlined here took
+/// 5 % more instructions in SSE2 code.
+#[inline(always)]
 fn compound<const AVX2: bool>(
     simplex: &mut Simplex,
-    a: &Shape,
-    pose_a: &Isometry3<f64>,
-    b: &Shape,
+    query: &Query<'_>,
     rel: &Isometry3<f64>,
-    options: &Options,
     warm: Option<&WarmStart>,
 ) -> (Answer, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: as in `subalgorithm`.
+        return unsafe { compound_avx2(simplex, query, rel, warm) };
+    }
+    compound_base(simplex, query, rel, warm)
+}
+
+/// [`compound_of`] for any CPU.
+#[inline(never)]
+fn compound_base(
+    simplex: &mut Simplex,
+    query: &Query<'_>,
+    rel: &Isometry3<f64>,
+    warm: Option<&WarmStart>,
+) -> (Answer, f64) {
+    compound_of::<false>(simplex, query, rel, warm)
+}
+
+/// [`compound_of`] compiled for AVX2 and FMA (see [`distance_avx2`]); out
+/// of line, so that the convex pair's path around its call stays as it was.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn compound_avx2(
+    simplex: &mut Simplex,
+    query: &Query<'_>,
+    rel: &Isometry3<f64>,
+    warm: Option<&WarmStart>,
+) -> (Answer, f64) {
+    compound_of::<true>(simplex, query, rel, warm)
+}
+
+/// The body of [`compound`], inlined into each of its compiled forms.
+#[inline(always)]
+fn compound_of<const AVX2: bool>(
+    simplex: &mut Simplex,
+    query: &Query<'_>,
+    rel: &Isometry3<f64>,
+    warm: Option<&WarmStart>,
+) -> (Answer, f64) {
+    let &Query {
+        a,
+        pose_a,
+        b,
+        options,
+        ..
+    } = query;
     let (na, nb) = (a.piece_count(), b.piece_count());
     // Piece pairs with their sphere gaps: on the stack for the usual few
     // pieces, so a query allocates nothing.

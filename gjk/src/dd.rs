@@ -1,5 +1,6 @@
 //! Double-double arithmetic for the one place it is needed: the offset between
-//! two centroids when a body frame sits far from its vertices. There the pose
+//! two centroids when a body frame (or a compound's piece frame) sits far
+//! from its vertices. There the pose
 //! translation and the rotated centroid are both huge and cancel, and plain
 //! f64 would lose the digits the distance is made of.
 
@@ -57,6 +58,16 @@ impl Dd {
         }
     }
 
+    fn mul_dd(self, b: Dd) -> Dd {
+        let p = two_prod(self.hi, b.hi);
+        let lo = p.lo + (self.hi * b.lo + self.lo * b.hi);
+        let hi = p.hi + lo;
+        Dd {
+            hi,
+            lo: lo - (hi - p.hi),
+        }
+    }
+
     fn scale2(self) -> Dd {
         Dd {
             hi: 2.0 * self.hi,
@@ -72,10 +83,41 @@ fn one() -> Dd {
 /// `pose * c` in double-double, the rotation matrix formed from the quaternion
 /// in double-double too.
 fn place(pose: &Isometry3<f64>, c: &Point3<f64>) -> [Dd; 3] {
+    let r = matrix(pose);
+    let t = pose.translation.vector;
+    [0, 1, 2].map(|i| {
+        (0..3).fold(Dd { hi: t[i], lo: 0.0 }, |acc, j| {
+            acc.add(r[i][j].mul(c[j]))
+        })
+    })
+}
+
+/// `pose * c` for a point `c` already in double-double.
+fn place_dd(pose: &Isometry3<f64>, c: &[Dd; 3]) -> [Dd; 3] {
+    let r = matrix(pose);
+    let t = pose.translation.vector;
+    [0, 1, 2].map(|i| {
+        (0..3).fold(Dd { hi: t[i], lo: 0.0 }, |acc, j| {
+            acc.add(r[i][j].mul_dd(c[j]))
+        })
+    })
+}
+
+/// `pose * (offset * c)`, or `pose * c` without an offset, in double-double.
+fn place_in(pose: &Isometry3<f64>, offset: Option<&Isometry3<f64>>, c: &Point3<f64>) -> [Dd; 3] {
+    match offset {
+        Some(o) => place_dd(pose, &place(o, c)),
+        None => place(pose, c),
+    }
+}
+
+/// The rotation matrix of `pose`, formed from its quaternion in
+/// double-double.
+fn matrix(pose: &Isometry3<f64>) -> [[Dd; 3]; 3] {
     let q = pose.rotation.quaternion();
     let (x, y, z, w) = (q.i, q.j, q.k, q.w);
     let sq = |a: f64, b: f64| two_prod(a, a).add(two_prod(b, b));
-    let r = [
+    [
         [
             one().add(sq(y, z).scale2().neg()),
             two_prod(x, y).add(two_prod(z, w).neg()).scale2(),
@@ -91,23 +133,21 @@ fn place(pose: &Isometry3<f64>, c: &Point3<f64>) -> [Dd; 3] {
             two_prod(y, z).add(two_prod(x, w)).scale2(),
             one().add(sq(x, y).scale2().neg()),
         ],
-    ];
-    let t = pose.translation.vector;
-    [0, 1, 2].map(|i| {
-        (0..3).fold(Dd { hi: t[i], lo: 0.0 }, |acc, j| {
-            acc.add(r[i][j].mul(c[j]))
-        })
-    })
+    ]
 }
 
-/// `pose_b * cb - pose_a * ca` in world coordinates, rounded once at the end.
+/// `pose_b * (offset_b * cb) - pose_a * (offset_a * ca)` in world
+/// coordinates (without an offset, `pose * c`), rounded once at the end.
 pub(crate) fn centroid_gap(
-    pose_a: &Isometry3<f64>,
+    (pose_a, offset_a): (&Isometry3<f64>, Option<&Isometry3<f64>>),
     ca: &Point3<f64>,
-    pose_b: &Isometry3<f64>,
+    (pose_b, offset_b): (&Isometry3<f64>, Option<&Isometry3<f64>>),
     cb: &Point3<f64>,
 ) -> Vector3<f64> {
-    let (a, b) = (place(pose_a, ca), place(pose_b, cb));
+    let (a, b) = (
+        place_in(pose_a, offset_a, ca),
+        place_in(pose_b, offset_b, cb),
+    );
     Vector3::from_fn(|i, _| {
         let d = b[i].add(a[i].neg());
         d.hi + d.lo
@@ -125,7 +165,12 @@ mod tests {
         let c = Point3::new(1e9, -2e9, 0.5e9);
         let pa = Isometry3::from_parts(Translation3::from(-(rot * c.coords)), rot);
         // World centroid of A: pa * c = 0 up to the rounding of the translation.
-        let gap = centroid_gap(&pa, &c, &Isometry3::identity(), &Point3::new(1.5, 0.0, 0.0));
+        let gap = centroid_gap(
+            (&pa, None),
+            &c,
+            (&Isometry3::identity(), None),
+            &Point3::new(1.5, 0.0, 0.0),
+        );
         let naive = Point3::new(1.5, 0.0, 0.0) - pa * c;
         // The translation was itself rounded, so the true residue is what the
         // exact product leaves; double-double sees it, plain f64 does not.

@@ -454,12 +454,16 @@ fn distance_of<const AVX2: bool>(
     // the other way round (see `second_opinion`).
     let (answer, stuck) = match (a, b) {
         (Shape::Convex(ca), Shape::Convex(cb)) => {
-            let pair = Pair::new(ca, cb, &rel, Some((pose_a, pose_b)), options.precision);
-            let simplex = &mut workspace.simplex;
             let place = Place {
                 pose: pose_a,
                 offset: None,
             };
+            let place_b = Place {
+                pose: pose_b,
+                offset: None,
+            };
+            let pair = Pair::new(ca, cb, &rel, (place, place_b), options.precision);
+            let simplex = &mut workspace.simplex;
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
             let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
             let stuck = if swapped {
@@ -625,6 +629,25 @@ struct Pair<'s> {
     single_slack: f64,
 }
 
+/// B's centroid minus A's in A's piece frame, the centroids placed in the
+/// world in double-double (see `crate::dd`): for a frame far from its
+/// vertices, where the f64 offset would cancel.
+#[inline(always)]
+fn exact_centroid_gap(
+    (pa, pb): (Place<'_>, Place<'_>),
+    ca: &Point3<f64>,
+    cb: &Point3<f64>,
+) -> Vector3<f64> {
+    let gap = crate::dd::centroid_gap((pa.pose, pa.offset), ca, (pb.pose, pb.offset), cb);
+    // Into A's piece frame: the gap is small, so the rotation's rounding
+    // costs only ε of it.
+    let rotation = match pa.offset {
+        Some(o) => pa.pose.rotation * o.rotation,
+        None => pa.pose.rotation,
+    };
+    rotation.inverse_transform_vector(&gap)
+}
+
 /// `R·z`, each component `(r_i0·z_0 + r_i1·z_1) + r_i2·z_2`: nalgebra's
 /// product term for term and in its order, so bit for bit the same, written
 /// out so that the hot loop keeps it in scalar registers.
@@ -736,15 +759,15 @@ enum Exit {
 }
 
 impl<'s> Pair<'s> {
-    /// The pair at relative pose `rel = A⁻¹·B`. `world`, when given, holds the
-    /// two poses themselves, for the exact centroid offset of a body frame far
-    /// from its vertices.
+    /// The pair at relative pose `rel = A⁻¹·B`. `world` holds where each
+    /// piece sits (its shape's pose and a compound piece's offset), for the
+    /// exact centroid offset of a frame far from its vertices.
     #[inline(always)]
     fn new(
         a: &'s Convex,
         b: &'s Convex,
         rel: &Isometry3<f64>,
-        world: Option<(&Isometry3<f64>, &Isometry3<f64>)>,
+        world: (Place<'_>, Place<'_>),
         precision: Precision,
     ) -> Self {
         let r = *rel.rotation.to_rotation_matrix().matrix();
@@ -755,13 +778,10 @@ impl<'s> Pair<'s> {
         // taken in world coordinates in double-double and rotated once.
         let (na, nb) = (a.centroid_norm(), b.centroid_norm());
         let far = na + nb > 16.0 * (a.size() + b.size());
-        let (t, exact) = match world {
-            Some((pa, pb)) if far => (
-                pa.rotation
-                    .inverse_transform_vector(&crate::dd::centroid_gap(pa, &ca, pb, &cb)),
-                true,
-            ),
-            _ => (rb + rel.translation.vector - ca.coords, false),
+        let (t, exact) = if far {
+            (exact_centroid_gap(world, &ca, &cb), true)
+        } else {
+            (rb + rel.translation.vector - ca.coords, false)
         };
         // The run works in a frame scaled by a power of two that brings the
         // pair's sizes near 1: exact (every result is the unscaled one times
@@ -1591,6 +1611,7 @@ fn compound_of<const AVX2: bool>(
         a,
         pose_a,
         b,
+        pose_b,
         options,
         ..
     } = query;
@@ -1658,15 +1679,28 @@ fn compound_of<const AVX2: bool>(
             continue;
         }
         let (oa, ca) = a.piece(i as usize).expect("index below piece_count");
-        let (ob, cb) = b.piece(j as usize).expect("index below piece_count");
-        let ob = rel * ob;
+        let (offset_b, cb) = b.piece(j as usize).expect("index below piece_count");
+        let ob = rel * offset_b;
         if let Some(n) = &axis
             && axis_gap(ca, &oa, cb, &ob, n) > cutoff * (1.0 + 1e-9)
         {
             continue;
         }
         let piece_rel = oa.inv_mul(&ob);
-        let pair = Pair::new(ca, cb, &piece_rel, None, options.precision);
+        // Each piece's place in the world, for a piece far from its own
+        // frame's origin (see `Pair::new`); a convex shape's identity
+        // offset places its centroid exactly.
+        let world = (
+            Place {
+                pose: pose_a,
+                offset: Some(&oa),
+            },
+            Place {
+                pose: pose_b,
+                offset: Some(&offset_b),
+            },
+        );
+        let pair = Pair::new(ca, cb, &piece_rel, world, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
         let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, cutoff);
         let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);

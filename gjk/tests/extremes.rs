@@ -11,7 +11,7 @@
 mod common;
 
 use common::{P, V, aabb_distance, p, v};
-use gjk::{Answer, Convex, Options, Precision, Shape, Status, distance};
+use gjk::{Answer, Compound, Convex, Options, Precision, Shape, Status, distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 struct Case {
@@ -372,6 +372,65 @@ fn body_frame_far_from_vertices() {
                 truth,
                 2.0,
             ));
+        }
+    }
+    run(&cases);
+}
+
+/// Unions whose pieces sit far from their own frames (vertices at 1e6 and
+/// 1e9, a box of size 2e-3 there), as meshes given in a scene's coordinates
+/// do: each body is a one-piece union, the piece at the same offset (none, or
+/// turned and moved) and both bodies at the same pose, so that the truth is
+/// the gap in the piece frame, exactly. The piece pairs once took the
+/// centroids' offset in f64, which lost ε times 1e6 to cancellation: 2.3e-10
+/// off a gap of 1.2e-10, against a requirement of 3.9e-12, in [0, 2.8e-8].
+/// They now take it in double-double, as a convex shape's far body frame does.
+#[test]
+fn union_pieces_far_from_their_frames() {
+    let h = 2f64.powi(-10);
+    let boxed = |x0: f64, x1: f64| -> Convex {
+        let corner = |i: usize| {
+            let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
+            p(pick(1, x0, x1), pick(2, -h, h), pick(4, -h, h))
+        };
+        Convex::new((0..8).map(corner).collect::<Vec<P>>(), 0.0).unwrap()
+    };
+    let offsets = [
+        Isometry3::identity(),
+        Isometry3::from_parts(
+            Translation3::new(5e2, -3e2, 1e2),
+            UnitQuaternion::from_euler_angles(0.4, -1.1, 0.25),
+        ),
+    ];
+    let mut cases = Vec::new();
+    for c in [1e6f64, 1e9] {
+        // Gaps of whole units in the last place of the coordinates, so that
+        // the boxes are exactly as written.
+        let ulp = 2f64.powi(c.log2().floor() as i32 - 52);
+        for k in [0.0, 1.0, 8.0, 1024.0] {
+            let gap = k * ulp;
+            let (ca, cb) = (boxed(c - h, c + h), boxed(c + h + gap, c + 3.0 * h + gap));
+            for offset in offsets {
+                for rot in rotations() {
+                    for t in [v(3e2, -1e2, 5.0), v(1e6, 2e6, -3e5)] {
+                        let union = |piece: &Convex| -> Shape {
+                            Compound::new(vec![(offset, piece.clone())]).unwrap().into()
+                        };
+                        let pose = posed(t, rot);
+                        cases.push(Case::new(
+                            format!(
+                                "pieces at {c:e}, gap {gap:e}, offset {offset:?}, pose {pose:?}"
+                            ),
+                            union(&ca),
+                            pose,
+                            union(&cb),
+                            pose,
+                            gap,
+                            4.0 * h,
+                        ));
+                    }
+                }
+            }
         }
     }
     run(&cases);

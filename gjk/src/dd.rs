@@ -1,8 +1,8 @@
 //! Double-double arithmetic for the one place it is needed: the offset between
 //! two centroids when a body frame (or a compound's piece frame) sits far
-//! from its vertices. There the pose
-//! translation and the rotated centroid are both huge and cancel, and plain
-//! f64 would lose the digits the distance is made of.
+//! from its vertices. There the pose translation and the rotated centroid are
+//! both huge and cancel, and plain f64 would lose the digits the distance is
+//! made of.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 

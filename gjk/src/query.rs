@@ -629,6 +629,14 @@ struct Pair<'s> {
     single_slack: f64,
 }
 
+/// Whether `iso` is the identity, exactly.
+#[inline(always)]
+fn is_identity(iso: &Isometry3<f64>) -> bool {
+    let q = iso.rotation.coords;
+    let t = iso.translation.vector;
+    (q.w == 1.0 && q.x == 0.0 && q.y == 0.0 && q.z == 0.0) && t == Vector3::zeros()
+}
+
 /// B's centroid minus A's in A's piece frame, the centroids placed in the
 /// world in double-double (see `crate::dd`): for a frame far from its
 /// vertices, where the f64 offset would cancel.
@@ -1461,11 +1469,11 @@ impl<'s> Pair<'s> {
         // v = Σλ(a_i - b_i) with the same weights. One placement serves both,
         // and their gap is v itself, not the difference of two placements.
         let (rot, shift) = match off_a {
-            Some(o) => (
+            Some(o) if !is_identity(o) => (
                 pose_a.rotation * o.rotation,
                 pose_a.rotation * o.translation.vector + pose_a.translation.vector,
             ),
-            None => (pose_a.rotation, pose_a.translation.vector),
+            _ => (pose_a.rotation, pose_a.translation.vector),
         };
         let core_a = Point3::from(rot * (self.a.centroid().coords + wa) + shift);
         // b - a = -v, in world coordinates.
@@ -1680,13 +1688,23 @@ fn compound_of<const AVX2: bool>(
         }
         let (oa, ca) = a.piece(i as usize).expect("index below piece_count");
         let (offset_b, cb) = b.piece(j as usize).expect("index below piece_count");
-        let ob = rel * offset_b;
+        // An identity offset (a convex shape's, or a piece placed at its
+        // compound's origin) changes nothing, to the bit: skip its products.
+        let ob = if is_identity(&offset_b) {
+            *rel
+        } else {
+            rel * offset_b
+        };
         if let Some(n) = &axis
             && axis_gap(ca, &oa, cb, &ob, n) > cutoff * (1.0 + 1e-9)
         {
             continue;
         }
-        let piece_rel = oa.inv_mul(&ob);
+        let piece_rel = if is_identity(&oa) {
+            ob
+        } else {
+            oa.inv_mul(&ob)
+        };
         // Each piece's place in the world, for a piece far from its own
         // frame's origin (see `Pair::new`); a convex shape's identity
         // offset places its centroid exactly.

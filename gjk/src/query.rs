@@ -1671,6 +1671,9 @@ fn compound_of<const AVX2: bool>(
     let mut backup_used = false;
     let mut penetration = 0.0f64;
     let mut trouble: Option<Status> = None;
+    // Whether a pair stopped on the margin before converging: only then is
+    // the union's answer an early exit rather than a converged one.
+    let mut early = false;
     // The widest interval a pair run to its end may have before the union's
     // answer is called stuck: the largest `stuck_width` among those pairs,
     // since every one of them may bound the union from below.
@@ -1747,6 +1750,7 @@ fn compound_of<const AVX2: bool>(
             Exit::Status(s) => s,
         };
         stuck = stuck.max(pair.stuck_width(options.tolerance));
+        early |= status == Status::Farther;
         if matches!(status, Status::IterationCap | Status::ToleranceNotMet)
             && trouble != Some(Status::ToleranceNotMet)
         {
@@ -1792,10 +1796,12 @@ fn compound_of<const AVX2: bool>(
     out.iterations = iterations;
     out.backup_used = backup_used;
     out.penetration = out.penetration.max(penetration);
-    // The margin is decided on the union's bounds, not on one pair's.
+    // The margin is decided on the union's bounds, not on one pair's. A
+    // union whose pairs all converged says so, as a convex pair that
+    // converges before its margin decides does.
     out.status = match options.margin {
         _ if out.status == Status::Closer => Status::Closer,
-        Some(m) if out.lower > m => Status::Farther,
+        Some(m) if early && out.lower > m => Status::Farther,
         _ => match trouble {
             Some(t) => t,
             None if out.status == Status::Farther => Status::Converged,

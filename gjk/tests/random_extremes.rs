@@ -1169,3 +1169,67 @@ fn unions_of_many_pieces_keep_the_truth() {
     }
     none_failed(&failed);
 }
+
+/// A union of one piece at its compound's origin answers as the piece does,
+/// to the last bit of every field (status, points and warm start too), on
+/// either side and on both, under every option: the union's path adds
+/// nothing to a pair's answer. Before 1d6e0e8 a piece far from its frame
+/// (vertices 1e6 from it) lost the centroids' offset to f64 cancellation in a
+/// union, where the convex shape kept it in double-double; before the union's
+/// margin decision followed its pairs', a union whose pairs had converged
+/// said `Farther` where the piece alone said `Converged`.
+#[test]
+fn a_one_piece_union_answers_as_its_piece() {
+    let cases = env("SWEEP_CASES", 3000) as usize;
+    let mut rng = Rng::new(env("SWEEP_SEED", 1) ^ 0x0e1ece);
+    let mut failed = Vec::new();
+    for i in 0..cases {
+        let case = draw(&mut rng, i % 500 == 499);
+        let (a, b) = (case.a.shape(), case.b.shape());
+        let union = |body: &sweep::Body| -> gjk::Shape {
+            let piece = gjk::Convex::new(body.vertices.clone(), body.radius).unwrap();
+            gjk::Compound::new(vec![(nalgebra::Isometry3::identity(), piece)])
+                .unwrap()
+                .into()
+        };
+        let (ua, ub) = (union(&case.a), union(&case.b));
+        let d = Options::default();
+        let options = [
+            d,
+            Options {
+                tolerance: 1e-6,
+                ..d
+            },
+            Options {
+                max_iterations: 2,
+                ..d
+            },
+            Options {
+                margin: Some(0.5 * case.truth),
+                ..d
+            },
+            Options {
+                margin: Some(case.truth + 1e-3 * case.size),
+                ..d
+            },
+        ];
+        let o = &options[i % options.len()];
+        let alone = distance(&a, &case.pa, &b, &case.pb, o, None);
+        for (how, x, y) in [("A", &ua, &b), ("B", &a, &ub), ("both", &ua, &ub)] {
+            let asked = distance(x, &case.pa, y, &case.pb, o, None);
+            if format!("{asked:?}") != format!("{alone:?}") {
+                failed.push(format!(
+                    "{} ({how} a union, {o:?}):\n  piece {alone:?}\n  union {asked:?}",
+                    case.describe()
+                ));
+            }
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "{} of {} answers differ:\n{}",
+        failed.len(),
+        3 * cases,
+        failed.join("\n")
+    );
+}

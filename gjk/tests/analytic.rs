@@ -91,6 +91,92 @@ fn reference_triangle_point_stays_on_a_sliver() {
     }
 }
 
+/// Property seed 8712: a segment meeting a triangle of size 1e-2 within
+/// 1e-15 of its border, in world coordinates as the property test forms them.
+/// Over these f64 points the segment meets the triangle (rational arithmetic,
+/// Python `fractions`): the truth is 0. No axis gap decides it and the
+/// nearest vertex, edge and triangle pairs are 1.3e-15 apart in f64, which the
+/// reference took for the distance until it asked exact orientation
+/// predicates whether a segment of one set meets a triangle of the other.
+#[test]
+fn reference_sees_a_segment_meeting_a_triangle_at_its_border() {
+    let seg_end = p(
+        0.011403511547707272,
+        0.008526607285277505,
+        -0.017933667927162455,
+    );
+    let a = [
+        p(
+            0.014199311081814839,
+            0.000335742027556863,
+            -0.012201220226457655,
+        ),
+        seg_end,
+        seg_end,
+    ];
+    let b = [
+        p(
+            0.006405027855799991,
+            -0.006141172505594758,
+            -0.012292973017363332,
+        ),
+        p(
+            0.0067224512215572916,
+            -0.005455698286760175,
+            -0.012227261740608501,
+        ),
+        p(
+            0.018526150049322176,
+            0.003727126980333957,
+            -0.01218028713881628,
+        ),
+    ];
+    assert_eq!(hull_distance(&a, &b).distance, 0.0);
+    assert_eq!(hull_distance(&b, &a).distance, 0.0);
+    // GJK on the same points, in the world frame: its interval holds 0.
+    let ans = query(
+        &convex(&a, 0.0),
+        &iso(0., 0., 0.),
+        &convex(&b, 0.0),
+        &iso(0., 0., 0.),
+    );
+    assert_eq!(ans.lower, 0.0, "{ans:?}");
+    assert!(ans.distance <= 1e-15, "{ans:?}");
+}
+
+/// The same case at scale 1e-3: the segment's end lies 6.356e-20 above the
+/// thin triangle's plane, over it (rational arithmetic). The reference's
+/// projection, weights solved once from the Gram system, put it 1.3e-16
+/// away; one refinement step on the residual brings it to round-off.
+#[test]
+fn reference_point_above_a_thin_triangle() {
+    let x = p(
+        0.0014199311081814839,
+        3.3574202755686346e-5,
+        -0.0012201220226457656,
+    );
+    let (a, b, c) = (
+        p(
+            0.0006405027855799991,
+            -0.0006141172505594758,
+            -0.0012292973017363333,
+        ),
+        p(
+            0.000672245122155729,
+            -0.0005455698286760174,
+            -0.00122272617406085,
+        ),
+        p(
+            0.0018526150049322171,
+            0.0003727126980333957,
+            -0.0012180287138816278,
+        ),
+    );
+    let truth = 6.356440386617582e-20;
+    let d = (closest_on_triangle(&x, &a, &b, &c) - x).norm();
+    assert!((d - truth).abs() <= 1e-18, "{d:e} against {truth:e}");
+}
+
 #[test]
 fn reference_matches_closed_forms() {
     // Unit cubes, one containing the other: 0 (no feature pair is at 0).

@@ -103,6 +103,8 @@
 
 #![warn(missing_docs)]
 
+mod open_failure;
+
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
@@ -111,6 +113,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
 use nalgebra::{Isometry3, Point3, Vector3};
+use open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 
 pub use gjkd_proto::{
     AdminOp, Answer, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemResult, MAX_NAME_LEN,
@@ -154,6 +157,40 @@ pub enum ClientError {
     /// (different protocol version or a broken server).
     #[error("protocol error: {0}")]
     Protocol(String),
+    /// A server serves this name, but with another protocol version than
+    /// this client's ([`PROTOCOL_VERSION`](gjkd_proto::PROTOCOL_VERSION)):
+    /// client and server come from different gjkd releases. Retrying does not
+    /// help; use a client of the server's release, or start a server of
+    /// this one's.
+    #[error(
+        "the server on `{service}` speaks protocol version {server}, this client speaks {client}"
+    )]
+    VersionMismatch {
+        /// The service name asked for.
+        service: String,
+        /// The protocol version of the server found on that name.
+        server: u32,
+        /// This client's protocol version.
+        client: u32,
+    },
+    /// A service of this name exists but cannot be opened by this client:
+    /// it was made by another program, another build of gjkd (other message
+    /// types or limits), or another iceoryx2 version. The cause names which.
+    #[error("the service `{service}` is incompatible with this client: {cause}")]
+    Incompatible {
+        /// The iceoryx2 service that could not be opened.
+        service: String,
+        /// What iceoryx2 found different.
+        cause: String,
+    },
+    /// The service belongs to another user and this process may not open
+    /// it: run client and server as the same user, or see the README's
+    /// "Access" section for sharing a server across users.
+    #[error("no permission to open the service `{0}` (it belongs to another user)")]
+    PermissionDenied(String),
+    /// The server already has as many client processes as it admits.
+    #[error("the service `{0}` admits no more clients")]
+    TooManyClients(String),
     /// iceoryx2 failed locally (shared memory, permissions, limits).
     #[error("iceoryx2: {0}")]
     Ipc(String),
@@ -282,7 +319,11 @@ impl ClientBuilder {
     ///
     /// # Errors
     /// [`ClientError::ServerGone`] if no server serves the name within the
-    /// timeout, [`ClientError::Ipc`] if iceoryx2 cannot set up this process.
+    /// timeout; [`ClientError::VersionMismatch`],
+    /// [`ClientError::Incompatible`], [`ClientError::PermissionDenied`] or
+    /// [`ClientError::TooManyClients`] at once if a service of that name
+    /// exists but this client cannot use it; [`ClientError::Ipc`] if
+    /// iceoryx2 cannot set up this process.
     pub fn connect(self) -> Result<Client, ClientError> {
         let node = NodeBuilder::new()
             .name(&NodeName::new("gjkd-client").map_err(ipc_err("node name"))?)
@@ -458,6 +499,44 @@ impl Client {
         ClientError::ServerGone(self.service.clone())
     }
 
+    /// The error for a service that could not be opened. A missing service
+    /// is a server not (yet) there, unless a server of another protocol
+    /// version serves the name: then waiting would never help.
+    fn open_failed(&self, service: &str, cause: OpenFailure) -> ClientError {
+        match cause {
+            OpenFailure::Missing => {
+                let ours = [
+                    query_service_name(&self.service),
+                    admin_service_name(&self.service),
+                    wake_service_name(&self.service),
+                ];
+                match name_taken_by(&self.service, ours.each_ref().map(String::as_str)) {
+                    Some(NameTakenBy::Version(server)) => ClientError::VersionMismatch {
+                        service: self.service.clone(),
+                        server,
+                        client: gjkd_proto::PROTOCOL_VERSION,
+                    },
+                    Some(NameTakenBy::OtherPattern { name, pattern }) => {
+                        ClientError::Incompatible {
+                            service: name,
+                            cause: format!(
+                                "a {pattern} service, not gjkd's (another program uses the name?)"
+                            ),
+                        }
+                    }
+                    None => self.gone(),
+                }
+            }
+            OpenFailure::Incompatible(cause) => ClientError::Incompatible {
+                service: service.to_owned(),
+                cause,
+            },
+            OpenFailure::Permission => ClientError::PermissionDenied(service.to_owned()),
+            OpenFailure::Full => ClientError::TooManyClients(service.to_owned()),
+            OpenFailure::Other(cause) => ClientError::Ipc(format!("open `{service}`: {cause}")),
+        }
+    }
+
     /// Opens the services and says hello. Drops any previous connection.
     /// `cleanup` first removes what dead processes left behind: a killed
     /// server's services linger until someone does, and a restarted server
@@ -475,20 +554,20 @@ impl Client {
             .request_response::<[Item], [ItemResult]>()
             .response_user_header::<ReplyHeader>()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&query_service_name(&self.service), e.into()))?;
         let admin_service = self
             .node
             .service_builder(&name(admin_service_name(&self.service))?)
             .request_response::<[Vertex], AdminReply>()
             .request_user_header::<AdminRequest>()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&admin_service_name(&self.service), e.into()))?;
         let wake_service = self
             .node
             .service_builder(&name(wake_service_name(&self.service))?)
             .event()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&wake_service_name(&self.service), e.into()))?;
         if query_service.dynamic_config().number_of_servers() == 0
             || admin_service.dynamic_config().number_of_servers() == 0
         {

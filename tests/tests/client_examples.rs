@@ -38,10 +38,12 @@ fn examples_dir() -> &'static PathBuf {
     })
 }
 
-/// Runs one example against `server` and returns its stdout.
+/// Runs one example against `server` and returns its stdout, after checking
+/// that iceoryx2's notice about its missing config file stayed quiet.
 fn run(example: &str, server: &Server) -> String {
     let output = Command::new(examples_dir().join(example))
         .arg(&server.service)
+        .env_remove("IOX2_LOG_LEVEL")
         .output()
         .unwrap_or_else(|e| panic!("start example {example}: {e}"));
     let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
@@ -50,6 +52,11 @@ fn run(example: &str, server: &Server) -> String {
         "example {example} failed ({}):\n{stdout}\n{}",
         output.status,
         String::from_utf8_lossy(&output.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !stderr.contains("No config file"),
+        "iceoryx2's notice reached the example's stderr:\n{stderr}"
     );
     stdout
 }

@@ -479,8 +479,8 @@ const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
 const YIELD_FOR: Duration = Duration::from_millis(2);
 /// While busy-polling, give the core away this often: a server the kernel
-/// woke onto this core cannot answer while the client holds it (on a busy
-/// 2-core machine that made a client spin out its whole 100 µs).
+/// woke onto this core cannot answer while the client holds it, and on a
+/// machine with few cores the client would spin out its whole `SPIN_FOR`.
 const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {

@@ -535,12 +535,17 @@ impl Client {
     fn open_failed(&self, service: &str, cause: OpenFailure) -> ClientError {
         match cause {
             OpenFailure::Missing => {
-                let ours = [
+                let (query, admin, wake) = (
                     query_service_name(&self.service),
                     admin_service_name(&self.service),
                     wake_service_name(&self.service),
+                );
+                let ours = [
+                    (query.as_str(), false),
+                    (admin.as_str(), false),
+                    (wake.as_str(), true),
                 ];
-                match name_taken_by(&self.service, ours.each_ref().map(String::as_str)) {
+                match name_taken_by(&self.service, ours) {
                     Some(NameTakenBy::Version(server)) => ClientError::VersionMismatch {
                         service: self.service.clone(),
                         server,

@@ -2,8 +2,10 @@
 //!
 //! The gjkd distance server as a library: the object store and its request
 //! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
-//! ([`scene`]), the state file that keeps objects across crashes
-//! ([`persist`]), the iceoryx2 serving loop ([`server`]), the built-in demo
+//! ([`scene`]), the database that keeps objects across crashes
+//! ([`database`], with the stored form of objects in [`stored`] and the
+//! migration of the old state file in [`legacy`]), the pose journal
+//! ([`journal`]), the iceoryx2 serving loop ([`server`]), the built-in demo
 //! ([`demo`]) and the measurements of `gjkd bench` ([`bench`](mod@bench)). The `gjkd`
 //! binary is a thin command line over these.
 //!
@@ -34,10 +36,12 @@
 
 pub mod bench;
 pub mod cache;
+pub mod database;
 pub mod demo;
 pub mod journal;
+pub mod legacy;
 pub mod objects;
-pub mod persist;
 pub mod scene;
 pub mod server;
 pub mod state;
+pub mod stored;

@@ -294,10 +294,10 @@ pub fn run(
     if let Err(e) = state.flush() {
         error!("cannot sync the pose journal: {e}");
     }
-    // One snapshot write, so that the next start reads a single file; if it
-    // fails, nothing is lost: the log still holds every change.
-    if let Err(e) = state.compact() {
-        error!("cannot fold the change log into the state file: {e}");
+    // The current poses into the database, so that the next start needs
+    // no journal; if it fails, nothing is lost: the journal has them.
+    if let Err(e) = state.persist() {
+        error!("cannot write the current poses into the database: {e}");
     }
     // Ports, services and the node are dropped here, in reverse order of
     // creation, which removes the services' shared memory.

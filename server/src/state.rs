@@ -15,8 +15,9 @@ use gjkd_proto::{
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use crate::cache::{FxBuild, PairKey, WarmCache};
+use crate::database::{Database, StoreError};
 use crate::journal::Journal;
-use crate::persist::{Change, Snapshot, Store, StoredObject, StoredOwner, StoredPose, StoredShape};
+use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredPose, StoredShape};
 
 /// Limits the server enforces, also used to size the iceoryx2 services.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,9 +59,9 @@ impl Default for Limits {
 /// A client is identified by the id of its iceoryx2 node: one per
 /// `gjkd-client` `Client`, kept for the `Client`'s whole life, across its
 /// reconnections and across server restarts (the id is stored in the state
-/// file). A client *process* that restarts has a new node, so objects
-/// registered by its previous life can no longer be removed by anyone; they
-/// stay until the state file and its log are removed (see
+/// store). A client *process* that restarts has a new node, so objects
+/// registered by its previous life can no longer be removed by any client;
+/// the operator can (`gjkd objects --remove-departed`, see
 /// `docs/reliability.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Owner {
@@ -99,17 +100,17 @@ pub struct State {
     names: HashMap<String, u64>,
     cache: WarmCache,
     stats: ServerStats,
-    /// Where registrations and removals are written before they are
+    /// Where registrations and removals are committed before they are
     /// acknowledged; `None` when persistence is off.
-    store: Option<Store>,
+    database: Option<Database>,
     /// Latest poses, kept where a crash of this process cannot lose them
-    /// (present when `store` is).
+    /// (present when `database` is).
     journal: Option<Journal>,
     /// Journal slots of removed objects, for reuse.
     free_slots: Vec<u32>,
     /// Lowest slot never used.
     next_slot: u32,
-    /// Writes of the state file or change log that failed.
+    /// Commits to the database and journal writes that failed.
     persist_errors: u64,
     /// Scratch memory of gjk queries, reused from one query to the next.
     workspace: gjk::Workspace,
@@ -142,7 +143,7 @@ impl State {
             names: HashMap::new(),
             cache: WarmCache::new(limits.cache_capacity),
             stats: ServerStats::default(),
-            store: None,
+            database: None,
             journal: None,
             free_slots: Vec::new(),
             next_slot: 0,
@@ -197,6 +198,36 @@ impl State {
         Ok(state)
     }
 
+    /// The state of a persisting server: the objects stored at `path`
+    /// (migrated from the old format, or none when the file is new or was
+    /// damaged and set aside, see [`Database::open`]), with persistence on.
+    /// A fresh store gets `epoch`.
+    ///
+    /// # Errors
+    /// What keeps the server from starting: the store in use by another
+    /// process, unreadable, or holding more objects than `limits` allow.
+    pub fn open(
+        limits: Limits,
+        wait: WaitMode,
+        path: &std::path::Path,
+        epoch: u32,
+    ) -> Result<Self, String> {
+        let (database, opened) = Database::open(path, epoch).map_err(|e| e.to_string())?;
+        let mut state = State::restore(limits, wait, &opened.snapshot).map_err(|e| {
+            format!(
+                "cannot restore {} ({e}); raise the limits or move the file away",
+                path.display()
+            )
+        })?;
+        if opened.fresh {
+            tracing::info!(file = %path.display(), "new object store");
+        } else {
+            tracing::info!(file = %path.display(), objects = state.len(), "objects restored");
+        }
+        state.set_database(database).map_err(|e| e.to_string())?;
+        Ok(state)
+    }
+
     /// Everything needed to rebuild this store: id counter and objects, in
     /// id order.
     pub fn snapshot(&self) -> Snapshot {
@@ -230,37 +261,36 @@ impl State {
     }
 
     /// Turns persistence on: from now on every registration and removal is
-    /// written to `store` (its change log) before it is acknowledged, and
-    /// every pose update goes to the pose journal next to it. Poses the
-    /// journal holds for the objects already here (restored from the state
-    /// file) replace theirs: they are the latest ones before a crash.
+    /// committed to `database` before it is acknowledged, and every pose
+    /// update goes to the pose journal next to it. Poses the journal holds
+    /// for the objects already here (restored from the database) replace
+    /// theirs: they are the latest ones before a crash.
     ///
     /// # Errors
     /// When the journal cannot be opened; persistence stays off then.
-    pub fn set_store(&mut self, store: Store) -> Result<(), crate::persist::StoreError> {
-        let path = crate::journal::path_for(store.path());
-        let mut journal =
-            Journal::open(&path).map_err(|source| crate::persist::StoreError::Io {
-                what: "cannot open the pose journal",
-                path: path.clone(),
-                source,
-            })?;
+    pub fn set_database(&mut self, database: Database) -> Result<(), StoreError> {
+        let path = crate::journal::path_for(database.path());
+        let mut journal = Journal::open(&path).map_err(|source| StoreError::Io {
+            what: "cannot open the pose journal",
+            path: path.clone(),
+            source,
+        })?;
         for (&id, o) in self.objects.iter_mut() {
             if let Some(pose) = journal.read(o.slot, id) {
                 o.pose = pose;
             }
         }
         for (&id, o) in &self.objects {
-            journal.write(o.slot, id, &o.pose).map_err(|source| {
-                crate::persist::StoreError::Io {
+            journal
+                .write(o.slot, id, &o.pose)
+                .map_err(|source| StoreError::Io {
                     what: "cannot write the pose journal",
                     path: path.clone(),
                     source,
-                }
-            })?;
+                })?;
         }
         self.journal = Some(journal);
-        self.store = Some(store);
+        self.database = Some(database);
         Ok(())
     }
 
@@ -277,44 +307,28 @@ impl State {
         }
     }
 
-    /// The state file, when persistence is on.
-    pub fn store(&self) -> Option<&Store> {
-        self.store.as_ref()
+    /// The database, when persistence is on.
+    pub fn database(&self) -> Option<&Database> {
+        self.database.as_ref()
     }
 
-    /// Writes the state file now (when persistence is on): a full snapshot,
-    /// which also empties the change log (compaction).
+    /// Makes the database hold exactly this store, current poses included
+    /// (when persistence is on), writing only what differs: at start after
+    /// the scene is installed, and at shutdown.
     ///
     /// # Errors
-    /// The write error; the previous file and log are then intact.
-    pub fn persist(&mut self) -> Result<(), crate::persist::StoreError> {
-        if self.store.is_none() {
+    /// The commit error; the database is then as it was.
+    pub fn persist(&mut self) -> Result<(), StoreError> {
+        if self.database.is_none() {
             return Ok(());
         }
         let snapshot = self.snapshot();
-        let Some(store) = &mut self.store else {
+        let Some(database) = &mut self.database else {
             return Ok(());
         };
-        match store.write(&snapshot) {
-            Ok(()) => Ok(()),
-            Err(e) => {
-                self.persist_errors += 1;
-                Err(e)
-            }
-        }
-    }
-
-    /// Folds the change log into the state file if it holds any change:
-    /// done at clean shutdown, so that the next start reads one file.
-    ///
-    /// # Errors
-    /// As [`State::persist`]; the log still holds every change then.
-    pub fn compact(&mut self) -> Result<(), crate::persist::StoreError> {
-        if self.store.as_ref().is_some_and(Store::has_changes) {
-            self.persist()
-        } else {
-            Ok(())
-        }
+        database.sync(&snapshot).inspect_err(|_| {
+            self.persist_errors += 1;
+        })
     }
 
     /// Asks the kernel to put the pose journal on disk if poses changed.
@@ -502,9 +516,9 @@ impl State {
     /// process ended: no client could remove them, since a restarted
     /// process gets a new identity). Scene objects stay; ids are never
     /// reused. A few are committed one by one, like a client's removals;
-    /// more than [`BULK_REMOVAL`] at once with one snapshot write, since a
+    /// more than [`BULK_REMOVAL`] at once in one transaction, since a
     /// crashed process's thousand objects would otherwise hold the request
-    /// loop for a thousand synced appends. Returns the ids removed, in id
+    /// loop for a thousand synced commits. Returns the ids removed, in id
     /// order, and the error that stopped the pass if a commit failed (the
     /// objects it concerned are kept).
     pub fn remove_departed(
@@ -520,7 +534,7 @@ impl State {
             })
             .collect();
         doomed.sort_unstable();
-        if doomed.len() > BULK_REMOVAL && self.store.is_some() {
+        if doomed.len() > BULK_REMOVAL && self.database.is_some() {
             return self.remove_in_bulk(&doomed);
         }
         let mut removed = Vec::with_capacity(doomed.len());
@@ -534,32 +548,38 @@ impl State {
     }
 
     /// [`remove_departed`](Self::remove_departed)'s many: all dropped, then
-    /// one snapshot; if it cannot be written, all put back (the previous
-    /// file and log are intact). Their warm starts go in one pass over the
-    /// cache once the snapshot is written, not in one pass per object.
+    /// one transaction; if it cannot be committed, all put back (the
+    /// database is as it was). Their warm starts go in one pass over the
+    /// cache once committed, not in one pass per object.
     fn remove_in_bulk(&mut self, doomed: &[(u64, u128)]) -> (Vec<u64>, Option<ErrorCode>) {
         let dropped: Vec<(u64, Object)> = doomed
             .iter()
             .filter_map(|&(id, _)| Some((id, self.unlink_object(id)?)))
             .collect();
-        if let Err(e) = self.persist() {
-            tracing::error!("{e}; the removals are undone");
+        let ids: Vec<u64> = dropped.iter().map(|&(id, _)| id).collect();
+        if let Err(code) = self.commit(|db| db.remove(&ids)) {
             // In reverse: each object's slot is then on top of the stack.
             for (id, object) in dropped.into_iter().rev() {
-                if self.free_slots.last() == Some(&object.slot) {
-                    self.free_slots.pop();
-                }
-                if let Some(name) = &object.name {
-                    self.names.insert(name.clone(), id);
-                }
-                self.objects.insert(id, object);
+                self.relink_object(id, object);
             }
-            return (Vec::new(), Some(ErrorCode::Internal));
+            return (Vec::new(), Some(code));
         }
-        let gone: std::collections::HashSet<u64> = dropped.iter().map(|&(id, _)| id).collect();
+        let gone: std::collections::HashSet<u64> = ids.iter().copied().collect();
         self.cache
             .retain(|k| !gone.contains(&k.a) && !gone.contains(&k.b));
-        (dropped.into_iter().map(|(id, _)| id).collect(), None)
+        (ids, None)
+    }
+
+    /// Undoes [`unlink_object`](Self::unlink_object), the last unlinked
+    /// first.
+    fn relink_object(&mut self, id: u64, object: Object) {
+        if self.free_slots.last() == Some(&object.slot) {
+            self.free_slots.pop();
+        }
+        if let Some(name) = &object.name {
+            self.names.insert(name.clone(), id);
+        }
+        self.objects.insert(id, object);
     }
 
     /// The id of the object named `name`.
@@ -717,11 +737,10 @@ impl State {
 
     /// Answers one admin request from client `requester` (the id of its
     /// iceoryx2 node, see [`Owner`]), with the request's slice payload
-    /// `vertices`. With persistence on, a registration or removal is written
-    /// to the change log (or the state file, see [`crate::persist`]) before
-    /// this returns; if the write fails the change is undone and the reply
-    /// is [`ErrorCode::Internal`], so an acknowledged change is always on
-    /// disk.
+    /// `vertices`. With persistence on, a registration or removal is
+    /// committed to the database ([`crate::database`]) before this returns;
+    /// if the commit fails the change is undone and the reply is
+    /// [`ErrorCode::Internal`], so an acknowledged change is always on disk.
     pub fn handle_admin(
         &mut self,
         requester: u128,
@@ -753,10 +772,13 @@ impl State {
                 .and_then(|new| self.insert(new, Owner::Client(requester)))
                 .and_then(|id| {
                     // Just inserted, so always there.
-                    let change = Change::Register(self.stored(id).ok_or(ErrorCode::Internal)?);
-                    self.commit(change).map(|()| id).inspect_err(|_| {
-                        self.drop_object(id);
-                    })
+                    let stored = self.stored(id).ok_or(ErrorCode::Internal)?;
+                    let next = self.next_index;
+                    self.commit(|db| db.register(&stored, next))
+                        .map(|()| id)
+                        .inspect_err(|_| {
+                            self.drop_object(id);
+                        })
                 }),
             Some(AdminOp::Remove) => self.remove_committed(request.id, requester),
             Some(AdminOp::Lookup) => match request.name() {
@@ -775,34 +797,17 @@ impl State {
 
 impl State {
     /// Makes a registration or removal durable before it is acknowledged:
-    /// appended to the change log, or, when the log is due for compaction
-    /// (or there is none), written as a full snapshot, which holds the
-    /// change as well. The error is what the client is told if neither
-    /// works; the caller then undoes the change.
-    fn commit(&mut self, change: Change) -> Result<(), ErrorCode> {
-        let Some(store) = &self.store else {
+    /// `write` commits it to the database (when persistence is on). The
+    /// error is what the client is told if that fails; the caller then
+    /// undoes the change.
+    fn commit(
+        &mut self,
+        write: impl FnOnce(&mut Database) -> Result<(), StoreError>,
+    ) -> Result<(), ErrorCode> {
+        let Some(database) = &mut self.database else {
             return Ok(());
         };
-        if store.wants_compaction() {
-            match self.persist() {
-                Ok(()) => return Ok(()),
-                // The snapshot is still the old one and the log intact, so
-                // the change can still go to the log: a compaction that
-                // fails (a full disk has room for a record, not a copy of
-                // the store) does not cost the client its request.
-                Err(e) if self.store.as_ref().is_some_and(Store::can_append) => {
-                    tracing::error!("{e}; compaction postponed, the change is appended");
-                }
-                Err(e) => {
-                    tracing::error!("{e}; the change is undone");
-                    return Err(ErrorCode::Internal);
-                }
-            }
-        }
-        let Some(store) = &mut self.store else {
-            return Ok(());
-        };
-        store.append(&change).map_err(|e| {
+        write(database).map_err(|e| {
             self.persist_errors += 1;
             tracing::error!("{e}; the change is undone");
             ErrorCode::Internal
@@ -819,22 +824,16 @@ impl State {
         let Some(object) = self.drop_object(id) else {
             return Err(ErrorCode::UnknownObject);
         };
-        if let Err(e) = self.commit(Change::Remove(id)) {
-            if self.free_slots.last() == Some(&object.slot) {
-                self.free_slots.pop();
-            }
-            if let Some(name) = &object.name {
-                self.names.insert(name.clone(), id);
-            }
-            self.objects.insert(id, object);
+        if let Err(e) = self.commit(|db| db.remove(&[id])) {
+            self.relink_object(id, object);
             return Err(e);
         }
         Ok(id)
     }
 }
 
-/// Most objects of departed clients removed one committed record at a time;
-/// beyond, [`State::remove_departed`] writes one snapshot instead.
+/// Most objects of departed clients removed one committed transaction at a
+/// time; beyond, [`State::remove_departed`] removes them all in one.
 pub const BULK_REMOVAL: usize = 16;
 
 /// The wire value of a gjk status.
@@ -1395,8 +1394,8 @@ mod tests {
         let before = one(&mut s, 1, Item::distance(ia, ib, &QueryOptions::cold()));
 
         let snap = s.snapshot();
-        let bytes = snap.encode().expect("encodes");
-        let back = crate::persist::Snapshot::decode(&bytes).expect("decodes");
+        let back = through_database("restored", &snap);
+        assert_eq!(back, snap);
         let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("valid");
         assert_eq!(r.len(), 2);
         let after = one(&mut r, 1, Item::distance(ia, ib, &QueryOptions::cold()));
@@ -1426,8 +1425,7 @@ mod tests {
         }
         let snap = s.snapshot();
         assert!(snap.objects.iter().any(|o| o.slot > 2000));
-        let bytes = snap.encode().expect("encodes");
-        let back = crate::persist::Snapshot::decode(&bytes).expect("a valid file");
+        let back = through_database("shrank", &snap);
         let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("restores");
         assert_eq!(r.len(), 10);
         // Freed slots are reused before new ones.
@@ -1524,24 +1522,36 @@ mod tests {
         dir
     }
 
+    /// `snapshot` written to a database, and read back as a restarted
+    /// server would.
+    fn through_database(tag: &str, snapshot: &Snapshot) -> Snapshot {
+        let dir = scratch(tag);
+        let path = dir.join("objects");
+        let (mut db, _) = Database::open(&path, 1).expect("create");
+        db.sync(snapshot).expect("sync");
+        drop(db);
+        let back = reload(&path);
+        let _ = std::fs::remove_dir_all(&dir);
+        back
+    }
+
     /// A state persisted in `<scratch dir>/objects`: the directory, the
-    /// state file and the state.
+    /// database file and the state.
     fn stored(tag: &str) -> (std::path::PathBuf, std::path::PathBuf, State) {
         let dir = scratch(tag);
         let path = dir.join("objects");
         let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
+        let (db, opened) = Database::open(&path, 3).expect("store");
+        assert!(opened.fresh);
+        s.set_database(db).expect("journal");
         (dir, path, s)
     }
 
     /// The store as a restarted server would load it.
-    fn reload(path: &std::path::Path) -> (Snapshot, crate::persist::Replay) {
-        let mut store = Store::open(path).expect("store");
-        match store.load_or_quarantine().expect("load") {
-            crate::persist::Loaded::Snapshot { snapshot, log } => (snapshot, log),
-            other => panic!("{other:?}"),
-        }
+    fn reload(path: &std::path::Path) -> Snapshot {
+        let (_, opened) = Database::open(path, 99).expect("reopen");
+        assert!(!opened.fresh && opened.set_aside.is_empty(), "{opened:?}");
+        opened.snapshot
     }
 
     fn register_named(s: &mut State, owner: u128, name: &str) -> u64 {
@@ -1556,8 +1566,12 @@ mod tests {
         reply.id
     }
 
-    /// More than [`BULK_REMOVAL`] objects of a departed client go with one
-    /// snapshot write: a restart sees none of them. If that write fails,
+    fn ids_of(snapshot: &Snapshot) -> Vec<u64> {
+        snapshot.objects.iter().map(|o| o.id).collect()
+    }
+
+    /// More than [`BULK_REMOVAL`] objects of a departed client go in one
+    /// transaction: a restart sees none of them. If it cannot be committed,
     /// every one of them is put back, named ones still found by name.
     #[test]
     fn a_departed_clients_many_objects_go_in_one_write_or_not_at_all() {
@@ -1593,25 +1607,20 @@ mod tests {
                 .warm_started
         );
         drop(s);
-        let (snapshot, log) = reload(&path);
-        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
-        assert_eq!(ids, vec![kept]);
-        assert_eq!(log.applied, 0, "one snapshot, no records: {log:?}");
+        assert_eq!(ids_of(&reload(&path)), vec![kept]);
 
-        // Again, with the state file's path blocked: nothing is removed.
-        let path = dir.join("again");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
-        register_box(&mut s, 1);
+        // Again, on a disk that is full: nothing is removed.
+        let _ = std::fs::remove_dir_all(&dir);
+        let (dir, path, mut s) = stored("bulk-removal-full");
+        let first = register_box(&mut s, 1);
         let doomed: Vec<u64> = (0..BULK_REMOVAL + 1)
             .map(|_| register_box(&mut s, 3))
             .collect();
         let named = register_named(&mut s, 3, "leg");
         one(&mut s, 10, pair(doomed[0], named));
         let before = s.len();
-        std::fs::remove_file(&path).expect("rm");
-        std::fs::create_dir(&path).expect("block the path");
+        let want = s.snapshot();
+        s.database().expect("db").simulate_full_disk(true);
         let (removed, failed) = s.remove_departed(|c| c == 1);
         assert_eq!((removed, failed), (vec![], Some(ErrorCode::Internal)));
         assert_eq!(s.len(), before);
@@ -1623,52 +1632,27 @@ mod tests {
                 .expect("ok")
                 .warm_started
         );
-        // Their slots are still theirs: a new object gets a fresh one.
+        // Their slots are still theirs: a new object gets a fresh one, once
+        // there is room again.
+        s.database().expect("db").simulate_full_disk(false);
         let fresh = register_box(&mut s, 1);
         let slots: std::collections::HashSet<u32> = s.objects.values().map(|o| o.slot).collect();
         assert_eq!(slots.len(), s.len(), "{fresh}: no slot shared");
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    /// A snapshot that drops objects registered since the last one, whose
-    /// change log cannot then be emptied: the old log, whose records would
-    /// bring them back at the next start, is removed instead.
-    #[test]
-    fn a_log_that_cannot_be_emptied_does_not_bring_removed_objects_back() {
-        let (dir, path, mut s) = stored("stale-log");
-        let kept = register_box(&mut s, 1);
-        // Appended to the log after the first snapshot.
-        let gone: Vec<u64> = (0..BULK_REMOVAL + 1)
-            .map(|_| register_box(&mut s, 2))
-            .collect();
-        assert!(s.store().expect("store").has_changes());
-        s.store.as_mut().expect("store").fail_log_resets();
-        let (removed, failed) = s.remove_departed(|c| c == 1);
-        assert_eq!((removed, failed), (gone, None));
         drop(s);
-        let (snapshot, log) = reload(&path);
-        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
-        assert_eq!(ids, vec![kept], "{log:?}");
+        let back = reload(&path);
+        assert_eq!(back.objects.len(), want.objects.len() + 1);
+        assert!(ids_of(&back).contains(&first) && ids_of(&back).contains(&fresh));
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    /// A commit that fails (a full disk: a real `ENOSPC` from the storage
+    /// layer) undoes the change in memory and says `Internal`; once the
+    /// disk has room again, changes are accepted without a restart.
     #[test]
     fn a_failed_write_undoes_the_change_and_says_internal() {
-        let dir = scratch("failed-write");
-        let path = dir.join("objects");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
-        // No log yet: the first change is written as a snapshot.
+        let (dir, path, mut s) = stored("failed-write");
         let kept = register_box(&mut s, 1);
-        assert!(path.exists());
-        let store = s.store().expect("store");
-        assert!(store.can_append() && !store.has_changes());
-        // The disk fills up under the log (a real ENOSPC), and a directory
-        // where the state file should be makes every rename onto it fail.
-        store.fill_disk_under_log();
-        std::fs::remove_file(&path).expect("rm");
-        std::fs::create_dir(&path).expect("block the path");
+        s.database().expect("db").simulate_full_disk(true);
         let mut req = AdminRequest::new(AdminOp::Register);
         req.shape = shape_kind::CONVEX;
         req.piece_count = 1;
@@ -1678,103 +1662,37 @@ mod tests {
         assert_eq!(reply.error_code(), ErrorCode::Internal);
         assert_eq!(s.len(), 1, "the unwritten object is not kept");
         assert_eq!(s.lookup("ghost"), None);
-        assert!(!s.store().expect("store").can_append(), "log closed");
-        // No log to append to, no snapshot can be written.
         assert_eq!(s.remove(kept, 1), Err(ErrorCode::Internal));
         assert!(s.object(kept).is_some(), "the unwritten removal is undone");
         assert_eq!(s.stats().persist_errors, 2);
-        std::fs::remove_dir(&path).expect("unblock");
-        // Written as a snapshot, which starts a fresh log...
-        assert_eq!(s.remove(kept, 1), Ok(()));
-        assert!(s.store().expect("store").can_append());
-        // ...that the next change goes to.
-        let last = register_box(&mut s, 1);
-        assert!(s.store().expect("store").has_changes());
-        drop(s);
-        let (snapshot, log) = reload(&path);
-        assert_eq!((log.applied, log.error), (1, None));
-        let ids: Vec<u64> = snapshot.objects.iter().map(|o| o.id).collect();
-        assert_eq!(ids, [last], "neither the ghost nor the removed object");
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    /// Registrations go to the log until it outgrows the snapshot (or
-    /// 64 KiB), which is then rewritten and the log emptied: the log never
-    /// gets much longer than the snapshot, so each registration writes a
-    /// bounded amount on average. A compaction that fails leaves the change
-    /// in the log instead.
-    #[test]
-    fn the_log_is_compacted_when_it_outgrows_the_snapshot() {
-        use crate::persist::{COMPACT_MIN, LOG_HEADER_LEN};
-        let dir = scratch("compaction");
-        let path = dir.join("objects");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
-        let (mut compactions, mut last_len, mut appended) = (0, 0, 0u64);
-        for _ in 0..700 {
-            register_box(&mut s, 1);
-            let store = s.store().expect("store");
-            let len = store.log_len();
-            if len < last_len {
-                compactions += 1;
-                assert_eq!(len, LOG_HEADER_LEN as u64, "emptied");
-            } else {
-                appended += len - last_len;
-            }
-            let snapshot = std::fs::metadata(&path).expect("state file").len();
-            assert!(
-                len <= snapshot.max(COMPACT_MIN) + 512,
-                "a log of {len} bytes beside a snapshot of {snapshot}"
-            );
-            last_len = len;
-        }
-        // A box's record is about 300 bytes: the first compaction comes
-        // after about 220 registrations, the next when the log outgrows the
-        // snapshot, so a handful in 700, and all other changes appended.
-        assert!((2..=5).contains(&compactions), "{compactions} compactions");
-        assert!(appended > 2 * COMPACT_MIN, "{appended} bytes appended");
-        let want = s.snapshot();
-
-        // Fill the log up to its threshold, then block the state file.
-        while !s.store().expect("store").wants_compaction() {
-            register_box(&mut s, 1);
-        }
-        std::fs::rename(&path, dir.join("aside")).expect("move");
-        std::fs::create_dir(&path).expect("block the path");
-        let before = s.store().expect("store").log_len();
-        let late = register_box(&mut s, 1);
-        assert!(s.store().expect("store").log_len() > before, "appended");
-        assert_eq!(s.stats().persist_errors, 1, "the failed compaction");
-        std::fs::remove_dir(&path).expect("unblock");
-        std::fs::rename(dir.join("aside"), &path).expect("back");
-        register_box(&mut s, 1);
-        assert_eq!(
-            s.store().expect("store").log_len(),
-            LOG_HEADER_LEN as u64,
-            "compacted at the next change"
+        // Queries and pose updates go on meanwhile.
+        let r = one(
+            &mut s,
+            9,
+            Item::set_pose(
+                ObjectId::from_raw(kept),
+                &Isometry3::translation(1.0, 0.0, 0.0),
+            ),
         );
-        let all = s.snapshot();
-        assert!(all.objects.iter().any(|o| o.id == late));
-        assert!(all.objects.len() > want.objects.len());
+        assert_eq!(r.error_code(), ErrorCode::Ok);
+        s.database().expect("db").simulate_full_disk(false);
+        assert_eq!(s.remove(kept, 1), Ok(()));
+        let last = register_box(&mut s, 1);
         drop(s);
-        let (snapshot, log) = reload(&path);
-        assert_eq!(snapshot, all);
-        assert_eq!(log.applied + log.skipped, 0);
+        assert_eq!(
+            ids_of(&reload(&path)),
+            [last],
+            "neither the ghost nor the removed object"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// A removal and a registration taking over the removed object's name
-    /// and journal slot, both only in the log: a restart gets exactly
-    /// that, and the counter goes on past both ids.
+    /// and journal slot: a restart gets exactly that, and the counter goes
+    /// on past both ids.
     #[test]
-    fn a_removal_then_a_registration_replays_from_the_log() {
-        let dir = scratch("remove-register");
-        let path = dir.join("objects");
-        let mut s = state();
-        s.set_store(Store::open(&path).expect("store"))
-            .expect("journal");
-        s.persist().expect("first snapshot");
+    fn a_removal_then_a_registration_reloads() {
+        let (dir, path, mut s) = stored("remove-register");
         let other = register_box(&mut s, 2);
         let a = register_named(&mut s, 1, "n");
         let slot = s.object(a).expect("there").slot;
@@ -1783,16 +1701,7 @@ mod tests {
         assert_eq!(s.object(b).expect("there").slot, slot, "slot reused");
         let want = s.snapshot();
         drop(s);
-        assert_eq!(
-            Snapshot::decode(&std::fs::read(&path).expect("state file"))
-                .expect("valid")
-                .objects
-                .len(),
-            0,
-            "everything is in the log"
-        );
-        let (snapshot, log) = reload(&path);
-        assert_eq!((log.applied, log.skipped, log.error), (4, 0, None));
+        let snapshot = reload(&path);
         assert_eq!(snapshot, want);
         let mut r = State::restore(Limits::default(), WaitMode::Spin, &snapshot).expect("valid");
         assert_eq!(r.lookup("n"), Some(b));

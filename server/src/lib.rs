@@ -1,7 +1,7 @@
 //! # gjkd
 //!
-//! The gjkd distance server as a library: the object store and its request
-//! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
+//! The gjkd distance server as a library: the server's state ([`state`]),
+//! its object store ([`store`]) and request handlers ([`requests`]), the per-pair warm-start cache ([`cache`]), scene files
 //! ([`scene`]), the database that keeps objects across crashes
 //! ([`database`], with the stored form of objects in [`stored`] and the
 //! migration of the old state file in [`legacy`]), the pose journal
@@ -41,7 +41,9 @@ pub mod demo;
 pub mod journal;
 pub mod legacy;
 pub mod objects;
+pub mod requests;
 pub mod scene;
 pub mod server;
 pub mod state;
+pub mod store;
 pub mod stored;

@@ -40,7 +40,7 @@ pub mod database;
 pub mod demo;
 pub mod journal;
 pub mod legacy;
-pub mod objects;
+pub mod offline;
 pub mod requests;
 pub mod scene;
 pub mod server;

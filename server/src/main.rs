@@ -181,7 +181,7 @@ fn objects(args: &ObjectsArgs) -> Result<(), String> {
         .clone()
         .or_else(|| gjkd::stored::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file")?;
-    gjkd::objects::run(&path, args.remove_departed)
+    gjkd::offline::run(&path, args.remove_departed)
 }
 
 fn serve(args: ServeArgs) -> ExitCode {

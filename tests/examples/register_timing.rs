@@ -29,6 +29,16 @@ fn main() {
     let sum = |t: &[Duration]| t.iter().sum::<Duration>();
     let first = sum(&times[..window]);
     let last = sum(&times[n - window..]);
+    let median = |t: &[Duration]| {
+        let mut t = t.to_vec();
+        t.sort();
+        t[t.len() / 2].as_secs_f64() * 1e3
+    };
+    println!(
+        "median of the first {window}: {:.3} ms, of the last {window}: {:.3} ms",
+        median(&times[..window]),
+        median(&times[n - window..])
+    );
     let mut sorted = times.clone();
     sorted.sort();
     let ms = |d: Duration| d.as_secs_f64() * 1e3;

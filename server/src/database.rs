@@ -1036,5 +1036,6 @@ mod tests {
                 assert_eq!(ids, [id(7), id(9)], "flip of bit {bit} of byte {i}");
             }
         }
+        eprintln!("{} flips in a middle record", (starts[3] - starts[2]) * 8);
     }
 }

@@ -680,7 +680,10 @@ impl Client {
     /// [`ClientError::Rejected`] with the reason for invalid geometry
     /// ([`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`],
     /// [`ErrorCode::NonFiniteVertex`], [`ErrorCode::TooManyVertices`], ...),
-    /// and the connection errors of every call.
+    /// [`ErrorCode::TooManyObjects`] when the server holds as many as it
+    /// accepts, [`ErrorCode::StorageFull`] when its disk has no room to
+    /// store the object (nothing was registered; the same call succeeds once
+    /// there is room), and the connection errors of every call.
     pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, ClientError> {
         self.register_with(geometry, None, &Isometry3::identity())
     }
@@ -849,7 +852,10 @@ impl Client {
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
-    /// client's object, [`ErrorCode::ReadOnly`] for a scene object.
+    /// client's object, [`ErrorCode::ReadOnly`] for a scene object,
+    /// [`ErrorCode::StorageFull`] when the server's disk has no room to
+    /// store the removal (the object stays; the same call succeeds once
+    /// there is room).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.id = id.raw();

@@ -38,7 +38,7 @@ use std::io::Read;
 use std::os::unix::fs::{DirBuilderExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 
 use redb::{ReadableDatabase, ReadableTable, StorageBackend, TableDefinition};
 use tracing::{error, info, warn};
@@ -109,9 +109,9 @@ pub struct Database {
     /// `None` after a commit failed: redb then refuses every transaction, so
     /// the next change reopens the file first.
     db: Option<redb::Database>,
-    /// Test hook shared with the storage backend: writes fail as on a full
-    /// disk while it is set.
-    full: Arc<AtomicBool>,
+    /// Test hook shared with the storage backend: while not 0, every write
+    /// fails with this OS error.
+    fail_with: Arc<AtomicI32>,
 }
 
 /// What [`Database::open`] found.
@@ -152,7 +152,7 @@ impl Database {
         }
         let mut set_aside = Vec::new();
         let migrated = migrate_if_legacy(&path, &mut set_aside)?;
-        let full = Arc::new(AtomicBool::new(false));
+        let fail_with = Arc::new(AtomicI32::new(0));
         let mut file = open_locked(&path)?;
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes)
@@ -173,9 +173,9 @@ impl Database {
             }
         };
         let mut db = Database {
-            db: Some(open_redb(&path, file, &full)?),
+            db: Some(open_redb(&path, file, &fail_with)?),
             path,
-            full,
+            fail_with,
         };
         let (snapshot, fresh) = match (stored, migrated) {
             (_, Some(old)) => {
@@ -213,7 +213,7 @@ impl Database {
     fn live(&mut self) -> Result<&redb::Database, StoreError> {
         if self.db.is_none() {
             let file = open_locked(&self.path)?;
-            self.db = Some(open_redb(&self.path, file, &self.full)?);
+            self.db = Some(open_redb(&self.path, file, &self.fail_with)?);
             warn!(file = %self.path.display(), "object store reopened after a failed write");
         }
         self.db.as_ref().ok_or_else(|| StoreError::Database {
@@ -344,24 +344,30 @@ impl Database {
     /// Test hook: while `full` is set, every write to the file fails with
     /// `ENOSPC`, as on a full disk.
     pub fn simulate_full_disk(&self, full: bool) {
-        self.full.store(full, Ordering::Release);
+        self.fail_writes(if full { libc::ENOSPC } else { 0 });
+    }
+
+    /// Test hook: while `errno` is not 0, every write to the file fails
+    /// with that OS error.
+    pub fn fail_writes(&self, errno: i32) {
+        self.fail_with.store(errno, Ordering::Release);
     }
 }
 
-/// redb's file backend, with writes that fail as on a full disk while the
-/// shared flag is set (for tests of that path with a real `ENOSPC`).
+/// redb's file backend, with writes that fail with the OS error of the
+/// shared test hook while it is set (see [`Database::fail_writes`]).
 #[derive(Debug)]
 struct Backend {
     file: redb::backends::FileBackend,
-    full: Arc<AtomicBool>,
+    fail_with: Arc<AtomicI32>,
 }
 
 impl Backend {
     fn check(&self) -> std::io::Result<()> {
-        if self.full.load(Ordering::Acquire) {
-            return Err(std::io::Error::from_raw_os_error(libc::ENOSPC));
+        match self.fail_with.load(Ordering::Acquire) {
+            0 => Ok(()),
+            errno => Err(std::io::Error::from_raw_os_error(errno)),
         }
-        Ok(())
     }
 }
 
@@ -498,10 +504,16 @@ fn verify(bytes: Vec<u8>) -> Result<Option<Snapshot>, Damage> {
 fn open_redb(
     path: &Path,
     file: File,
-    full: &Arc<AtomicBool>,
+    fail_with: &Arc<AtomicI32>,
 ) -> Result<redb::Database, StoreError> {
     let fail = |e: redb::DatabaseError| match e {
         redb::DatabaseError::DatabaseAlreadyOpen => StoreError::InUse(path.to_path_buf()),
+        // Reopening after a crash or a failed commit writes (redb's repair).
+        redb::DatabaseError::Storage(redb::StorageError::Io(io))
+            if io.raw_os_error() == Some(libc::ENOSPC) =>
+        {
+            StoreError::Full(path.to_path_buf())
+        }
         e => StoreError::Database {
             what: "cannot open",
             path: path.to_path_buf(),
@@ -510,7 +522,7 @@ fn open_redb(
     };
     let backend = Backend {
         file: redb::backends::FileBackend::new(file).map_err(fail)?,
-        full: Arc::clone(full),
+        fail_with: Arc::clone(fail_with),
     };
     let mut builder = redb::Builder::new();
     builder.set_cache_size(CACHE_BYTES);

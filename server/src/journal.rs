@@ -196,13 +196,28 @@ impl Journal {
 fn map(file: &File, slots: usize) -> std::io::Result<MmapMut> {
     let len = HEADER + slots * SLOT;
     if (file.metadata()?.len() as usize) < len {
-        file.set_len(len as u64)?;
+        allocate(file, len)?;
     }
     // SAFETY: the file is ours (0600, under the store's lock, which keeps a
     // second server away) and never truncated while mapped, so the mapping
     // cannot lose its pages under us; every access goes through the slice
     // bounds of `MmapMut`.
     unsafe { memmap2::MmapOptions::new().len(len).map_mut(file) }
+}
+
+/// Grows `file` to `len` bytes with its disk blocks allocated: a store into
+/// a mapped page that has no block yet would kill the process (`SIGBUS`) on
+/// a full disk, where this fails with `ENOSPC` instead.
+fn allocate(file: &File, len: usize) -> std::io::Result<()> {
+    use std::os::unix::io::AsRawFd;
+    let len = libc::off_t::try_from(len).map_err(std::io::Error::other)?;
+    // SAFETY: posix_fallocate(3) on a descriptor we own.
+    match unsafe { libc::posix_fallocate(file.as_raw_fd(), 0, len) } {
+        0 => Ok(()),
+        // A file system without fallocate: grow it sparse.
+        libc::EOPNOTSUPP | libc::EINVAL => file.set_len(len as u64),
+        errno => Err(std::io::Error::from_raw_os_error(errno)),
+    }
 }
 
 impl Drop for Journal {

@@ -412,8 +412,8 @@ impl ObjectStore {
     /// object is not kept.
     ///
     /// # Errors
-    /// As [`ObjectStore::insert`], and [`ErrorCode::Internal`] when the
-    /// commit fails.
+    /// As [`ObjectStore::insert`], and [`ErrorCode::StorageFull`] (no room
+    /// on the disk) or [`ErrorCode::Internal`] when the commit fails.
     pub fn register(
         &mut self,
         new: NewObject,
@@ -511,7 +511,10 @@ impl ObjectStore {
         write(database).map_err(|e| {
             self.persist_errors += 1;
             tracing::error!("{e}; the change is undone");
-            ErrorCode::Internal
+            match e {
+                StoreError::Full(_) => ErrorCode::StorageFull,
+                _ => ErrorCode::Internal,
+            }
         })
     }
 
@@ -522,7 +525,8 @@ impl ObjectStore {
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
     /// objects, [`ErrorCode::NotOwner`] for another client's object,
-    /// [`ErrorCode::Internal`] when the commit fails (nothing is removed).
+    /// [`ErrorCode::StorageFull`] or [`ErrorCode::Internal`] when the commit
+    /// fails (nothing is removed).
     pub fn remove(&mut self, id: u64, requester: u128) -> Result<u64, ErrorCode> {
         let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
         match object.owner {
@@ -722,7 +726,7 @@ mod tests {
         let want = s.snapshot();
         s.database().expect("db").simulate_full_disk(true);
         let (removed, failed) = s.remove_departed(|c| c == 1);
-        assert_eq!((removed, failed), (vec![], Some(ErrorCode::Internal)));
+        assert_eq!((removed, failed), (vec![], Some(ErrorCode::StorageFull)));
         assert_eq!(s.len(), before);
         assert!(doomed.iter().all(|&id| s.object(id).is_some()));
         assert_eq!(s.lookup("leg"), Some(named));
@@ -746,13 +750,16 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
-    /// A commit that fails (a full disk: a real `ENOSPC` from the storage
-    /// layer) undoes the change in memory and says `Internal`; once the
-    /// disk has room again, changes are accepted without a restart.
+    /// A commit that fails on a full disk (a real `ENOSPC` from the storage
+    /// layer) undoes the change in memory and says `StorageFull`, while
+    /// queries and pose updates go on; once the disk has room again,
+    /// changes are accepted without a restart. Any other write failure
+    /// says `Internal`.
     #[test]
-    fn a_failed_write_undoes_the_change_and_says_internal() {
-        let (dir, path, mut s) = stored("failed-write");
+    fn a_full_disk_refuses_changes_until_there_is_room_again() {
+        let (dir, path, mut s) = stored("full-disk");
         let kept = register_box(&mut s, 1);
+        let other = register_box(&mut s, 1);
         s.database().expect("db").simulate_full_disk(true);
         let mut req = AdminRequest::new(AdminOp::Register);
         req.shape = shape_kind::CONVEX;
@@ -760,29 +767,34 @@ mod tests {
         req.pieces[0].vertex_count = 1;
         assert!(req.set_name("ghost"));
         let reply = s.handle_admin(1, &req, &[Vertex::default()]);
-        assert_eq!(reply.error_code(), ErrorCode::Internal);
-        assert_eq!(s.len(), 1, "the unwritten object is not kept");
+        assert_eq!(reply.error_code(), ErrorCode::StorageFull);
+        assert_eq!(s.len(), 2, "the unwritten object is not kept");
         assert_eq!(s.lookup("ghost"), None);
-        assert_eq!(s.remove(kept, 1), Err(ErrorCode::Internal));
+        assert_eq!(s.remove(kept, 1), Err(ErrorCode::StorageFull));
         assert!(s.object(kept).is_some(), "the unwritten removal is undone");
         assert_eq!(s.stats().persist_errors, 2);
         // Queries and pose updates go on meanwhile.
-        let r = one(
-            &mut s,
-            9,
-            Item::set_pose(
-                ObjectId::from_raw(kept),
-                &Isometry3::translation(1.0, 0.0, 0.0),
-            ),
+        let (ik, io) = (ObjectId::from_raw(kept), ObjectId::from_raw(other));
+        let moved = Isometry3::translation(5.0, 0.0, 0.0);
+        assert_eq!(
+            one(&mut s, 9, Item::set_pose(ik, &moved)).error_code(),
+            ErrorCode::Ok
         );
-        assert_eq!(r.error_code(), ErrorCode::Ok);
-        s.database().expect("db").simulate_full_disk(false);
+        let d = one(&mut s, 9, Item::distance(ik, io, &QueryOptions::cold()));
+        assert_eq!(d.answer().expect("served").distance, 3.0);
+        // Another failure of the storage is the server's own.
+        s.database().expect("db").fail_writes(libc::EIO);
+        assert_eq!(
+            s.handle_admin(1, &req, &[Vertex::default()]).error_code(),
+            ErrorCode::Internal
+        );
+        s.database().expect("db").fail_writes(0);
         assert_eq!(s.remove(kept, 1), Ok(()));
         let last = register_box(&mut s, 1);
         drop(s);
         assert_eq!(
             ids_of(&reload(&path)),
-            [last],
+            [other, last],
             "neither the ghost nor the removed object"
         );
         let _ = std::fs::remove_dir_all(&dir);

@@ -233,8 +233,13 @@ impl ObjectStore {
     /// (when persistence is on), writing only what differs: at start after
     /// the scene is installed, and at shutdown.
     ///
+    /// On a full disk this is not an error: the server must start (and
+    /// stop) there too. The poses stay in the journal, and the scene
+    /// objects not yet stored get new ids at the next start; it is counted
+    /// and logged.
+    ///
     /// # Errors
-    /// The commit error; the database is then as it was.
+    /// Any other commit error; the database is then as it was.
     pub fn persist(&mut self) -> Result<(), StoreError> {
         if self.database.is_none() {
             return Ok(());
@@ -243,9 +248,21 @@ impl ObjectStore {
         let Some(database) = &mut self.database else {
             return Ok(());
         };
-        database.sync(&snapshot).inspect_err(|_| {
-            self.persist_errors += 1;
-        })
+        match database.sync(&snapshot) {
+            Ok(()) => Ok(()),
+            Err(StoreError::Full(path)) => {
+                self.persist_errors += 1;
+                tracing::warn!(
+                    file = %path.display(),
+                    "no room on the disk to bring the store up to date: the current poses stay in the journal only"
+                );
+                Ok(())
+            }
+            Err(e) => {
+                self.persist_errors += 1;
+                Err(e)
+            }
+        }
     }
 
     /// Asks the kernel to put the pose journal on disk if poses changed.

@@ -160,11 +160,21 @@ impl Database {
         let stored = match verify(bytes) {
             Ok(stored) => stored,
             Err(reason) => {
+                let lost = std::fs::read(&path).ok().and_then(readable_ids);
                 let moved_to = set_aside_file(&path, &reason)?;
+                let (count, ids) = match &lost {
+                    Some(ids) => (
+                        ids.len().to_string(),
+                        ids.iter().take(32).map(|id| format!("{id:#x}")).collect(),
+                    ),
+                    None => ("unknown".to_owned(), Vec::new()),
+                };
                 error!(
                     file = %path.display(),
                     moved_to = %moved_to.display(),
-                    "the object store is damaged ({reason}): set aside as it was, starting with no objects"
+                    lost_objects = %count,
+                    lost_ids = ?ids,
+                    "the object store is damaged ({reason}): set aside as it was, starting with no objects; the objects it held (as far as it can be read) are lost to this server"
                 );
                 set_aside.push(moved_to);
                 drop(file);
@@ -500,6 +510,28 @@ fn verify(bytes: Vec<u8>) -> Result<Option<Snapshot>, Damage> {
     }
 }
 
+/// The ids of the objects a damaged store file still shows, read from a
+/// copy in memory as far as redb can read it; `None` when it cannot.
+fn readable_ids(bytes: Vec<u8>) -> Option<Vec<u64>> {
+    let copy = Copy(std::sync::RwLock::new(bytes));
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let db = redb::Builder::new()
+            .set_cache_size(CACHE_BYTES)
+            .create_with_backend(copy)
+            .ok()?;
+        let tx = db.begin_read().ok()?;
+        let table = tx.open_table(OBJECTS).ok()?;
+        let ids: Vec<u64> = table
+            .iter()
+            .ok()?
+            .map_while(|entry| entry.ok().map(|(k, _)| k.value()))
+            .collect();
+        Some(ids)
+    }))
+    .ok()
+    .flatten()
+}
+
 /// redb on `file` (locked by [`open_locked`], content already verified).
 fn open_redb(
     path: &Path,
@@ -689,7 +721,7 @@ fn take_old_lock(path: &Path) -> Result<File, StoreError> {
 }
 
 /// `<file>.<tag>-<unix seconds>`, with a suffix if that exists already.
-fn aside_name(path: &Path, tag: &str) -> PathBuf {
+pub(crate) fn aside_name(path: &Path, tag: &str) -> PathBuf {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs())
@@ -868,6 +900,10 @@ mod tests {
         let good = std::fs::read(&path).expect("file");
         let (_, opened) = Database::open(&path, 6).expect("intact");
         let want = opened.snapshot;
+        // What a damaged file's ERROR line names as lost.
+        let all: Vec<u64> = want.objects.iter().map(|o| o.id).collect();
+        assert_eq!(readable_ids(good.clone()), Some(all));
+        assert_eq!(readable_ids(b"garbage".to_vec()), None);
         let mut cases: Vec<(String, Vec<u8>)> = Vec::new();
         for cut in [1, 7, 4096, good.len() / 2, good.len() - 100] {
             cases.push((format!("cut to {cut}"), good[..cut].to_vec()));

@@ -83,8 +83,9 @@ pub struct Journal {
 
 impl Journal {
     /// Opens (creating owner-only, 0600) the journal at `path`, keeping its
-    /// content. A file that is not a journal of this version is started
-    /// afresh: its poses are only a refinement of the stored ones.
+    /// content. A file that is not a journal of this version is copied
+    /// aside (`<file>.corrupt-<unix seconds>`) and started afresh: its poses
+    /// are only a refinement of the stored ones.
     ///
     /// # Errors
     /// When the file cannot be opened, sized or mapped.
@@ -103,6 +104,17 @@ impl Journal {
             head[..8] == MAGIC && head[8..12] == VERSION.to_le_bytes()
         };
         if !valid_header {
+            if current > 0 {
+                // Kept as found before it is started afresh; the objects it
+                // held poses for are reported by the store.
+                let kept = crate::database::aside_name(path, "corrupt");
+                std::fs::copy(path, &kept)?;
+                tracing::error!(
+                    file = %path.display(),
+                    kept_as = %kept.display(),
+                    "the pose journal is not a journal of this version: kept aside, started afresh"
+                );
+            }
             file.set_len(0)?;
         }
         let slots = current.saturating_sub(HEADER) / SLOT;
@@ -261,11 +273,18 @@ mod tests {
         assert_eq!(j.read(3, 13), None, "torn slot");
         assert_eq!(j.read(0, 11), Some(p));
         j.sync().expect("sync");
-        // A file that is not a journal starts afresh.
+        // A file that is not a journal starts afresh, kept aside first.
         drop(j);
         std::fs::write(&path, b"garbage").expect("spoil");
         let j = Journal::open(&path).expect("reopen");
         assert_eq!(j.read(0, 11), None);
+        let kept: Vec<_> = std::fs::read_dir(&dir)
+            .expect("list")
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().contains(".corrupt-"))
+            .collect();
+        assert_eq!(kept.len(), 1);
+        assert_eq!(std::fs::read(kept[0].path()).expect("kept"), b"garbage");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -130,11 +130,12 @@ impl State {
         self.store.snapshot()
     }
 
-    /// Turns persistence on (see [`ObjectStore::set_database`]).
+    /// Turns persistence on (see [`ObjectStore::set_database`]); returns
+    /// the objects whose journaled pose could not be verified.
     ///
     /// # Errors
     /// As [`ObjectStore::set_database`].
-    pub fn set_database(&mut self, database: Database) -> Result<(), StoreError> {
+    pub fn set_database(&mut self, database: Database) -> Result<Vec<u64>, StoreError> {
         self.store.set_database(database)
     }
 

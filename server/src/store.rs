@@ -57,6 +57,34 @@ pub struct NewObject {
     pub name: Option<String>,
 }
 
+/// Logs the objects whose pose the journal at `path` could not verify, after
+/// keeping a copy of the journal as it was `found` (it is rewritten next).
+fn report_unverified_poses(path: &std::path::Path, found: &[u8], ids: &[u64]) {
+    let kept = crate::database::aside_name(path, "corrupt");
+    let write = |kept: &std::path::Path| {
+        use std::io::Write;
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o600)
+            .open(kept)?
+            .write_all(found)
+    };
+    let kept = match write(&kept) {
+        Ok(()) => kept.display().to_string(),
+        Err(e) => format!("(no copy: {e})"),
+    };
+    let first: Vec<String> = ids.iter().take(32).map(|id| format!("{id:#x}")).collect();
+    tracing::error!(
+        file = %path.display(),
+        kept_as = %kept,
+        objects = ids.len(),
+        ids = ?first,
+        "the pose journal holds no verifiable pose for these objects (damaged, cut short, or an update torn by a crash): they are served at the pose stored with them in the database, as of their registration or the last clean shutdown"
+    );
+}
+
 /// Most objects of departed clients removed one committed transaction at a
 /// time; beyond, [`ObjectStore::remove_departed`] removes them all in one.
 pub const BULK_REMOVAL: usize = 16;
@@ -183,32 +211,42 @@ impl ObjectStore {
     /// for the objects already here (restored from the database) replace
     /// theirs: they are the latest ones before a crash.
     ///
+    /// An object whose journal slot does not hold a whole record of it
+    /// (the journal damaged or cut short, or its last update torn by a
+    /// crash) keeps the pose stored with it in the database, the pose of
+    /// its registration or of the last clean shutdown, which may be older
+    /// than its last update: such objects are logged at ERROR by id, with a
+    /// copy of the journal as it was found, and returned.
+    ///
     /// # Errors
     /// When the journal cannot be opened; persistence stays off then.
-    pub fn set_database(&mut self, database: Database) -> Result<(), StoreError> {
+    pub fn set_database(&mut self, database: Database) -> Result<Vec<u64>, StoreError> {
         let path = crate::journal::path_for(database.path());
-        let mut journal = Journal::open(&path).map_err(|source| StoreError::Io {
+        // As found, before opening grows it: kept if it proves damaged.
+        let found = std::fs::read(&path).unwrap_or_default();
+        let journal = Journal::open(&path).map_err(|source| StoreError::Io {
             what: "cannot open the pose journal",
             path: path.clone(),
             source,
         })?;
+        let mut unverified = Vec::new();
         for (&id, o) in self.objects.iter_mut() {
-            if let Some(pose) = journal.read(o.slot, id) {
-                o.pose = pose;
+            match journal.read(o.slot, id) {
+                Some(pose) => o.pose = pose,
+                None => unverified.push(id),
             }
         }
-        for (&id, o) in &self.objects {
-            journal
-                .write(o.slot, id, &o.pose)
-                .map_err(|source| StoreError::Io {
-                    what: "cannot write the pose journal",
-                    path: path.clone(),
-                    source,
-                })?;
+        unverified.sort_unstable();
+        if !unverified.is_empty() {
+            report_unverified_poses(&path, &found, &unverified);
         }
         self.journal = Some(journal);
         self.database = Some(database);
-        Ok(())
+        let slots: Vec<(u32, u64)> = self.objects.iter().map(|(&id, o)| (o.slot, id)).collect();
+        for (slot, id) in slots {
+            self.journal_pose(slot, id);
+        }
+        Ok(unverified)
     }
 
     /// Writes `pose` of object `id` (in `slot`) to the journal, if any. A
@@ -814,6 +852,61 @@ mod tests {
             [other, last],
             "neither the ghost nor the removed object"
         );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A pose journal damaged while the server was stopped: the objects
+    /// whose slot no longer verifies are returned (and logged) and keep the
+    /// pose stored in the database (here: their registration pose), the
+    /// others their journaled pose; the journal is copied aside as found.
+    #[test]
+    fn poses_the_journal_cannot_verify_are_reported_and_fall_back() {
+        let (dir, path, mut s) = stored("journal-damage");
+        let ids: Vec<u64> = (0..3).map(|_| register_box(&mut s, 1)).collect();
+        let moved = Isometry3::translation(7.0, 0.0, 0.0);
+        for &id in &ids {
+            let r = one(&mut s, 9, Item::set_pose(ObjectId::from_raw(id), &moved));
+            assert_eq!(r.error_code(), ErrorCode::Ok);
+        }
+        let slot = s.object(ids[1]).expect("there").slot as usize;
+        drop(s);
+        let journal = crate::journal::path_for(&path);
+        let reopen = || {
+            let (db, opened) = Database::open(&path, 9).expect("reopen");
+            let mut r =
+                State::restore(Limits::default(), WaitMode::Spin, &opened.snapshot).expect("ok");
+            let unverified = r.set_database(db).expect("journal");
+            (r, unverified)
+        };
+        let kept = |bytes: &[u8]| {
+            std::fs::read_dir(&dir)
+                .expect("list")
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().contains("poses.corrupt-"))
+                .any(|e| std::fs::read(e.path()).expect("read") == bytes)
+        };
+        // A byte of object 1's slot (after the 16-byte header).
+        let mut bytes = std::fs::read(&journal).expect("journal");
+        bytes[16 + slot * crate::journal::SLOT + 20] ^= 0x40;
+        std::fs::write(&journal, &bytes).expect("spoil");
+        let (r, unverified) = reopen();
+        assert_eq!(unverified, [ids[1]]);
+        assert_eq!(r.object(ids[0]).expect("there").pose, moved);
+        assert_eq!(r.object(ids[1]).expect("there").pose, Isometry3::identity());
+        assert_eq!(r.object(ids[2]).expect("there").pose, moved);
+        assert!(kept(&bytes), "the damaged journal is kept as found");
+        drop(r);
+        // Cut short to its header: no pose verifies.
+        let mut bytes = std::fs::read(&journal).expect("journal");
+        bytes.truncate(16);
+        std::fs::write(&journal, &bytes).expect("cut");
+        let (r, unverified) = reopen();
+        assert_eq!(unverified, ids);
+        assert!(
+            ids.iter()
+                .all(|&id| r.object(id).expect("there").pose == Isometry3::identity())
+        );
+        assert!(kept(&bytes));
         let _ = std::fs::remove_dir_all(&dir);
     }
 

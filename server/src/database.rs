@@ -668,7 +668,7 @@ fn migrate_if_legacy(
             warn!(
                 file = %log_path.display(),
                 bytes = replay.torn,
-                "old change log ends in a record cut short by a crash (never acknowledged): dropped"
+                "old change log ends in an incomplete record, dropped: an append cut short by a crash (never acknowledged) or a log cut short by damage (then the records after the cut are lost)"
             );
         }
     }

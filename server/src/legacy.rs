@@ -87,7 +87,8 @@ pub struct Replay {
     /// Records that changed the snapshot.
     pub applied: u64,
     /// Bytes at the end that did not form a whole record: an append that a
-    /// crash cut short, never acknowledged.
+    /// crash cut short (never acknowledged), or a log cut short by damage,
+    /// which cannot be told apart.
     pub torn: u64,
     /// Damage before the end of the log (or a wrong header): the records
     /// after it are lost.

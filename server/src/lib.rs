@@ -1,12 +1,14 @@
 //! # gjkd
 //!
 //! The gjkd distance server as a library: the server's state ([`state`]),
-//! its object store ([`store`]) and request handlers ([`requests`]), the per-pair warm-start cache ([`cache`]), scene files
-//! ([`scene`]), the database that keeps objects across crashes
-//! ([`database`], with the stored form of objects in [`stored`] and the
-//! migration of the old state file in [`legacy`]), the pose journal
-//! ([`journal`]), the iceoryx2 serving loop ([`server`]), the built-in demo
-//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`](mod@bench)). The `gjkd`
+//! its object store ([`store`]) and request handlers ([`requests`]), the
+//! per-pair warm-start cache ([`cache`]), scene files ([`scene`]), the
+//! database that keeps objects across crashes ([`database`], with the
+//! stored form of objects in [`stored`] and the migration of the old state
+//! file in [`legacy`]), the pose journal ([`journal`]), the offline
+//! `gjkd objects` command ([`offline`]), the iceoryx2 serving loop
+//! ([`server`]), the built-in demo ([`demo`]) and the measurements of
+//! `gjkd bench` ([`bench`](mod@bench)). The `gjkd`
 //! binary is a thin command line over these.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the

@@ -802,8 +802,9 @@ impl Client {
     ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
     ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
     ///   piece offset), [`ErrorCode::TooManyObjects`] (the server's
-    ///   `--max-objects`), [`ErrorCode::Internal`] (the server could not
-    ///   write the object to its store, for example on a full disk).
+    ///   `--max-objects`), [`ErrorCode::StorageFull`] (the server's disk
+    ///   has no room to store the object; the same call succeeds once there
+    ///   is room), [`ErrorCode::Internal`] (the store failed otherwise).
     /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`]. **The
     ///   registration may then have happened**: the request may have
     ///   reached the server and been stored before the server died or the
@@ -978,7 +979,10 @@ impl Client {
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
-    /// client's object, [`ErrorCode::ReadOnly`] for a scene object.
+    /// client's object, [`ErrorCode::ReadOnly`] for a scene object,
+    /// [`ErrorCode::StorageFull`] when the server's disk has no room to
+    /// store the removal (the object stays; the same call succeeds once
+    /// there is room).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.id = id.raw();

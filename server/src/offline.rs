@@ -1,4 +1,4 @@
-//! `gjkd objects`: what a stopped server's state file holds, and, on the
+//! `gjkd objects`: what a stopped server's object store holds, and, on the
 //! operator's word, the removal of the objects whose registering client
 //! process no longer runs.
 //!
@@ -15,7 +15,47 @@ use std::fmt::Write as _;
 use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 
-use crate::persist::{Snapshot, StoredObject, StoredOwner, StoredShape};
+use crate::database::Database;
+use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredShape};
+
+/// `gjkd objects`: prints the table of the objects stored at `path` and,
+/// with `remove`, removes those whose owner is gone, printing their ids.
+/// Opening the store does what a server start would: a file of the old
+/// format is migrated, a damaged one set aside.
+///
+/// # Errors
+/// When the store cannot be opened (a server holding it included), the
+/// iceoryx2 nodes cannot be listed, or the removal cannot be committed.
+pub fn run(path: &std::path::Path, remove: bool) -> Result<(), String> {
+    let (mut db, opened) = Database::open(path, 1)
+        .map_err(|e| format!("{e} (a server using this file must be stopped first)"))?;
+    if opened.fresh {
+        println!("no objects stored at {}", path.display());
+        return Ok(());
+    }
+    let mut snapshot = opened.snapshot;
+    let alive = alive_nodes()?;
+    print!("{}", table(&snapshot, &liveness(&snapshot, &alive)));
+    if !remove {
+        return Ok(());
+    }
+    let removed = remove_departed(&mut snapshot, &alive);
+    if removed.is_empty() {
+        println!("no object has an owner that is gone: nothing removed");
+        return Ok(());
+    }
+    let ids: Vec<u64> = removed.iter().map(|o| o.id).collect();
+    db.remove(&ids).map_err(|e| e.to_string())?;
+    println!(
+        "removed {} object(s) whose owner is gone: {}",
+        removed.len(),
+        ids.iter()
+            .map(|id| format!("{id:#x}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(())
+}
 
 /// Whether the client that registered an object still runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -125,7 +165,7 @@ pub fn table(snapshot: &Snapshot, states: &[Liveness]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::persist::{StoredConvex, StoredPose};
+    use crate::stored::{StoredConvex, StoredPose};
 
     /// Object `index` of a store of epoch 3.
     fn object(index: u64, owner: StoredOwner, name: Option<&str>) -> StoredObject {

@@ -34,6 +34,9 @@ fn error_codes() -> Vec<(String, u32, &'static str)> {
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // iceoryx2 logs to the console by itself; keep it to real problems, as
+    // the `gjkd` binary does.
+    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
     m.add_class::<client::Client>()?;
     m.add_class::<local::Local>()?;
     m.add_class::<shape::Shape>()?;

@@ -66,8 +66,54 @@ impl Store {
 }
 
 /// `gjkd serve` with `args` (no program name); the exit status.
+///
+/// Interim, until the server library has the serve command: in-memory
+/// objects only, and the flags `--service`, `--wait`, `--max-batch`,
+/// `--cache-capacity`, `--no-persist`.
 pub fn serve(args: &[String]) -> i32 {
-    let _ = args;
-    eprintln!("gjkd serve: not available in this build yet");
-    2
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+    let mut limits = Limits::default();
+    let mut options = gjkd::server::ServeOptions {
+        service: gjkd_proto::DEFAULT_SERVICE.to_owned(),
+        wait: WaitMode::Adaptive,
+        remove_departed: false,
+    };
+    let mut it = args.iter();
+    while let Some(flag) = it.next() {
+        let mut value = || it.next().cloned().unwrap_or_default();
+        match flag.as_str() {
+            "--service" => options.service = value(),
+            "--wait" => {
+                options.wait = match value().as_str() {
+                    "spin" => WaitMode::Spin,
+                    "block" => WaitMode::Block,
+                    _ => WaitMode::Adaptive,
+                }
+            }
+            "--max-batch" => limits.max_batch = value().parse().unwrap_or(limits.max_batch),
+            "--cache-capacity" => {
+                limits.cache_capacity = value().parse().unwrap_or(limits.cache_capacity)
+            }
+            "--no-persist" => {}
+            other => {
+                eprintln!("gjkd serve: unknown flag {other}");
+                return 2;
+            }
+        }
+    }
+    let state = gjkd::state::State::new(limits, options.wait, std::process::id().max(1));
+    let shutdown = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        if signal_hook::flag::register(signal, Arc::clone(&shutdown)).is_err() {
+            return 1;
+        }
+    }
+    match gjkd::server::run(&options, state, &shutdown, || {}) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("gjkd serve: {e}");
+            1
+        }
+    }
 }

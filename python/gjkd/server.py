@@ -63,11 +63,11 @@ class Server:
         flags = ["--service", service, "--wait", wait]
         if persist:
             if state_file is not None:
-                flags += ["--state-file", os.fspath(state_file)]
+                flags += ["--state-file", os.path.abspath(state_file)]
         else:
             flags.append("--no-persist")
         if scene is not None:
-            flags += ["--scene", os.fspath(scene)]
+            flags += ["--scene", os.path.abspath(scene)]
         flags += list(args)
         self.args = flags
         self._log = log
@@ -100,8 +100,12 @@ class Server:
         if log is None:
             self._own_log = tempfile.TemporaryFile(mode="w+")
             log = self._own_log
+        # Started from the directory that holds this very package, so that
+        # `-m gjkd` (which looks in the working directory first) runs it and
+        # not some other copy, such as a source tree without its extension.
+        here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
         self._process = subprocess.Popen(
-            self.command, stdin=subprocess.DEVNULL, stdout=log, stderr=log
+            self.command, stdin=subprocess.DEVNULL, stdout=log, stderr=log, cwd=here
         )
         self._wait_ready()
         return self

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pathlib
 import subprocess
 import sys
 import time
@@ -75,12 +76,14 @@ def test_server_stops_on_exit_and_reports_a_failed_start() -> None:
     assert not first.running
 
 
-def test_python_m_gjkd_serve_runs_and_stops_on_sigterm() -> None:
+def test_python_m_gjkd_serve_runs_and_stops_on_sigterm(tmp_path: pathlib.Path) -> None:
     service = unique_service("cli")
+    # Away from the source tree, which `-m` would find first.
     process = subprocess.Popen(
         [sys.executable, "-m", "gjkd", "serve", "--service", service, "--no-persist"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
+        cwd=tmp_path,
     )
     try:
         with gjkd.Client(service, timeout=1.0, connect_timeout=10.0) as client:

@@ -264,4 +264,3 @@ def serve(args: list[str]) -> int:
 
 def error_codes() -> list[tuple[str, int, str]]:
     """Every error code as ``(name, value, description)``."""
-

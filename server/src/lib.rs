@@ -1,17 +1,17 @@
-//! # gjkd
+//! # gjkd-server
 //!
 //! The gjkd distance server as a library: the object store and its request
 //! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
 //! ([`scene`]), the state file that keeps objects across crashes
-//! ([`persist`]), the iceoryx2 serving loop ([`server`]), the built-in demo
-//! ([`demo`]) and the measurements of `gjkd bench` ([`bench`](mod@bench)). The `gjkd`
-//! binary is a thin command line over these.
+//! ([`persist`]), the iceoryx2 serving loop ([`server`]) and the daemon's
+//! commands with their flags ([`commands`]). The `gjkd` binary (package
+//! `gjkd`) is a thin command line over these and the tools of `gjkd-bench`.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the
 //! request's bytes, so they can be tested and fuzzed without any IPC:
 //!
 //! ```
-//! use gjkd::state::{Limits, State};
+//! use gjkd_server::state::{Limits, State};
 //! use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Item, ItemResult, ObjectId, QueryOptions,
 //!     Vertex, WaitMode, shape_kind};
 //!
@@ -32,9 +32,8 @@
 
 #![warn(missing_docs)]
 
-pub mod bench;
 pub mod cache;
-pub mod demo;
+pub mod commands;
 pub mod journal;
 pub mod objects;
 pub mod persist;

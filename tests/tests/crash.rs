@@ -266,7 +266,7 @@ fn a_state_file_in_use_is_not_shared() {
     assert_eq!(client.stats().expect("stats").objects, 1);
     client.remove(id).expect("first server still owns its file");
     let bytes = std::fs::read(&path).expect("state file");
-    let snap = gjkd::persist::Snapshot::decode(&bytes).expect("intact");
+    let snap = gjkd_server::persist::Snapshot::decode(&bytes).expect("intact");
     assert!(snap.objects.is_empty());
 }
 

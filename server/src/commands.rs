@@ -1,49 +1,25 @@
-//! `gjkd`: the distance server (`gjkd serve`), its demo (`gjkd demo`), its
-//! measurements (`gjkd bench`) and a state-file tool (`gjkd objects`).
+//! The daemon's two commands, flags and all: `gjkd serve` ([`ServeArgs`],
+//! [`serve`]) and the offline `gjkd objects` ([`ObjectsArgs`], [`objects`]).
+//! They live in the library rather than in the binary so that every front
+//! end that starts a server (the `gjkd` command line, language bindings)
+//! takes the same flags and starts it the same way.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use gjkd::persist::{Loaded, LogError, Replay, Store};
-use gjkd::scene::Scene;
-use gjkd::server::{ServeOptions, run};
-use gjkd::state::{Limits, State};
+use clap::{Args, ValueEnum};
 use gjkd_proto::{DEFAULT_SERVICE, MAX_PIECES, WaitMode};
 use tracing::{error, info, warn};
 
-#[derive(Parser, Debug)]
-#[command(
-    name = "gjkd",
-    version,
-    about = "Distance server for co-located processes"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
+use crate::persist::{Loaded, LogError, Replay, Store};
+use crate::scene::Scene;
+use crate::server::{ServeOptions, run};
+use crate::state::{Limits, State};
 
-#[derive(Subcommand, Debug)]
-enum Command {
-    /// Serve distance queries until SIGINT or SIGTERM.
-    Serve(ServeArgs),
-    /// Start a server, sweep the Section 8 scene through it and print the
-    /// distances and the warm-start speed-up.
-    Demo(DemoArgs),
-    /// Measurements: `latency`, `tradeoff` (speed against accuracy) and
-    /// `paper` (Section 7). See docs/benchmarks.md.
-    Bench(gjkd::bench::BenchArgs),
-    /// List the objects of a stopped server's state file, with whether each
-    /// owner still runs; with --remove-departed, remove those whose
-    /// registering client process is gone (a client can remove only its
-    /// own objects, so no client can remove these).
-    Objects(ObjectsArgs),
-}
-
+/// How the server waits for requests (`--wait`).
 #[derive(Clone, Copy, Debug, ValueEnum)]
-enum Wait {
+pub enum Wait {
     /// Busy-poll: lowest latency, burns a core.
     Spin,
     /// Sleep until a client notifies: no busy CPU.
@@ -62,127 +38,86 @@ impl From<Wait> for WaitMode {
     }
 }
 
+/// The flags of `gjkd serve`.
 #[derive(Args, Debug)]
-struct ServeArgs {
+pub struct ServeArgs {
     /// Deployment name: the services are NAME/v1/query, NAME/v1/admin and
     /// NAME/v1/wake.
     #[arg(long, default_value = DEFAULT_SERVICE)]
-    service: String,
+    pub service: String,
     /// Scene file (TOML) of read-only named objects to load at start.
     #[arg(long)]
-    scene: Option<PathBuf>,
+    pub scene: Option<PathBuf>,
     /// Wait strategy.
     #[arg(long, value_enum, default_value_t = Wait::Adaptive)]
-    wait: Wait,
+    pub wait: Wait,
     /// Most clients at once (one per `gjkd-client` `Client`; the limit holds
     /// for each of the query and admin services).
     #[arg(long, default_value_t = Limits::default().max_clients)]
-    max_clients: usize,
+    pub max_clients: usize,
     /// Most processes (iceoryx2 nodes) per service.
     #[arg(long, default_value_t = Limits::default().max_nodes)]
-    max_nodes: usize,
+    pub max_nodes: usize,
     /// Most items per query request.
     #[arg(long, default_value_t = Limits::default().max_batch)]
-    max_batch: usize,
+    pub max_batch: usize,
     /// Most vertices per registered object.
     #[arg(long, default_value_t = Limits::default().max_vertices)]
-    max_vertices: usize,
+    pub max_vertices: usize,
     /// Most objects held at once.
     #[arg(long, default_value_t = Limits::default().max_objects)]
-    max_objects: usize,
+    pub max_objects: usize,
     /// Most warm-start cache entries (one per client and ordered pair).
     #[arg(long, default_value_t = Limits::default().cache_capacity)]
-    cache_capacity: usize,
+    pub cache_capacity: usize,
     /// State file: registered objects are written here before each
     /// registration or removal is acknowledged, and reloaded at start with
     /// the same ids. Default
     /// `${XDG_STATE_HOME:-$HOME/.local/state}/gjkd/<service>.objects`
     /// (directory created 0700, file 0600).
     #[arg(long, value_name = "PATH", conflicts_with = "no_persist")]
-    state_file: Option<PathBuf>,
+    pub state_file: Option<PathBuf>,
     /// Keep objects in memory only: they are lost when the server stops.
     #[arg(long)]
-    no_persist: bool,
+    pub no_persist: bool,
     /// Remove, while serving, the objects of clients whose process has
     /// ended, within seconds of it (scene objects and those of running
     /// clients stay; ids are never reused). Off by default: such objects
     /// keep being served, and `gjkd objects --remove-departed` removes
     /// them with the server stopped.
     #[arg(long)]
-    remove_departed: bool,
+    pub remove_departed: bool,
 }
 
+/// The flags of `gjkd objects`.
 #[derive(Args, Debug)]
-struct ObjectsArgs {
+pub struct ObjectsArgs {
     /// Deployment name, for the default state file.
     #[arg(long, default_value = DEFAULT_SERVICE)]
-    service: String,
+    pub service: String,
     /// State file (default as for `gjkd serve`). The server using it must
     /// be stopped: its lock on the file is checked.
     #[arg(long, value_name = "PATH")]
-    state_file: Option<PathBuf>,
+    pub state_file: Option<PathBuf>,
     /// Remove the objects whose owner (an iceoryx2 node) no longer runs.
     /// Scene objects and those of running clients stay; ids are never
     /// reused.
     #[arg(long)]
-    remove_departed: bool,
+    pub remove_departed: bool,
 }
 
-#[derive(Args, Debug)]
-struct DemoArgs {
-    /// Sweep steps to time, besides the paper's 10, 100 and 1000.
-    #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000])]
-    steps: Vec<usize>,
-    /// Repetitions of each timed sweep (the median is reported).
-    #[arg(long, default_value_t = 7)]
-    repeats: usize,
-}
-
-fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_writer(std::io::stderr)
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
-        )
-        .init();
-    // iceoryx2 logs to the console by itself; keep it to real problems.
-    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
-    let cli = Cli::parse();
-    match cli.command {
-        Command::Serve(args) => serve(args),
-        Command::Demo(args) => match gjkd::demo::run(&args.steps, args.repeats.max(1)) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("gjkd demo: {e}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Bench(args) => match gjkd::bench::run(args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("gjkd bench: {e}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Objects(args) => match objects(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("gjkd objects: {e}");
-                ExitCode::FAILURE
-            }
-        },
-    }
-}
-
-/// `gjkd objects`: the table, and the removal when asked for. Loading does
-/// to a damaged change log what a server start would (see `open_state`).
-fn objects(args: &ObjectsArgs) -> Result<(), String> {
-    use gjkd::objects::{alive_nodes, liveness, remove_departed, table};
+/// Runs `gjkd objects`: prints the table, and removes the departed owners'
+/// objects when asked. Loading does to a damaged change log what a server
+/// start would (see `open_state`).
+///
+/// # Errors
+/// A message saying what stopped it.
+pub fn objects(args: &ObjectsArgs) -> Result<(), String> {
+    use crate::objects::{alive_nodes, liveness, remove_departed, table};
     let path = args
         .state_file
         .clone()
-        .or_else(|| gjkd::persist::default_path(&args.service))
+        .or_else(|| crate::persist::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file")?;
     let mut store = Store::open(&path)
         .map_err(|e| format!("{e} (a server using this file must be stopped first)"))?;
@@ -229,7 +164,31 @@ fn objects(args: &ObjectsArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn serve(args: ServeArgs) -> ExitCode {
+/// Runs `gjkd serve` until SIGINT or SIGTERM.
+///
+/// # Errors
+/// A message saying what stopped it: the state file, the scene or the
+/// service could not be opened, or serving failed.
+pub fn serve(args: ServeArgs) -> Result<(), String> {
+    let shutdown = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(signal, Arc::clone(&shutdown))
+            .map_err(|e| format!("cannot install the handler of signal {signal}: {e}"))?;
+    }
+    serve_until(args, &shutdown, || {})
+}
+
+/// Runs `gjkd serve` until `shutdown` is set, calling `ready` once the
+/// services are open; for a front end that handles signals itself or stops
+/// the server on its own terms.
+///
+/// # Errors
+/// As [`serve`].
+pub fn serve_until(
+    args: ServeArgs,
+    shutdown: &AtomicBool,
+    ready: impl FnOnce(),
+) -> Result<(), String> {
     let limits = Limits {
         max_clients: args.max_clients.max(1),
         max_nodes: args.max_nodes.max(2),
@@ -242,48 +201,23 @@ fn serve(args: ServeArgs) -> ExitCode {
     let mut state = if args.no_persist {
         State::new(limits, args.wait.into(), epoch())
     } else {
-        match open_state(&args, limits) {
-            Ok(state) => state,
-            Err(message) => {
-                error!("{message}");
-                return ExitCode::FAILURE;
-            }
-        }
+        open_state(&args, limits)?
     };
     if let Some(path) = &args.scene {
-        match Scene::load(path).and_then(|s| s.install(&mut state)) {
-            Ok(ids) => info!(scene = %path.display(), objects = ids.len(), "scene loaded"),
-            Err(e) => {
-                error!("{e}");
-                return ExitCode::FAILURE;
-            }
-        }
+        let ids = Scene::load(path)
+            .and_then(|s| s.install(&mut state))
+            .map_err(|e| e.to_string())?;
+        info!(scene = %path.display(), objects = ids.len(), "scene loaded");
     }
     // Written once at start: a read-only directory fails now rather than at
     // the first registration, and the scene's ids become durable.
-    if let Err(e) = state.persist() {
-        error!("{e}");
-        return ExitCode::FAILURE;
-    }
-    let shutdown = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        if let Err(e) = signal_hook::flag::register(signal, Arc::clone(&shutdown)) {
-            error!("cannot install the handler of signal {signal}: {e}");
-            return ExitCode::FAILURE;
-        }
-    }
+    state.persist().map_err(|e| e.to_string())?;
     let options = ServeOptions {
         service: args.service,
         wait: args.wait.into(),
         remove_departed: args.remove_departed,
     };
-    match run(&options, state, &shutdown, || {}) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            error!("{e}");
-            ExitCode::FAILURE
-        }
-    }
+    run(&options, state, shutdown, ready).map_err(|e| e.to_string())
 }
 
 /// The state of a persisting server: restored from its state file, or
@@ -292,7 +226,7 @@ fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
     let path = args
         .state_file
         .clone()
-        .or_else(|| gjkd::persist::default_path(&args.service))
+        .or_else(|| crate::persist::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file or --no-persist")?;
     let mut store = Store::open(&path).map_err(|e| e.to_string())?;
     let wait = args.wait.into();

@@ -220,6 +220,17 @@ fn median(mut v: Vec<Duration>) -> Duration {
     v[v.len() / 2]
 }
 
+/// The flags of `gjkd demo`.
+#[derive(clap::Args, Debug)]
+pub struct DemoArgs {
+    /// Sweep steps to time, besides the paper's 10, 100 and 1000.
+    #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000])]
+    pub steps: Vec<usize>,
+    /// Repetitions of each timed sweep (the median is reported).
+    #[arg(long, default_value_t = 7)]
+    pub repeats: usize,
+}
+
 /// Runs the demo, printing to stdout.
 ///
 /// # Errors

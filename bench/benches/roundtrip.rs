@@ -14,12 +14,11 @@
 //!
 //! Before the percentiles (and after them, with `GJKD_BENCH_PERCENTILES_ONLY`)
 //! it prints the time for a cache line to go from CPU 0 to CPU 1 and back. On
-//! this VM that is about 65 ns at some times and about 340 ns at others, the
-//! host's doing; in the slow state the single round trip takes about 3.5 µs
-//! instead of 1.6 and the batch about 23 µs instead of 14.5, with the GJK
-//! work unchanged. Read the figures against the probe.
+//! a virtual machine that time is the host's doing and can change
+//! several-fold between runs, and the round trips follow it with the GJK
+//! work unchanged: read the figures against the probe.
 //!
-//! `cargo bench -p gjkd --bench roundtrip` (set `GJKD_BENCH_PERCENTILES_ONLY`
+//! `cargo bench -p gjkd-bench --bench roundtrip` (set `GJKD_BENCH_PERCENTILES_ONLY`
 //! to stop after the percentiles).
 
 use std::hint::black_box;
@@ -28,10 +27,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group};
-use gjkd::server::{ServeOptions, run};
-use gjkd::state::{Limits, State};
 use gjkd_client::{Client, Item, ItemResult, ObjectId, QueryOptions};
 use gjkd_proto::WaitMode;
+use gjkd_server::server::{ServeOptions, run};
+use gjkd_server::state::{Limits, State};
 use nalgebra::{Isometry3, Vector3};
 
 struct Fixture {
@@ -57,11 +56,11 @@ impl Fixture {
         let name = service.clone();
         let pinned = std::env::var_os("GJKD_BENCH_NO_PIN").is_none();
         if pinned {
-            gjkd::bench::latency::pin(0, 0);
+            gjkd_bench::latency::pin(0, 0);
         }
         let server = std::thread::spawn(move || {
             if pinned {
-                gjkd::bench::latency::pin(0, 1);
+                gjkd_bench::latency::pin(0, 1);
             }
             let state = State::new(Limits::default(), WaitMode::Spin, 1);
             let options = ServeOptions {
@@ -178,7 +177,7 @@ fn percentiles(name: &str, mut f: impl FnMut()) {
 
 fn benches(c: &mut Criterion) {
     // The host's cross-core latency decides much of a round trip on a VM.
-    if let Some(ns) = gjkd::bench::latency::core_round_trip_ns(0, 1) {
+    if let Some(ns) = gjkd_bench::latency::core_round_trip_ns(0, 1) {
         println!("cache-line round trip CPU 0 <-> CPU 1: {ns:.0} ns");
     }
     let mut fx = Fixture::start();
@@ -191,7 +190,7 @@ fn benches(c: &mut Criterion) {
     if std::env::var_os("GJKD_BENCH_PERCENTILES_ONLY").is_some() {
         // Probed with the spinning server stopped: it holds CPU 1.
         drop(fx);
-        if let Some(ns) = gjkd::bench::latency::core_round_trip_ns(0, 1) {
+        if let Some(ns) = gjkd_bench::latency::core_round_trip_ns(0, 1) {
             println!("cache-line round trip CPU 0 <-> CPU 1: {ns:.0} ns");
         }
         return;

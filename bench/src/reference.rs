@@ -26,7 +26,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 /// the gap along an axis, from gjk's own brute-force test reference: shared
 /// rather than copied, since both references must owe nothing to GJK and one
 /// implementation of them is enough.
-#[path = "../../../gjk/tests/common/mod.rs"]
+#[path = "../../gjk/tests/common/mod.rs"]
 mod common;
 use common::gap_along;
 pub use common::{closest_on_segment, closest_on_triangle, closest_segment_segment};

@@ -25,7 +25,7 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 use gjkd_proto::{ErrorCode, Item, ItemResult, ReplyHeader};
 
 use super::{BenchError, io};
-use crate::state::State;
+use gjkd_server::state::State;
 
 // The byte views below rely on these types having no padding (every byte is
 // a field's) and accepting any bit pattern (every field is an integer or a
@@ -285,8 +285,8 @@ impl UdsClient {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Limits;
     use gjkd_proto::{AdminOp, AdminRequest, ObjectId, QueryOptions, Vertex, WaitMode, shape_kind};
+    use gjkd_server::state::Limits;
 
     #[test]
     fn answers_over_the_socket_equal_the_handler() {

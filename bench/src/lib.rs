@@ -1,5 +1,11 @@
-//! `gjkd bench ...`: the measurements behind `docs/benchmarks.md` and
-//! `docs/speed-accuracy.md`, one command each.
+//! # gjkd-bench
+//!
+//! The tools that use a gjkd server rather than make one: the built-in demo
+//! (`gjkd demo`, [`demo`]) and the measurements of `gjkd bench`, behind
+//! `docs/benchmarks.md` and `docs/speed-accuracy.md`, one command each.
+//! They start real `gjkd serve` processes and talk to them through
+//! `gjkd-client`, which is why they sit in a crate of their own above the
+//! server library instead of inside it.
 //!
 //! - [`latency`]: round trips through real `gjkd serve` processes in each
 //!   wait mode, beside a Unix-socket server process and a plain function call, with
@@ -14,8 +20,11 @@
 //! progress bar while it runs. Timing is never asserted anywhere: the tests
 //! cover only the logic (percentiles, fits, the Pareto front, the reference).
 
+#![warn(missing_docs)]
+
 use std::path::PathBuf;
 
+pub mod demo;
 pub mod extremes;
 pub mod latency;
 pub mod paper;

@@ -36,7 +36,7 @@ use super::stats::{Csv, Progress};
 use super::uds::{UdsClient, UdsServer};
 use super::{BenchError, CommonArgs, io, out_dir};
 use crate::demo::ServerProcess;
-use crate::state::{Limits, State};
+use gjkd_server::state::{Limits, State};
 
 /// Flags of `gjkd bench latency`.
 #[derive(clap::Args, Debug, Clone)]
@@ -90,10 +90,10 @@ pub fn pin(pid: libc::pid_t, cpu: usize) -> bool {
 /// The median time, in ns, for one cache line to go from CPU `a` to CPU `b`
 /// and back (two threads pinned there bouncing an atomic counter), or `None`
 /// when the threads cannot be pinned. Every round trip through shared memory
-/// is a handful of such transfers, and on a VM their cost is the host's
-/// business: this machine has shown about 65 ns at some times and about
-/// 340 ns at others, which doubles a single round trip. Printed with each
-/// run so that its figures can be read against the state it ran in.
+/// is a handful of such transfers, and on a virtual machine their cost is
+/// the host's business and can change several-fold between runs. Printed
+/// with each run so that its figures can be read against the state it ran
+/// in.
 pub fn core_round_trip_ns(a: usize, b: usize) -> Option<f64> {
     use std::sync::atomic::{AtomicU64, Ordering};
     #[repr(align(128))]

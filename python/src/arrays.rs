@@ -31,7 +31,12 @@ pub fn id_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<IdArray<'
         let a: PyReadonlyArrayDyn<'py, i64> = a.extract()?;
         if let Some(i) = a.as_slice()?.iter().position(|&v| v < 0) {
             let row = i / a.shape().iter().skip(1).product::<usize>().max(1);
-            return Err(invalid(py, field, Some(row), format!("{field}: negative id (row {row})")));
+            return Err(invalid(
+                py,
+                field,
+                Some(row),
+                format!("{field}: negative id (row {row})"),
+            ));
         }
         return Ok(IdArray::Signed(a));
     }

@@ -12,15 +12,15 @@ use nalgebra::Isometry3;
 /// # Errors
 /// `NonFinitePose` or `BadQuaternion`.
 pub fn check_pose(p: &Pose) -> Result<Isometry3<f64>, ErrorCode> {
-    gjkd::state::check_pose(p)
+    gjkd_server::state::check_pose(p)
 }
 
 /// The server's limits, with defaults.
-pub use gjkd::state::Limits;
+pub use gjkd_server::state::Limits;
 
 /// The server's object store and request handlers, without any IPC.
 pub struct Store {
-    state: gjkd::state::State,
+    state: gjkd_server::state::State,
 }
 
 /// The client identity `gjkd.Local` uses with the handlers: the owner of
@@ -31,7 +31,7 @@ impl Store {
     /// An empty store.
     pub fn new(limits: Limits) -> Self {
         Store {
-            state: gjkd::state::State::new(limits, WaitMode::Spin, 1),
+            state: gjkd_server::state::State::new(limits, WaitMode::Spin, 1),
         }
     }
 
@@ -65,51 +65,41 @@ impl Store {
     }
 }
 
-/// `gjkd serve` with `args` (no program name); the exit status.
-///
-/// Interim, until the server library has the serve command: in-memory
-/// objects only, and the flags `--service`, `--wait`, `--max-batch`,
-/// `--cache-capacity`, `--no-persist`.
+/// `python -m gjkd serve`: the flags of `gjkd serve`, parsed by the
+/// server library's own definition.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "python -m gjkd serve",
+    about = "Serve distance queries until SIGINT or SIGTERM."
+)]
+struct ServeCommand {
+    #[command(flatten)]
+    args: gjkd_server::commands::ServeArgs,
+}
+
+/// Runs `gjkd serve` with `args` (without the program name) until SIGINT
+/// or SIGTERM, logging to stderr as the `gjkd` binary does; the exit
+/// status.
 pub fn serve(args: &[String]) -> i32 {
-    use std::sync::Arc;
-    use std::sync::atomic::AtomicBool;
-    let mut limits = Limits::default();
-    let mut options = gjkd::server::ServeOptions {
-        service: gjkd_proto::DEFAULT_SERVICE.to_owned(),
-        wait: WaitMode::Adaptive,
-        remove_departed: false,
+    use clap::Parser;
+    let program = std::iter::once("python -m gjkd serve".to_owned());
+    let command = match ServeCommand::try_parse_from(program.chain(args.iter().cloned())) {
+        Ok(c) => c,
+        Err(e) => {
+            // Help and version go to stdout with status 0, mistakes to
+            // stderr with status 2, as clap does on its own.
+            let _ = e.print();
+            return e.exit_code();
+        }
     };
-    let mut it = args.iter();
-    while let Some(flag) = it.next() {
-        let mut value = || it.next().cloned().unwrap_or_default();
-        match flag.as_str() {
-            "--service" => options.service = value(),
-            "--wait" => {
-                options.wait = match value().as_str() {
-                    "spin" => WaitMode::Spin,
-                    "block" => WaitMode::Block,
-                    _ => WaitMode::Adaptive,
-                }
-            }
-            "--max-batch" => limits.max_batch = value().parse().unwrap_or(limits.max_batch),
-            "--cache-capacity" => {
-                limits.cache_capacity = value().parse().unwrap_or(limits.cache_capacity)
-            }
-            "--no-persist" => {}
-            other => {
-                eprintln!("gjkd serve: unknown flag {other}");
-                return 2;
-            }
-        }
-    }
-    let state = gjkd::state::State::new(limits, options.wait, std::process::id().max(1));
-    let shutdown = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        if signal_hook::flag::register(signal, Arc::clone(&shutdown)).is_err() {
-            return 1;
-        }
-    }
-    match gjkd::server::run(&options, state, &shutdown, || {}) {
+    let _ = tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .try_init();
+    match gjkd_server::commands::serve(command.args) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("gjkd serve: {e}");

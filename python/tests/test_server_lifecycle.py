@@ -91,3 +91,35 @@ def test_python_m_gjkd_serve_runs_and_stops_on_sigterm(tmp_path: pathlib.Path) -
     finally:
         process.terminate()
         assert process.wait(10) == 0
+
+
+def test_serve_takes_the_flags_of_gjkd_serve(tmp_path: pathlib.Path) -> None:
+    def run(*args: str) -> "subprocess.CompletedProcess[str]":
+        return subprocess.run(
+            [sys.executable, "-m", "gjkd", *args],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            timeout=60,
+        )
+
+    helped = run("serve", "--help")
+    assert helped.returncode == 0
+    for flag in ("--service", "--wait", "--max-batch", "--state-file", "--no-persist", "--scene"):
+        assert flag in helped.stdout
+    wrong = run("serve", "--no-such-flag")
+    assert wrong.returncode == 2 and "--no-such-flag" in wrong.stderr
+    assert run("frobnicate").returncode == 2
+
+
+def test_a_persisting_server_keeps_ids_across_a_crash(tmp_path: pathlib.Path) -> None:
+    service = unique_service("persist")
+    server = gjkd.Server(service=service, persist=True, state_file=tmp_path / "objects")
+    with server, gjkd.Client(service, timeout=0.5) as client:
+        a = client.register_box([1.0, 1.0, 1.0])
+        b = client.register_sphere(0.5, pose=[3.0, 0, 0, 0, 0, 0, 1])
+        server.kill()
+        with pytest.raises(gjkd.ServerGone):
+            client.distance(a, b)
+        server.start()
+        assert abs(client.distance(a, b).distance - 1.5) < 1e-9

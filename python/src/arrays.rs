@@ -7,7 +7,7 @@
 //! tuples) are converted, since they carry no dtype to be wrong about.
 
 use nalgebra::{Matrix3, Point3, Rotation3, UnitQuaternion};
-use numpy::{PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
+use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyAnyMethods;
 
@@ -15,11 +15,26 @@ use gjkd_proto::Pose;
 
 use crate::errors::invalid;
 
-/// A float64 array, contiguous, read-only.
-pub fn f64_array<'py>(
-    obj: &Bound<'py, PyAny>,
-    field: &str,
-) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+/// A contiguous numpy array of `T`.
+pub type Array<'py, T> = Bound<'py, PyArrayDyn<T>>;
+
+/// The elements of `a`, a C-contiguous array (as every function here
+/// returns).
+///
+/// numpy's own borrow tracking (`PyReadonlyArray`) costs a few hundred
+/// nanoseconds an array, which a batch of one pair pays several times over;
+/// like any C extension, this one instead reads the buffer directly.
+pub fn slice<'a, T: numpy::Element>(a: &'a Array<'_, T>) -> PyResult<&'a [T]> {
+    // SAFETY: the slice lives no longer than the borrow of `a`, which keeps
+    // the array alive; this crate holds no mutable view of input arrays.
+    // Another Python thread may write the array while the GIL is released,
+    // as with any extension that releases it: numpy leaves that to the
+    // caller.
+    Ok(unsafe { a.as_slice() }?)
+}
+
+/// A float64 array, contiguous.
+pub fn f64_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<Array<'py, f64>> {
     array_of::<f64>(obj, field, "float64")
 }
 
@@ -27,9 +42,8 @@ pub fn f64_array<'py>(
 pub fn id_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<IdArray<'py>> {
     let py = obj.py();
     if let Ok(a) = obj.cast::<PyArrayDyn<i64>>() {
-        let a = contiguous(a.clone().into_any(), field)?;
-        let a: PyReadonlyArrayDyn<'py, i64> = a.extract()?;
-        if let Some(i) = a.as_slice()?.iter().position(|&v| v < 0) {
+        let a = contiguous(a.clone().into_any(), field)?.cast_into::<PyArrayDyn<i64>>()?;
+        if let Some(i) = slice(&a)?.iter().position(|&v| v < 0) {
             let row = i / a.shape().iter().skip(1).product::<usize>().max(1);
             return Err(invalid(
                 py,
@@ -46,9 +60,9 @@ pub fn id_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<IdArray<'
 /// Ids read either way.
 pub enum IdArray<'py> {
     /// From an int64 array, none negative.
-    Signed(PyReadonlyArrayDyn<'py, i64>),
+    Signed(Array<'py, i64>),
     /// From a uint64 array.
-    Unsigned(PyReadonlyArrayDyn<'py, u64>),
+    Unsigned(Array<'py, u64>),
 }
 
 impl IdArray<'_> {
@@ -64,8 +78,8 @@ impl IdArray<'_> {
     /// keeps its value.
     pub fn slice(&self) -> PyResult<Ids<'_>> {
         Ok(match self {
-            IdArray::Signed(a) => Ids::Signed(a.as_slice()?),
-            IdArray::Unsigned(a) => Ids::Unsigned(a.as_slice()?),
+            IdArray::Signed(a) => Ids::Signed(slice(a)?),
+            IdArray::Unsigned(a) => Ids::Unsigned(slice(a)?),
         })
     }
 }
@@ -102,7 +116,7 @@ fn array_of<'py, T: numpy::Element>(
     obj: &Bound<'py, PyAny>,
     field: &str,
     want: &str,
-) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
+) -> PyResult<Array<'py, T>> {
     let py = obj.py();
     let array = if let Ok(untyped) = obj.cast::<PyUntypedArray>() {
         if obj.cast::<PyArrayDyn<T>>().is_err() {
@@ -130,7 +144,7 @@ fn array_of<'py, T: numpy::Element>(
             }
         }
     };
-    Ok(array.extract()?)
+    Ok(array.cast_into::<PyArrayDyn<T>>()?)
 }
 
 /// `obj` if C-contiguous, else a contiguous copy.
@@ -157,7 +171,7 @@ pub fn points(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Vec<Point3<f64>>>
             format!("{field} must have shape (N, 3), got {shape:?}"),
         ));
     }
-    Ok(a.as_slice()?
+    Ok(slice(&a)?
         .chunks_exact(3)
         .map(|c| Point3::new(c[0], c[1], c[2]))
         .collect())
@@ -174,7 +188,7 @@ pub fn point(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Point3<f64>> {
             format!("{field} must have shape (3,), got {:?}", a.shape()),
         ));
     }
-    let s = a.as_slice()?;
+    let s = slice(&a)?;
     Ok(Point3::new(s[0], s[1], s[2]))
 }
 
@@ -234,7 +248,7 @@ impl<'a> Poses<'a> {
 
 /// A pose array and its layout, held while its slice is in use.
 pub struct PoseArray<'py> {
-    array: PyReadonlyArrayDyn<'py, f64>,
+    array: Array<'py, f64>,
     layout: Layout,
 }
 
@@ -242,7 +256,7 @@ impl PoseArray<'_> {
     /// The poses.
     pub fn poses(&self) -> PyResult<Poses<'_>> {
         Ok(Poses {
-            data: self.array.as_slice()?,
+            data: slice(&self.array)?,
             layout: self.layout,
         })
     }
@@ -273,7 +287,7 @@ pub fn pose(obj: Option<&Bound<'_, PyAny>>, field: &str) -> PyResult<Option<Pose
         return Ok(None);
     }
     let a = f64_array(obj, field)?;
-    let s = a.as_slice()?;
+    let s = slice(&a)?;
     match a.shape() {
         [7] => Ok(Some(Pose {
             translation: [s[0], s[1], s[2]],

@@ -204,6 +204,9 @@ pub struct Distances {
     error: Py<PyArray1<u32>>,
     warm_started: Py<PyArray1<bool>>,
     len: usize,
+    /// Set while a call writes the arrays: a second call given the same
+    /// `out` meanwhile (from another thread) is refused.
+    busy: std::sync::atomic::AtomicBool,
 }
 
 /// The field names of [`Distances`], in [`Distances::as_dict`]'s order.
@@ -241,6 +244,7 @@ impl Distances {
             error: PyArray1::zeros(py, n, false).unbind(),
             warm_started: PyArray1::zeros(py, n, false).unbind(),
             len: n,
+            busy: std::sync::atomic::AtomicBool::new(false),
         }
     }
 
@@ -346,40 +350,75 @@ impl Distances {
         self.len
     }
 
-    /// Runs `fill` with the arrays' storage borrowed for writing (the
-    /// borrows are numpy's own checks: a view of these arrays being written
-    /// elsewhere raises instead of racing).
+    /// Runs `fill` with the arrays' storage to write into.
     pub fn with_writer<R>(
         &self,
         py: Python<'_>,
         fill: impl FnOnce(Writer<'_>) -> PyResult<R>,
     ) -> PyResult<R> {
-        let mut distance = self.distance.bind(py).try_readwrite()?;
-        let mut lower = self.lower.bind(py).try_readwrite()?;
-        let mut upper = self.upper.bind(py).try_readwrite()?;
-        let mut penetration = self.penetration.bind(py).try_readwrite()?;
-        let mut point_a = self.point_a.bind(py).try_readwrite()?;
-        let mut point_b = self.point_b.bind(py).try_readwrite()?;
-        let mut normal = self.normal.bind(py).try_readwrite()?;
-        let mut status = self.status.bind(py).try_readwrite()?;
-        let mut iterations = self.iterations.bind(py).try_readwrite()?;
-        let mut pieces = self.pieces.bind(py).try_readwrite()?;
-        let mut error = self.error.bind(py).try_readwrite()?;
-        let mut warm = self.warm_started.bind(py).try_readwrite()?;
-        fill(Writer {
-            distance: distance.as_slice_mut()?,
-            lower: lower.as_slice_mut()?,
-            upper: upper.as_slice_mut()?,
-            penetration: penetration.as_slice_mut()?,
-            point_a: point_a.as_slice_mut()?,
-            point_b: point_b.as_slice_mut()?,
-            normal: normal.as_slice_mut()?,
-            status: status.as_slice_mut()?,
-            iterations: iterations.as_slice_mut()?,
-            pieces: pieces.as_slice_mut()?,
-            error: error.as_slice_mut()?,
-            warm: warm.as_slice_mut()?,
-        })
+        /// The storage of `a`, an array this object created (C-contiguous).
+        /// The storage is numpy's, not the handle's: hence a mutable slice
+        /// from a shared handle.
+        #[allow(clippy::mut_from_ref)]
+        fn storage<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+            a: &'a Bound<'_, numpy::PyArray<T, D>>,
+        ) -> PyResult<&'a mut [T]> {
+            // SAFETY: the arrays were created contiguous by `Distances::new`
+            // and numpy arrays that own their data cannot be resized while
+            // this object references them. No other Rust view of them
+            // exists: each field is lent once per call, and `busy` keeps two
+            // calls from writing one `Distances` at once. Python code
+            // holding a view may read them,
+            // also from another thread while the GIL is released, as with
+            // any extension that releases it; numpy's borrow tracking,
+            // which would catch that, costs more than a one-pair batch.
+            Ok(unsafe { a.as_slice_mut() }?)
+        }
+        let (d, lo, up, pen) = (
+            self.distance.bind(py),
+            self.lower.bind(py),
+            self.upper.bind(py),
+            self.penetration.bind(py),
+        );
+        let (pa, pb, nrm) = (
+            self.point_a.bind(py),
+            self.point_b.bind(py),
+            self.normal.bind(py),
+        );
+        let (st, it, pc, er, wm) = (
+            self.status.bind(py),
+            self.iterations.bind(py),
+            self.pieces.bind(py),
+            self.error.bind(py),
+            self.warm_started.bind(py),
+        );
+        use std::sync::atomic::Ordering;
+        if self.busy.swap(true, Ordering::Acquire) {
+            return Err(invalid(
+                py,
+                "out",
+                None,
+                "out is being written by another call".into(),
+            ));
+        }
+        let result = (|| {
+            fill(Writer {
+                distance: storage(d)?,
+                lower: storage(lo)?,
+                upper: storage(up)?,
+                penetration: storage(pen)?,
+                point_a: storage(pa)?,
+                point_b: storage(pb)?,
+                normal: storage(nrm)?,
+                status: storage(st)?,
+                iterations: storage(it)?,
+                pieces: storage(pc)?,
+                error: storage(er)?,
+                warm: storage(wm)?,
+            })
+        })();
+        self.busy.store(false, Ordering::Release);
+        result
     }
 
     /// `out` if it has `n` rows and is not referenced elsewhere in a way

@@ -14,9 +14,9 @@ if [ ! -x "$venv/bin/python" ]; then
   echo "== creating $venv"
   "$python" -m venv "$venv"
 fi
-echo "== installing maturin, numpy, pytest and ./python"
+echo "== installing maturin, numpy, pytest, mypy and ./python"
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet "maturin>=1.7,<2" "numpy>=1.21" "pytest>=7"
+"$venv/bin/python" -m pip install --quiet "maturin>=1.7,<2" "numpy>=1.21" "pytest>=7" "mypy>=1.10"
 "$venv/bin/python" -m pip install --quiet "$here"
 echo "== pytest"
 cd "$here"

@@ -1,10 +1,26 @@
 """Type stubs of the native module ``gjkd._native`` (see ``gjkd``)."""
 
 from types import TracebackType
-from typing import Optional, Sequence, Tuple, Type, Union
+from typing import Optional, Sequence, Tuple, Type
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Self, final
+
+__all__ = [
+    "Answer",
+    "Client",
+    "DEFAULT_MAX_ITERATIONS",
+    "DEFAULT_TOLERANCE",
+    "Distances",
+    "Local",
+    "MAX_NAME_LEN",
+    "MAX_PIECES",
+    "PROTOCOL_VERSION",
+    "Shape",
+    "error_codes",
+    "serve",
+]
 
 DEFAULT_TOLERANCE: float
 DEFAULT_MAX_ITERATIONS: int
@@ -12,14 +28,15 @@ MAX_PIECES: int
 MAX_NAME_LEN: int
 PROTOCOL_VERSION: int
 
-ArrayLike = npt.ArrayLike
-Pose = npt.ArrayLike
+_ArrayLike = npt.ArrayLike
+_Pose = npt.ArrayLike
 """A pose: ``(7,)`` ``[x, y, z, qx, qy, qz, qw]`` or a ``(4, 4)`` rigid
 transform, float64."""
 
-F64 = npt.NDArray[np.float64]
-U32 = npt.NDArray[np.uint32]
+_F64 = npt.NDArray[np.float64]
+_U32 = npt.NDArray[np.uint32]
 
+@final
 class Shape:
     """A convex shape: the hull of its vertices grown by a radius."""
 
@@ -27,13 +44,13 @@ class Shape:
     def sphere(radius: float) -> Shape:
         """A ball of ``radius`` about the body origin."""
     @staticmethod
-    def capsule(a: ArrayLike, b: ArrayLike, radius: float) -> Shape:
+    def capsule(a: _ArrayLike, b: _ArrayLike, radius: float) -> Shape:
         """The segment ``a``-``b`` grown by ``radius``."""
     @staticmethod
-    def box(half_extents: ArrayLike, radius: float = 0.0) -> Shape:
+    def box(half_extents: _ArrayLike, radius: float = 0.0) -> Shape:
         """A box of these half extents, edges rounded by ``radius``."""
     @staticmethod
-    def polytope(vertices: ArrayLike, radius: float = 0.0) -> Shape:
+    def polytope(vertices: _ArrayLike, radius: float = 0.0) -> Shape:
         """The convex hull of ``(N, 3)`` float64 ``vertices`` grown by ``radius``."""
     @property
     def kind(self) -> str:
@@ -42,9 +59,10 @@ class Shape:
     def radius(self) -> float:
         """The rounding radius."""
     @property
-    def vertices(self) -> F64:
+    def vertices(self) -> _F64:
         """``(N, 3)`` vertices in the order the server stores them."""
 
+@final
 class Answer:
     """The answer to one pair query."""
 
@@ -85,44 +103,45 @@ class Answer:
     def backup_used(self) -> bool:
         """The Backup Procedure ran."""
 
+@final
 class Distances:
     """The answers of N pair queries, one numpy array per field."""
 
-    def __init__(self, n: int) -> None:
+    def __new__(cls, n: int) -> Self:
         """Zeroed arrays for ``n`` pairs, to pass as ``out=``."""
     def __len__(self) -> int: ...
     @property
-    def distance(self) -> F64:
+    def distance(self) -> _F64:
         """``(N,)`` distances."""
     @property
-    def lower(self) -> F64:
+    def lower(self) -> _F64:
         """``(N,)`` certified lower bounds."""
     @property
-    def upper(self) -> F64:
+    def upper(self) -> _F64:
         """``(N,)`` certified upper bounds."""
     @property
-    def penetration(self) -> F64:
+    def penetration(self) -> _F64:
         """``(N,)`` lower bounds on penetration depth."""
     @property
-    def point_a(self) -> F64:
+    def point_a(self) -> _F64:
         """``(N, 3)`` nearest points on A."""
     @property
-    def point_b(self) -> F64:
+    def point_b(self) -> _F64:
         """``(N, 3)`` nearest points on B."""
     @property
-    def normal(self) -> F64:
+    def normal(self) -> _F64:
         """``(N, 3)`` unit normals from A towards B."""
     @property
-    def status(self) -> U32:
+    def status(self) -> _U32:
         """``(N,)`` ``gjkd.Status`` values (0 for failed rows)."""
     @property
-    def iterations(self) -> U32:
+    def iterations(self) -> _U32:
         """``(N,)`` subalgorithm iterations."""
     @property
-    def pieces(self) -> U32:
+    def pieces(self) -> _U32:
         """``(N, 2)`` pieces realising the distance."""
     @property
-    def error(self) -> U32:
+    def error(self) -> _U32:
         """``(N,)`` ``gjkd.ErrorCode`` values, 0 when answered."""
     @property
     def warm_started(self) -> npt.NDArray[np.bool_]:
@@ -137,63 +156,63 @@ class _Objects:
     """The methods ``Client`` and ``Local`` share."""
 
     def register(
-        self, shape: Shape, *, name: Optional[str] = None, pose: Optional[Pose] = None
+        self, shape: Shape, *, name: Optional[str] = None, pose: Optional[_Pose] = None
     ) -> int:
         """Registers ``shape``; returns its id."""
     def register_sphere(
-        self, radius: float, *, name: Optional[str] = None, pose: Optional[Pose] = None
+        self, radius: float, *, name: Optional[str] = None, pose: Optional[_Pose] = None
     ) -> int:
         """Registers a ball; returns its id."""
     def register_capsule(
         self,
-        a: ArrayLike,
-        b: ArrayLike,
+        a: _ArrayLike,
+        b: _ArrayLike,
         radius: float,
         *,
         name: Optional[str] = None,
-        pose: Optional[Pose] = None,
+        pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a capsule; returns its id."""
     def register_box(
         self,
-        half_extents: ArrayLike,
+        half_extents: _ArrayLike,
         radius: float = 0.0,
         *,
         name: Optional[str] = None,
-        pose: Optional[Pose] = None,
+        pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a box; returns its id."""
     def register_polytope(
         self,
-        vertices: ArrayLike,
+        vertices: _ArrayLike,
         radius: float = 0.0,
         *,
         name: Optional[str] = None,
-        pose: Optional[Pose] = None,
+        pose: Optional[_Pose] = None,
     ) -> int:
         """Registers the convex hull of ``(N, 3)`` vertices; returns its id."""
     def register_compound(
         self,
-        pieces: Sequence[Tuple[Pose, Shape]],
+        pieces: Sequence[Tuple[_Pose, Shape]],
         *,
         name: Optional[str] = None,
-        pose: Optional[Pose] = None,
+        pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a union of ``(offset, Shape)`` pieces; returns its id."""
     def remove(self, id: int) -> None:
         """Removes object ``id``."""
     def lookup(self, name: str) -> int:
         """The id of the object named ``name``."""
-    def set_pose(self, id: int, pose: Pose) -> None:
+    def set_pose(self, id: int, pose: _Pose) -> None:
         """Stores the pose of object ``id``."""
-    def set_poses(self, ids: ArrayLike, poses: ArrayLike) -> None:
+    def set_poses(self, ids: _ArrayLike, poses: _ArrayLike) -> None:
         """Stores ``(N, 7)`` or ``(N, 4, 4)`` poses of ``(N,)`` ids."""
     def distance(
         self,
         a: int,
         b: int,
-        pose_a: Optional[Pose] = None,
-        pose_b: Optional[Pose] = None,
+        pose_a: Optional[_Pose] = None,
+        pose_b: Optional[_Pose] = None,
         *,
         tolerance: float = ...,
         max_iterations: int = 128,
@@ -203,9 +222,9 @@ class _Objects:
         """The distance between objects ``a`` and ``b``."""
     def distances(
         self,
-        pairs: ArrayLike,
-        poses_a: Optional[ArrayLike] = None,
-        poses_b: Optional[ArrayLike] = None,
+        pairs: _ArrayLike,
+        poses_a: Optional[_ArrayLike] = None,
+        poses_b: Optional[_ArrayLike] = None,
         *,
         tolerance: float = ...,
         max_iterations: int = 128,
@@ -217,12 +236,13 @@ class _Objects:
     def close(self) -> None:
         """Closes (a no-op for ``Local``)."""
 
+@final
 class Client(_Objects):
     """A connection to a gjkd server on this host."""
 
-    def __init__(
-        self, service: str = "gjkd", timeout: float = 1.0, connect_timeout: Optional[float] = None
-    ) -> None: ...
+    def __new__(
+        cls, service: str = "gjkd", timeout: float = 1.0, connect_timeout: Optional[float] = None
+    ) -> Self: ...
     @property
     def service(self) -> str:
         """The service name."""
@@ -244,10 +264,11 @@ class Client(_Objects):
         tb: Optional[TracebackType],
     ) -> bool: ...
 
+@final
 class Local(_Objects):
     """Shapes held in this process, answered with no server."""
 
-    def __init__(self, max_vertices: int = 100000, cache_capacity: int = 65536) -> None: ...
+    def __new__(cls, max_vertices: int = 100000, cache_capacity: int = 65536) -> Self: ...
     def __len__(self) -> int: ...
     def forget_warm_starts(self) -> None:
         """Forgets every pair's last simplex."""

@@ -398,14 +398,16 @@ macro_rules! backend_methods {
             /// The distance between objects `a` and `b`, at their stored
             /// poses or at `pose_a` / `pose_b` (`(7,)` or `(4, 4)`) for this
             /// query only. `tolerance` is the relative tolerance of the
-            /// stopping rule, `max_iterations` the iteration cap, `margin`
+            /// stopping rule (default `gjkd.DEFAULT_TOLERANCE`, 100 × machine
+            /// epsilon), `max_iterations` the iteration cap, `margin`
             /// an early exit (stop once the distance is proved above or at
             /// most it), `warm_start` starts from the pair's last simplex.
             /// Returns an `Answer`; a refused query raises (`NotFound` for
             /// an unknown id, `InvalidInput` for a bad pose).
             #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true))]
+                margin = None, warm_start = true),
+                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True)")]
             #[allow(clippy::too_many_arguments)]
             fn distance(
                 &mut self,
@@ -434,7 +436,8 @@ macro_rules! backend_methods {
             /// from an earlier call, is filled instead of new arrays.
             #[pyo3(signature = (pairs, poses_a = None, poses_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true, out = None))]
+                margin = None, warm_start = true, out = None),
+                text_signature = "($self, pairs, poses_a=None, poses_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, out=None)")]
             #[allow(clippy::too_many_arguments)]
             fn distances(
                 &mut self,

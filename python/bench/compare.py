@@ -176,6 +176,12 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=1000)
     parser.add_argument("--repeats", type=int, default=30)
     parser.add_argument("--single", type=int, default=20000, help="single-query round trips")
+    parser.add_argument(
+        "--no-pin",
+        action="store_true",
+        help="leave the server and this process unpinned (default: server on CPU 1, "
+        "this process and the Rust client on CPU 0, as `gjkd bench latency` does)",
+    )
     args = parser.parse_args()
     n = args.pairs
     ha, hb, pa, pb = box_pairs(n)
@@ -183,6 +189,11 @@ def main() -> None:
     rows: list[tuple[str, float, str]] = []
 
     with gjkd.Server(service=service, wait="spin") as server, gjkd.Client(service) as client:
+        pinned = not args.no_pin and len(os.sched_getaffinity(0)) >= 2
+        if pinned:
+            assert server.pid is not None
+            os.sched_setaffinity(server.pid, {1})
+            os.sched_setaffinity(0, {0})
         ids_a = np.array([client.register_box(h) for h in ha], dtype=np.uint64)
         ids_b = np.array([client.register_box(h) for h in hb], dtype=np.uint64)
         pairs = np.stack([ids_a, ids_b], axis=1)
@@ -217,19 +228,24 @@ def main() -> None:
         rows.append(("Client.distances, batch 1000", statistics.median(python_1000), ""))
         rust = statistics.median(rust_1000) if rust_1000 else None
 
-        # Single-query round trip: one pair at its stored poses.
+        # Single-query round trip: one pair at its stored poses, from Python
+        # and from Rust (a batch of one) in turns.
         client.set_poses(pairs[0], np.stack([pa[0], pb[0]]))
         a0, b0 = int(pairs[0, 0]), int(pairs[0, 1])
-        for _ in range(1000):
-            client.distance(a0, b0)
-        single = []
-        for _ in range(args.single):
-            start = time.perf_counter_ns()
-            client.distance(a0, b0)
-            single.append(time.perf_counter_ns() - start)
+        single: list[int] = []
+        rust_single = []
+        for _ in range(ROUNDS):
+            for _ in range(1000):
+                client.distance(a0, b0)
+            for _ in range(args.single // ROUNDS):
+                start = time.perf_counter_ns()
+                client.distance(a0, b0)
+                single.append(time.perf_counter_ns() - start)
+            one = rust_query_batch(service, ha[:1], hb[:1], pa[:1], pb[:1], args.single // ROUNDS)
+            if one is not None:
+                rust_single.append(one)
         single_p50 = float(np.percentile(single, 50)) / 1000
         single_p90 = float(np.percentile(single, 90)) / 1000
-        server_pid = server.pid
 
     local = gjkd.Local()
     lids = np.stack(
@@ -269,7 +285,8 @@ def main() -> None:
             )
         )
 
-    print(f"{n} separated box pairs, each with its own poses; server pid {server_pid}, wait spin")
+    print(f"{n} separated box pairs, each with its own poses; server wait spin")
+    print(f"load average at the end: {os.getloadavg()[0]:.2f} (1 min)")
     print(f"{'':34} {'µs/pair':>9}  error against gjkd's [lower, upper]")
     for name, t, note in rows:
         print(f"{name:34} {t:9.3f}  {note}")
@@ -279,6 +296,10 @@ def main() -> None:
         print(f"Python batch 1000 / Rust query_batch: {batch_1000 / rust:.2f}x")
     print(f"gjkd.Local against the server: max {local_error.max():.2e} outside the interval")
     print(f"single query round trip from Python: p50 {single_p50:.2f} µs, p90 {single_p90:.2f} µs")
+    if rust_single:
+        rust_p50 = statistics.median(rust_single)
+        print(f"single query round trip from Rust (batch of one), median: {rust_p50:.2f} µs")
+    print(f"pinned: {'server on CPU 1, clients on CPU 0' if pinned else 'no'}")
     print(f"interval width: median {np.median(truth.upper - truth.lower):.2e}")
 
 

@@ -8,7 +8,7 @@
 //! sees the same geometry.
 //!
 //! ```
-//! use gjk::paper::{self, Case};
+//! use gjkd_testkit::paper::{self, Case};
 //! use gjk::{distance, Options, Shape};
 //!
 //! let family = paper::family();
@@ -31,7 +31,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use crate::{Answer, Compound, Convex, Error, Options, Shape, WarmStart, distance};
+use gjk::{Answer, Compound, Convex, Error, Options, Shape, WarmStart, distance};
 
 /// SplitMix64 (Steele, Lea, Flood 2014): 64 bits of state, good enough for
 /// test geometry, and tiny.

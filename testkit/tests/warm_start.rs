@@ -1,10 +1,9 @@
 //! Warm start along smooth motions: the same answers as a cold start, in fewer
 //! iterations; and the right answer after a jump.
 
-mod common;
-
-use common::{p, shape_distance, v};
 use gjk::{Answer, Compound, Convex, Options, Shape, Status, WarmStart, distance};
+use gjkd_testkit::check::shape_distance;
+use gjkd_testkit::input::{p, v};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 const STEPS: usize = 1000;

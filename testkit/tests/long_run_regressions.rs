@@ -1,12 +1,12 @@
 //! Inputs found by long runs of the property tests (100 000 cases a test,
 //! random seeds: `PROPTEST_CASES=100000 PROPTEST_RNG_SEED=<n> cargo test
-//! --release -p gjk --test properties`) that broke a promise, kept with the
-//! brute force of `common` as their truth.
+//! --release -p gjkd-testkit --test properties`) that broke a promise, kept with the
+//! brute force of `gjkd_testkit::reference` as their truth.
 
-mod common;
-
-use common::{points as shape, printed_pose as pose, shape_distance};
 use gjk::{Options, Shape, Status, distance};
+use gjkd_testkit::check::shape_distance;
+use gjkd_testkit::input::{points as shape, printed_pose as pose};
+use gjkd_testkit::reference::point_to_hull;
 use nalgebra::Isometry3;
 
 /// The answer against the brute force: bounds around the truth (to round-off
@@ -243,15 +243,15 @@ fn touching_triangles_far_out_share_a_point_of_both() {
         "{ans:?}"
     );
     let size = 17029.937258479084;
-    let on_a = common::point_to_hull(&ans.point_a, &truth.pieces_a[0].points);
-    let on_b = common::point_to_hull(&ans.point_b, &truth.pieces_b[0].points);
+    let on_a = point_to_hull(&ans.point_a, &truth.pieces_a[0].points);
+    let on_b = point_to_hull(&ans.point_b, &truth.pieces_b[0].points);
     assert!(
         on_a <= 1e-9 * size && on_b <= 1e-9 * size,
         "{on_a:e} {on_b:e}: {ans:?}"
     );
 }
 
-/// A point 6.4e-7 from a six-point polytope (seed 405). GJK's triangle had
+/// A point 6.4e-7 from a six-point polytope. GJK's triangle had
 /// the right `|v|` but a direction 4e-7 rad off (Johnson's absolute error
 /// over a small `|v|`), so the support point, a vertex of K, seemed 1e-6
 /// beyond it; the tetrahedron it made failed every test of Theorem 5.2, the

@@ -15,18 +15,15 @@
 //!
 //! `cargo test` runs 40 pairs of shapes (`CONES_PAIRS`, `CONES_POSES`
 //! placements each, 4 by default) from `CONES_SEED` (1). A long hunt:
-//! `CONES_PAIRS=12500 CONES_SEED=$RANDOM cargo test --release -p gjk --test
-//! mid_sets -- --nocapture` (about a minute). Written for the hunt that found
-//! the needle-on-a-polygon misses of `degenerate_contacts.rs` (about 30 in
-//! 200 000 placements before the exact orientation test, none after).
+//! `CONES_PAIRS=12500 CONES_SEED=$RANDOM cargo test --release -p gjkd-testkit
+//! --test mid_sets -- --nocapture`. Written for the hunt that found the
+//! needle-on-a-polygon misses of gjk's `degenerate_contacts.rs`, which the
+//! exact orientation test mended.
 
-mod common;
-mod sweep;
-
-use common::gap_along as gap;
 use gjk::{Convex, Options, Shape, Status, distance};
+use gjkd_testkit::reference::{self, gap_along as gap};
+use gjkd_testkit::sweep::Rng;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use sweep::Rng;
 
 type P = Point3<f64>;
 type V = Vector3<f64>;
@@ -420,16 +417,16 @@ fn argmax(ps: &[P], n: &V, o: &P) -> usize {
     best.1
 }
 
-/// The test crate's nearest point of a segment or triangle, to the origin.
+/// The reference's nearest point of a segment or triangle, to the origin.
 fn closest_on_segment(a: &V, b: &V) -> V {
-    common::closest_on_segment(&P::origin(), &P::from(*a), &P::from(*b)).coords
+    reference::closest_on_segment(&P::origin(), &P::from(*a), &P::from(*b)).coords
 }
 
 /// A point of triangle `abc` near the origin, as an upper bound: a convex
-/// combination of the vertices ([`common::closest_on_triangle`]).
+/// combination of the vertices ([`reference::closest_on_triangle`]).
 fn closest_on_triangle(a: &V, b: &V, c: &V) -> V {
     let (a, b, c) = (P::from(*a), P::from(*b), P::from(*c));
-    common::closest_on_triangle(&P::origin(), &a, &b, &c).coords
+    reference::closest_on_triangle(&P::origin(), &a, &b, &c).coords
 }
 
 /// Distance from the origin to conv(ws), |ws| <= 4, by every sub-simplex.
@@ -743,9 +740,9 @@ fn cones_hunt() {
             // other ties), so its run may take another path: each answer is
             // held to the truth above, and here the two certified intervals
             // must meet. A gap beyond the tight level that both certify is
-            // informational, as TIGHT is (seed 8204 found a touching pair
-            // ending cold at 3.5e-10, 1.8e-10 of the size, inside its own
-            // interval [0, 3.5e-10], where the copy ended at 0).
+            // informational, as TIGHT is: a touching pair can end cold a
+            // little above 0, inside its own certified interval, where the
+            // copy ends at 0.
             let dd = (cold.distance - dupc.distance).abs();
             let meet = cold.lower <= dupc.upper + slack && dupc.lower <= cold.upper + slack;
             let diff = format!(
@@ -761,9 +758,9 @@ fn cones_hunt() {
             // clear of it by the reference's own slack as well: the
             // reference places B by a rounded relative pose, which with
             // vertices 6e7 from their body origin is off gjk's exact
-            // placement by 1e-8 (seed 8403 pair 7224: gjk certified the
-            // distance 0, checked in rational arithmetic, where the
-            // reference put it in [8.9e-9, 1.4e-8], 3e-9 from a margin).
+            // placement by about 1e-8: a pair that gjk certified at
+            // distance 0 (and rational arithmetic agreed) had the
+            // reference's interval a few 1e-9 from a margin.
             if pinned {
                 for (m, never) in [
                     (hi_t + 1e-3 * size + 2.0 * slack, Status::Farther),

@@ -1,6 +1,6 @@
 //! Randomised extreme cases whose distance is known by construction, shared by
-//! `tests/random_extremes.rs` (gjk alone, every case must pass) and
-//! `examples/extremes_compare.rs` (gjk beside parry3d-f64).
+//! `testkit/tests/random_extremes.rs` (gjk alone, every case must pass) and
+//! `bench/examples/extremes_compare.rs` (gjk beside parry3d-f64).
 //!
 //! The truth comes from a slab argument, not from another distance routine:
 //! when `p` is a point of A that maximises `n·x` over A, and `q` a point of B
@@ -20,18 +20,20 @@
 //! error `e` (TwoSum), and B's body vertices are moved by `Rb⁻¹·e` so that the
 //! realised geometry is the constructed one. The truth is then exact up to the
 //! round-off of a few products at the bodies' own scale, `32 ε · extent`.
-#![allow(dead_code)]
 
 use gjk::{Convex, Shape};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
+/// A point in three-space.
 pub type P = Point3<f64>;
+/// A vector in three-space.
 pub type V = Vector3<f64>;
 
 /// A small deterministic generator (SplitMix64), so a seed names a sweep.
 pub struct Rng(u64);
 
 impl Rng {
+    /// The generator whose draws `seed` names.
     pub fn new(seed: u64) -> Self {
         Rng(seed)
     }
@@ -49,14 +51,17 @@ impl Rng {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
+    /// Uniform in [lo, hi).
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit_interval()
     }
 
+    /// Uniform in 0..n (`n` > 0).
     pub fn below(&mut self, n: usize) -> usize {
         (self.next_u64() % n as u64) as usize
     }
 
+    /// One of `items` (not empty), uniformly.
     pub fn pick<T: Copy>(&mut self, items: &[T]) -> T {
         items[self.below(items.len())]
     }
@@ -68,6 +73,7 @@ impl Rng {
         }
     }
 
+    /// 1 or -1, evenly.
     pub fn sign(&mut self) -> f64 {
         if self.next_u64() & 1 == 0 { 1.0 } else { -1.0 }
     }
@@ -137,10 +143,13 @@ enum Feature {
 /// One body of a case, as built.
 #[derive(Clone, Debug)]
 pub struct Body {
+    /// What it is, for messages.
     pub name: &'static str,
+    /// How its support point is known.
     pub form: Form,
     /// The body-frame vertices handed to gjk (after the shift, if any).
     pub vertices: Vec<P>,
+    /// The rounding radius.
     pub radius: f64,
     /// Added to every template vertex to absorb a far pose's rounding;
     /// zero when the pose was stored exactly.
@@ -211,6 +220,7 @@ impl Body {
             .expect("bodies have vertices")
     }
 
+    /// The body as a gjk shape.
     pub fn shape(&self) -> Shape {
         Convex::new(self.vertices.clone(), self.radius)
             .expect("constructed bodies are valid")
@@ -587,10 +597,15 @@ pub enum Contact {
 
 /// One query with its truth.
 pub struct Case {
+    /// How the bodies meet.
     pub contact: Contact,
+    /// The first body.
     pub a: Body,
+    /// The first body's pose.
     pub pa: Isometry3<f64>,
+    /// The second body.
     pub b: Body,
+    /// The second body's pose.
     pub pb: Isometry3<f64>,
     /// The distance after radii.
     pub truth: f64,
@@ -600,7 +615,9 @@ pub struct Case {
     pub size: f64,
     /// How far the truth may be from the real geometry of the stored inputs.
     pub truth_slack: f64,
+    /// The bodies' scale drawn, one of [`SCALES`].
     pub scale: f64,
+    /// The distance from the world origin drawn, one of [`OFFSETS`].
     pub offset: f64,
     /// The gap drawn, as a fraction of `size` (0 for overlaps).
     pub gap: f64,
@@ -611,6 +628,7 @@ pub struct Case {
 }
 
 impl Case {
+    /// A one-line description for a failure message.
     pub fn describe(&self) -> String {
         format!(
             "{:?} {} vs {} (r {:e}, {:e}), scale {:e}, offset {:e}, gap {:e}·size, truth {:e}, size {:e}",
@@ -628,8 +646,11 @@ impl Case {
     }
 }
 
+/// The bodies' scales drawn.
 pub const SCALES: [f64; 6] = [1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e6];
+/// The distances of the pair from the world origin drawn.
 pub const OFFSETS: [f64; 4] = [0.0, 1e3, 1e6, 1e9];
+/// The gaps drawn, as fractions of the size.
 pub const GAPS: [f64; 7] = [1.0, 1e-1, 1e-3, 1e-6, 1e-9, 1e-12, 0.0];
 
 /// `a + b = s + e` exactly, `s` the rounded sum (Knuth's TwoSum).

@@ -1,13 +1,10 @@
 //! Property tests: random small point sets (general, with duplicates,
 //! collinear, coplanar, single points), random radii and poses, compared with
-//! the brute force in `common`.
+//! the brute force of `gjkd_testkit::reference`.
 
-mod common;
-
-use common::{
-    P, RefShape, Tolerance, V, hull_distance, shape_distance, verify, verify_penetration,
-};
 use gjk::{Compound, Convex, Options, Precision, Shape, Status, WarmStart, distance};
+use gjkd_testkit::check::{RefShape, Tolerance, shape_distance, verify, verify_penetration};
+use gjkd_testkit::reference::{P, V, aabb_distance, hull_distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -414,15 +411,15 @@ fn verify_rejects_perturbed_answers() {
 /// the two distances differ by at most the f32 slack.
 #[test]
 fn single_precision_agrees_with_double_on_the_paper_family() {
-    let convex = gjk::paper::family();
+    let convex = gjkd_testkit::paper::family();
     let family: Vec<Shape> = convex.iter().cloned().map(Into::into).collect();
     let single = Options {
         precision: Precision::Single,
         ..Options::default()
     };
     let mut checked = 0;
-    for case in gjk::paper::Case::ALL {
-        for c in gjk::paper::cases(case, 10, 3) {
+    for case in gjkd_testkit::paper::Case::ALL {
+        for c in gjkd_testkit::paper::cases(case, 10, 3) {
             let (a, b) = (&family[c.a], &family[c.b]);
             let d = distance(a, &c.pose_a, b, &c.pose_b, &Options::default(), None).unwrap();
             let s = distance(a, &c.pose_a, b, &c.pose_b, &single, None).unwrap();
@@ -494,7 +491,7 @@ proptest! {
         let pa = Isometry3::from_parts(Translation3::new(1e3, -1e3, 5e2), rot);
         let pb = Isometry3::from_parts(Translation3::from(pa.translation.vector + rot * rel), rot);
         let rel_actual = rot.inverse_transform_vector(&(pb.translation.vector - pa.translation.vector));
-        let core = common::aabb_distance(&V::zeros(), &ha, &rel_actual, &hb);
+        let core = aabb_distance(&V::zeros(), &ha, &rel_actual, &hb);
         let truth = (core - ra - rb).max(0.0);
         let size = ha.norm() + hb.norm() + ra + rb;
         // Round-off of the 1e3 offset and of the truth itself.

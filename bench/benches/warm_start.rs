@@ -1,4 +1,4 @@
-//! Section 8 of the paper: the collision sweep of `gjk::paper::section8()`
+//! Section 8 of the paper: the collision sweep of `gjkd_testkit::paper::section8()`
 //! (a two-piece object moved through five obstacles), the five distances at
 //! `s = t/T` for `t = 0..=T`, started cold at every step (single point,
 //! Section 6) against warm (each obstacle's previous final simplex). The
@@ -11,14 +11,14 @@
 //! `pieces_cold`/`pieces_warm` query each piece against each obstacle with its
 //! own warm start (10 convex queries per step), as the paper does.
 //!
-//! `cargo bench -p gjk --bench warm_start`. Throughput is per query.
+//! `cargo bench -p gjkd-bench --bench warm_start`. Throughput is per query.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use gjk::Options;
-use gjk::paper::{self, OBSTACLES};
+use gjkd_testkit::paper::{self, OBSTACLES};
 
 fn sweep(c: &mut Criterion) {
     let motion = paper::section8();

@@ -8,10 +8,9 @@
 //! test gathers every failing case and prints them all; nothing is printed on
 //! success.
 
-mod common;
-
-use common::{P, V, aabb_distance, p, v};
 use gjk::{Answer, Compound, Convex, Options, Precision, Shape, Status, distance};
+use gjkd_testkit::input::{p, v};
+use gjkd_testkit::reference::{P, V, aabb_distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 struct Case {
@@ -976,7 +975,7 @@ fn single_precision_at_scales_offsets_and_gaps() {
 /// scene, and the ulp of the offset) is allowed for.
 #[test]
 fn paper_family_at_scales_and_offsets() {
-    let family = gjk::paper::family();
+    let family = gjkd_testkit::paper::family();
     let mut failures = Vec::new();
     let mut checked = 0;
     for precision in [Precision::Double, Precision::Single] {
@@ -995,8 +994,8 @@ fn paper_family_at_scales_and_offsets() {
                 .collect();
             for off in [0.0, 1e9] {
                 let shift = v(off, -off, 0.5 * off) * s;
-                for case in gjk::paper::Case::ALL {
-                    for c in gjk::paper::cases(case, 2, 3) {
+                for case in gjkd_testkit::paper::Case::ALL {
+                    for c in gjkd_testkit::paper::cases(case, 2, 3) {
                         let place = |p: &Isometry3<f64>| {
                             Isometry3::from_parts(
                                 Translation3::from(p.translation.vector * s + shift),

@@ -1,9 +1,9 @@
 //! Inputs found by `fuzz/` (target `gjk_query`) that broke an invariant,
 //! kept as regression tests: no panic, no NaN, `lower <= distance <= upper`.
 
-mod common;
-
 use gjk::{Convex, Options, Shape, distance};
+use gjkd_testkit::check::world_convex;
+use gjkd_testkit::reference::rounded_distance;
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 fn check(
@@ -106,9 +106,9 @@ fn mixed_magnitudes_1e108_and_1() {
     let (Shape::Convex(ca), Shape::Convex(cb)) = (&a, &b) else {
         unreachable!("both convex")
     };
-    let wa = common::world_convex(ca, &pose);
-    let wb = common::world_convex(cb, &turned);
-    let brute = common::rounded_distance(&wa.points, wa.radius, &wb.points, wb.radius);
+    let wa = world_convex(ca, &pose);
+    let wb = world_convex(cb, &turned);
+    let brute = rounded_distance(&wa.points, wa.radius, &wb.points, wb.radius);
     // The f64 brute force works in world coordinates of 1e108 and is off by
     // about 1e-5 here; the same minimum over vertex-triangle and edge-edge
     // distances in 60-digit arithmetic (mpmath) gives the truth below.

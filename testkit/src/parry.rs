@@ -1,7 +1,5 @@
-//! Shared by the benches and `examples/paper_compare.rs`: the same world
-//! geometry handed to parry3d-f64, converted through plain arrays.
-
-#![allow(dead_code)]
+//! The same world geometry handed to parry3d-f64, converted through plain
+//! arrays, for the benches and examples that set gjk beside it.
 
 use gjk::Convex;
 use nalgebra::Isometry3;
@@ -23,7 +21,7 @@ fn vector(v: &nalgebra::Point3<f64>) -> Vector {
     Vector::new(v.x, v.y, v.z)
 }
 
-/// Family member `index` of `gjk::paper::family()` as the parry shape a parry
+/// Family member `index` of [`crate::paper::family`] as the parry shape a parry
 /// user would pick: `Segment` for the segment, `Triangle` for the triangle,
 /// `Cuboid` for the (origin-centred, axis-aligned) box, and
 /// `ConvexPolyhedron::from_convex_hull` for the rest. Same geometry, same body

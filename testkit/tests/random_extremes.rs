@@ -1,4 +1,4 @@
-//! Randomised extremes (see `tests/sweep/mod.rs`): scales 1e-9 to 1e6, poses
+//! Randomised extremes (see `gjkd_testkit::sweep`): scales 1e-9 to 1e6, poses
 //! up to 1e9 from the origin, gaps from the size down to 1e-12 of it and 0,
 //! vertex, face, edge and nearly parallel edge contacts, overlaps shallow,
 //! deep and of the rounded shells only, degenerate vertex sets and identical
@@ -7,16 +7,14 @@
 //! cold and warm (from the answer at a pose nudged by 1 % of the size).
 //!
 //! `SWEEP_CASES` and `SWEEP_SEED` set a longer hunt (release mode advised):
-//! `SWEEP_CASES=1000000 SWEEP_SEED=7 cargo test --release -p gjk --test random_extremes`.
+//! `SWEEP_CASES=1000000 SWEEP_SEED=$RANDOM cargo test --release -p gjkd-testkit --test random_extremes`.
 //! `SWEEP_BIG_EVERY=1` lets every case of the main sweep draw a 100 000-point
 //! body (a sphere's or a box's surface), instead of one in 500.
 
-mod common;
-mod sweep;
-
-use common::{points, printed_pose as pose};
 use gjk::{Options, Status, distance};
-use sweep::{Case, Contact, Rng, bounds_error, depth_error, distance_error, draw};
+use gjkd_testkit::input::{points, printed_pose as pose};
+use gjkd_testkit::sweep;
+use gjkd_testkit::sweep::{Case, Contact, Rng, bounds_error, depth_error, distance_error, draw};
 
 fn env(name: &str, default: u64) -> u64 {
     std::env::var(name)
@@ -561,7 +559,7 @@ fn boxes_with_nearly_parallel_edges_far_out() {
 
 /// A triangle touching a segment edge to nearly parallel edge (depth 0),
 /// objects of size 1.7e-9 placed 1e3 from the origin, found by
-/// `unions_of_many_pieces_keep_the_truth` (seed 8101) as the near pieces of
+/// `unions_of_many_pieces_keep_the_truth` as the near pieces of
 /// two unions. The run ended on a tetrahedron that the exact orientation
 /// test certified around the origin by a hair; one face is a sliver (the
 /// nearly parallel edges), whose plane the points' own round-off tilts by
@@ -712,7 +710,7 @@ fn coplanar_twins_touching_asked_warm() {
 }
 
 /// A segment touching the edge of a box given with duplicate and mid-edge
-/// vertices, nearly parallel to it (union sweep, seed 17). The run reaches
+/// vertices, nearly parallel to it (found by the union sweep). The run reaches
 /// the plane of the segment and the box's face (4.1e-9 from the origin),
 /// whose corners tie as support points: the supports cycle over them, each
 /// step level with the last, and the refinement of a repeat counted as a

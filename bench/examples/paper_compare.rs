@@ -1,7 +1,7 @@
 //! gjk against parry3d-f64 on the paper's test data, in one run.
 //!
 //! ```text
-//! cargo run --release -p gjk --example paper_compare [PER_PAIR]
+//! cargo run --release -p gjkd-bench --example paper_compare [PER_PAIR]
 //! ```
 //!
 //! Section 7: the family of twelve polytopes, twenty pairs, three cases,
@@ -12,18 +12,17 @@
 //! reference: gjk with tolerance 0, cross-checked against the construction
 //! (the drawn gap, or 0) and against parry.
 //!
-//! Section 8: the collision sweep of `gjk::paper::section8()` for T = 10, 100,
+//! Section 8: the collision sweep of `gjkd_testkit::paper::section8()` for T = 10, 100,
 //! 1000, cold start against warm start, beside the paper's Table 1; then warm
 //! against cold along a 1000-step motion of family pairs from M = 16 to 200.
-
-#[path = "../benches/common/mod.rs"]
-mod common;
 
 use std::hint::black_box;
 use std::time::Instant;
 
-use gjk::paper::{self, Case, FamilyCase, PAIRS};
 use gjk::{Options, Shape};
+use gjkd_testkit::paper::{self, Case, FamilyCase, PAIRS};
+use gjkd_testkit::parry::{parry_family, parry_pose};
+use gjkd_testkit::reference::{self, Hull};
 use parry3d_f64::math::Pose;
 
 /// Target duration of one timed batch.
@@ -84,195 +83,6 @@ fn time_pair(per_call: usize, mut f: impl FnMut() -> f64, mut g: impl FnMut() ->
     }
 }
 
-/// An independent reference for separated polytopes: the boundary of each hull
-/// found by brute force (every plane through three vertices with all vertices
-/// on one side is a facet), then the minimum over vertex-triangle and
-/// edge-edge pairs, which is the exact distance between two disjoint convex
-/// polytopes.
-mod brute {
-    use nalgebra::{Isometry3, Point3, Vector3};
-
-    pub struct Boundary {
-        pub vertices: Vec<Point3<f64>>,
-        pub edges: Vec<[usize; 2]>,
-        pub triangles: Vec<[usize; 3]>,
-    }
-
-    pub fn boundary(v: &[Point3<f64>]) -> Boundary {
-        let n = v.len();
-        let mut edges = Vec::new();
-        let mut triangles = Vec::new();
-        if n == 2 {
-            edges.push([0, 1]);
-        } else if n == 3 {
-            edges.extend([[0, 1], [1, 2], [0, 2]]);
-            triangles.push([0, 1, 2]);
-        } else {
-            let scale = v.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
-            let tol = 1e-9 * scale;
-            let mut facets: Vec<Vec<usize>> = Vec::new();
-            for i in 0..n {
-                for j in i + 1..n {
-                    for k in j + 1..n {
-                        let nn = (v[j] - v[i]).cross(&(v[k] - v[i]));
-                        if nn.norm() < 1e-9 * scale * scale {
-                            continue;
-                        }
-                        let nn = nn.normalize();
-                        let off = nn.dot(&v[i].coords);
-                        let (mut lo, mut hi) = (0.0f64, 0.0f64);
-                        for p in v {
-                            let d = nn.dot(&p.coords) - off;
-                            lo = lo.min(d);
-                            hi = hi.max(d);
-                        }
-                        if hi > tol && lo < -tol {
-                            continue;
-                        }
-                        let on: Vec<usize> = (0..n)
-                            .filter(|&q| (nn.dot(&v[q].coords) - off).abs() <= tol)
-                            .collect();
-                        if on[0] != i || on[1] != j || on[2] != k {
-                            continue; // each facet once, from its first three vertices
-                        }
-                        // Order the facet's vertices around their centroid.
-                        let c = on.iter().fold(Vector3::zeros(), |a, &q| a + v[q].coords)
-                            / on.len() as f64;
-                        let u = (v[on[0]].coords - c).normalize();
-                        let w = nn.cross(&u);
-                        let mut ordered = on.clone();
-                        ordered.sort_by(|&a, &b| {
-                            let ang = |q: usize| {
-                                let d = v[q].coords - c;
-                                d.dot(&w).atan2(d.dot(&u))
-                            };
-                            ang(a).total_cmp(&ang(b))
-                        });
-                        facets.push(ordered);
-                    }
-                }
-            }
-            for f in &facets {
-                for t in 1..f.len() - 1 {
-                    triangles.push([f[0], f[t], f[t + 1]]);
-                }
-                for t in 0..f.len() {
-                    let (a, b) = (f[t], f[(t + 1) % f.len()]);
-                    edges.push([a.min(b), a.max(b)]);
-                }
-            }
-            edges.sort_unstable();
-            edges.dedup();
-        }
-        Boundary {
-            vertices: v.to_vec(),
-            edges,
-            triangles,
-        }
-    }
-
-    /// Closest point on triangle `abc` to `p` (Ericson, Real-Time Collision
-    /// Detection, 5.1.5).
-    fn point_triangle(p: Point3<f64>, a: Point3<f64>, b: Point3<f64>, c: Point3<f64>) -> f64 {
-        let (ab, ac, ap) = (b - a, c - a, p - a);
-        let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-        if d1 <= 0.0 && d2 <= 0.0 {
-            return (p - a).norm();
-        }
-        let bp = p - b;
-        let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-        if d3 >= 0.0 && d4 <= d3 {
-            return (p - b).norm();
-        }
-        let vc = d1 * d4 - d3 * d2;
-        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-            let t = d1 / (d1 - d3);
-            return (p - (a + ab * t)).norm();
-        }
-        let cp = p - c;
-        let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-        if d6 >= 0.0 && d5 <= d6 {
-            return (p - c).norm();
-        }
-        let vb = d5 * d2 - d1 * d6;
-        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-            let t = d2 / (d2 - d6);
-            return (p - (a + ac * t)).norm();
-        }
-        let va = d3 * d6 - d5 * d4;
-        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-            let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-            return (p - (b + (c - b) * t)).norm();
-        }
-        let denom = 1.0 / (va + vb + vc);
-        let (v, w) = (vb * denom, vc * denom);
-        (p - (a + ab * v + ac * w)).norm()
-    }
-
-    /// Distance between segments `p1q1` and `p2q2` (Ericson 5.1.9).
-    fn segment_segment(p1: Point3<f64>, q1: Point3<f64>, p2: Point3<f64>, q2: Point3<f64>) -> f64 {
-        let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
-        let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
-        let (s, t);
-        if a <= f64::EPSILON && e <= f64::EPSILON {
-            return r.norm();
-        }
-        if a <= f64::EPSILON {
-            s = 0.0;
-            t = (f / e).clamp(0.0, 1.0);
-        } else {
-            let c = d1.dot(&r);
-            if e <= f64::EPSILON {
-                t = 0.0;
-                s = (-c / a).clamp(0.0, 1.0);
-            } else {
-                let b = d1.dot(&d2);
-                let denom = a * e - b * b;
-                let mut s0 = if denom > 0.0 {
-                    ((b * f - c * e) / denom).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let mut t0 = (b * s0 + f) / e;
-                if t0 < 0.0 {
-                    t0 = 0.0;
-                    s0 = (-c / a).clamp(0.0, 1.0);
-                } else if t0 > 1.0 {
-                    t0 = 1.0;
-                    s0 = ((b - c) / a).clamp(0.0, 1.0);
-                }
-                s = s0;
-                t = t0;
-            }
-        }
-        ((p1 + d1 * s) - (p2 + d2 * t)).norm()
-    }
-
-    /// Exact distance between the hulls of `a` and `b` placed at their poses,
-    /// when they are disjoint (for touching hulls it is ~0 as well).
-    pub fn distance(a: &Boundary, pa: &Isometry3<f64>, b: &Boundary, pb: &Isometry3<f64>) -> f64 {
-        let va: Vec<Point3<f64>> = a.vertices.iter().map(|p| pa * p).collect();
-        let vb: Vec<Point3<f64>> = b.vertices.iter().map(|p| pb * p).collect();
-        let mut best = f64::INFINITY;
-        for p in &va {
-            for t in &b.triangles {
-                best = best.min(point_triangle(*p, vb[t[0]], vb[t[1]], vb[t[2]]));
-            }
-        }
-        for p in &vb {
-            for t in &a.triangles {
-                best = best.min(point_triangle(*p, va[t[0]], va[t[1]], va[t[2]]));
-            }
-        }
-        for e in &a.edges {
-            for f in &b.edges {
-                best = best.min(segment_segment(va[e[0]], va[e[1]], vb[f[0]], vb[f[1]]));
-            }
-        }
-        best
-    }
-}
-
 /// One line of the table by M: `M`, pair index, (gjk, parry) ns per query
 /// for each case, mean gjk iterations.
 type Row = (usize, usize, [(f64, f64); 3], f64);
@@ -291,7 +101,7 @@ fn main() {
     let seed = 7;
     let family = paper::family();
     let shapes: Vec<Shape> = family.iter().cloned().map(Shape::from).collect();
-    let parry = common::parry_family(&family);
+    let parry = parry_family(&family);
     let options = Options::default();
     let exact = Options {
         tolerance: 0.0,
@@ -336,17 +146,14 @@ fn main() {
         "bkup",
         "tol0 bad"
     );
-    let boundaries: Vec<brute::Boundary> = family
-        .iter()
-        .map(|c| brute::boundary(c.vertices()))
-        .collect();
+    let hulls: Vec<Hull> = family.iter().map(|c| Hull::new(c.vertices())).collect();
     let mut all: Vec<(Case, Vec<Prepared>)> = Vec::new();
     for case in Case::ALL {
         let prepared: Vec<Prepared> = paper::cases(case, per_pair, seed)
             .into_iter()
             .map(|c| Prepared {
-                pa: common::parry_pose(&c.pose_a),
-                pb: common::parry_pose(&c.pose_b),
+                pa: parry_pose(&c.pose_a),
+                pb: parry_pose(&c.pose_b),
                 case: c,
             })
             .collect();
@@ -358,7 +165,10 @@ fn main() {
             let c = &p.case;
             let reference = match case {
                 Case::Intersecting => 0.0,
-                _ => brute::distance(&boundaries[c.a], &c.pose_a, &boundaries[c.b], &c.pose_b),
+                _ => {
+                    let (ha, hb) = (&hulls[c.a], &hulls[c.b]);
+                    reference::distance(ha, &c.pose_a, 0.0, hb, &c.pose_b, 0.0).distance
+                }
             };
             let g = gjk_q(c, &options);
             let d = parry_q(p);

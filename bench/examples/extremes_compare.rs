@@ -1,8 +1,9 @@
 //! gjk beside parry3d-f64 on randomised extreme cases whose distance is known
-//! by construction (the generator of `tests/random_extremes.rs`).
+//! by construction (the generator of `gjkd_testkit::sweep`, as in
+//! `testkit/tests/random_extremes.rs`).
 //!
 //! ```text
-//! cargo run --release -p gjk --example extremes_compare [CASES] [SEED]
+//! cargo run --release -p gjkd-bench --example extremes_compare [CASES] [SEED]
 //! ```
 //!
 //! Each case is checked against the issue's requirement: the distance within
@@ -14,17 +15,13 @@
 //! coplanar sets, whose hull parry declines, a capsule or two triangles.
 //! Cases: CASES (default 20 000); one in 500 may draw a 100 000-point body.
 
-#[path = "../benches/common/mod.rs"]
-mod common;
-#[path = "../tests/sweep/mod.rs"]
-mod sweep;
-
 use std::collections::BTreeMap;
 
 use gjk::{Options, Status};
+use gjkd_testkit::parry::parry_pose;
+use gjkd_testkit::sweep::{self, Body, Case, Contact, Form, P, Rng, V};
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::shape::SharedShape;
-use sweep::{Body, Case, Contact, Form, P, Rng, V};
 
 fn vector(p: &P) -> Vector {
     Vector::new(p.x, p.y, p.z)
@@ -167,7 +164,7 @@ fn main() {
             t.gjk_uncertified = 1;
         }
         let (sa, sb) = (parry_shape(&case.a), parry_shape(&case.b));
-        let (pa, pb) = (common::parry_pose(&case.pa), common::parry_pose(&case.pb));
+        let (pa, pb) = (parry_pose(&case.pa), parry_pose(&case.pb));
         match parry3d_f64::query::distance(&pa, &*sa, &pb, &*sb) {
             Ok(d) => {
                 let d = d.distance;

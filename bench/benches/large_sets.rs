@@ -11,15 +11,14 @@
 //! steps are small (with 50 steps for this motion, warm took more iterations
 //! than cold).
 //!
-//! `cargo bench -p gjk --bench large_sets`. Throughput is per query.
-
-mod common;
+//! `cargo bench -p gjkd-bench --bench large_sets`. Throughput is per query.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use gjk::{Convex, Options, Shape, WarmStart};
+use gjkd_testkit::parry::parry_pose;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::shape::ConvexPolyhedron;
 
@@ -63,7 +62,7 @@ fn large(c: &mut Criterion) {
         .collect();
     let parry_poses: Vec<_> = poses
         .iter()
-        .map(|(a, b)| (common::parry_pose(a), common::parry_pose(b)))
+        .map(|(a, b)| (parry_pose(a), parry_pose(b)))
         .collect();
     let options = Options::default();
     let mut group = c.benchmark_group("large_sets");

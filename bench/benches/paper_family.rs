@@ -3,24 +3,23 @@
 //! separated, just touching and intersecting poses; gjk and
 //! `parry3d_f64::query::distance` side by side on identical world geometry.
 //!
-//! `cargo bench -p gjk --bench paper_family`. Each benchmark runs all
+//! `cargo bench -p gjkd-bench --bench paper_family`. Each benchmark runs all
 //! `PER_PAIR` examples of one pair and case; the throughput is per query.
-
-mod common;
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use gjk::paper::{self, Case, PAIRS};
 use gjk::{Options, Shape};
+use gjkd_testkit::paper::{self, Case, PAIRS};
+use gjkd_testkit::parry::{parry_family, parry_pose};
 
 const PER_PAIR: usize = 100;
 const SEED: u64 = 7;
 
 fn family(c: &mut Criterion) {
     let family = paper::family();
-    let parry = common::parry_family(&family);
+    let parry = parry_family(&family);
     let shapes: Vec<Shape> = family.iter().cloned().map(Shape::from).collect();
     let options = Options::default();
     for case in Case::ALL {
@@ -32,7 +31,7 @@ fn family(c: &mut Criterion) {
             let m = chunk[0].m;
             let parry_poses: Vec<_> = chunk
                 .iter()
-                .map(|c| (common::parry_pose(&c.pose_a), common::parry_pose(&c.pose_b)))
+                .map(|c| (parry_pose(&c.pose_a), parry_pose(&c.pose_b)))
                 .collect();
             group.bench_with_input(BenchmarkId::new("gjk", m), chunk, |bench, chunk| {
                 bench.iter(|| {

@@ -3,8 +3,8 @@
 //! one query's scratch state reaches the next, whatever ran before it (a
 //! query of another kind, a compound, an error).
 
-use gjk::paper::{self, Case};
 use gjk::{Answer, Error, Options, Precision, Shape, WarmStart, Workspace, distance, distance_in};
+use gjkd_testkit::paper::{self, Case};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 /// Every number of an answer as bits, so that -0.0 and 0.0 differ.

@@ -455,10 +455,12 @@ macro_rules! backend_methods {
                 crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
             }
 
+            /// Returns itself: `with ... as x:`.
             fn __enter__(slf: Py<Self>) -> Py<Self> {
                 slf
             }
 
+            /// Closes (see `close`); exceptions pass through.
             #[pyo3(signature = (*_args))]
             fn __exit__(&mut self, _args: &Bound<'_, pyo3::types::PyTuple>) -> bool {
                 self.close();

@@ -100,8 +100,16 @@
 //!
 //! A `Client` is not `Send` (iceoryx2 ports are bound to their thread): create
 //! one per thread. Each holds one iceoryx2 node and two client ports.
+//!
+//! iceoryx2 runs with its built-in defaults when no config file exists, as
+//! gjkd expects, and says so on stderr in every process. The first connect
+//! sets iceoryx2's log level to errors only, unless `IOX2_LOG_LEVEL` is set
+//! (`IOX2_LOG_LEVEL=warn` brings its warnings back) or the program set
+//! another level through iceoryx2 before.
 
 #![warn(missing_docs)]
+
+mod open_failure;
 
 use std::time::{Duration, Instant};
 
@@ -111,17 +119,20 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
 use nalgebra::{Isometry3, Point3, Vector3};
+use open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 
-pub use gjkd_proto::{
-    AdminOp, Answer, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemResult, MAX_NAME_LEN,
-    MAX_PIECES, ObjectId, Precision, QueryOptions, ServerInfo, ServerStats, Status, WaitMode,
-};
 use gjkd_proto::{
-    AdminReply, AdminRequest, PieceDesc, Pose, ReplyHeader, Vertex, admin_service_name,
+    AdminOp, AdminReply, AdminRequest, PieceDesc, ReplyHeader, Vertex, admin_service_name,
     query_service_name, shape_kind, wake_service_name,
 };
+pub use gjkd_proto::{
+    Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemKind,
+    ItemResult, MAX_NAME_LEN, MAX_PIECES, ObjectId, PROTOCOL_VERSION, Pose, Precision,
+    QueryOptions, ServerInfo, ServerStats, Status, WaitMode, item_flags, result_flags,
+};
 
-/// Timeout of every call unless set with [`ClientBuilder::timeout`].
+/// Timeout of every call unless set with [`ClientBuilder::timeout`]: one
+/// second.
 pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(1);
 
 /// What can go wrong with a call.
@@ -154,9 +165,59 @@ pub enum ClientError {
     /// (different protocol version or a broken server).
     #[error("protocol error: {0}")]
     Protocol(String),
+    /// A server serves this name, but with another protocol version than
+    /// this client's ([`PROTOCOL_VERSION`]):
+    /// client and server come from different gjkd releases. Retrying does not
+    /// help; use a client of the server's release, or start a server of
+    /// this one's.
+    #[error(
+        "the server on `{service}` speaks protocol version {server}, this client speaks {client}"
+    )]
+    VersionMismatch {
+        /// The service name asked for.
+        service: String,
+        /// The protocol version of the server found on that name.
+        server: u32,
+        /// This client's protocol version.
+        client: u32,
+    },
+    /// A service of this name exists but cannot be opened by this client:
+    /// it was made by another program, another build of gjkd (other message
+    /// types or limits), or another iceoryx2 version. The cause names which.
+    #[error("the service `{service}` is incompatible with this client: {cause}")]
+    Incompatible {
+        /// The iceoryx2 service that could not be opened.
+        service: String,
+        /// What iceoryx2 found different.
+        cause: String,
+    },
+    /// The service belongs to another user and this process may not open
+    /// it: run client and server as the same user, or see the README's
+    /// "Access" section for sharing a server across users.
+    #[error("no permission to open the service `{0}` (it belongs to another user)")]
+    PermissionDenied(String),
+    /// The server already has as many client processes as it admits.
+    #[error("the service `{0}` admits no more clients")]
+    TooManyClients(String),
     /// iceoryx2 failed locally (shared memory, permissions, limits).
     #[error("iceoryx2: {0}")]
     Ipc(String),
+}
+
+/// iceoryx2 warns on stderr, in every process, that it found no config
+/// file and uses its defaults, which is what gjkd wants. Unless the user
+/// chose a level (the `IOX2_LOG_LEVEL` variable, or iceoryx2's
+/// `set_log_level` to anything but its default before the first connect),
+/// the client lets through iceoryx2's errors only.
+fn quiet_iceoryx2_notices() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if std::env::var_os("IOX2_LOG_LEVEL").is_none()
+            && iceoryx2_log::get_log_level() == LogLevel::Info as u8
+        {
+            set_log_level(LogLevel::Error);
+        }
+    });
 }
 
 fn ipc_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ClientError {
@@ -233,6 +294,11 @@ impl Geometry<'_> {
                 half_extents: h,
                 radius,
             } => {
+                // A negative extent would give the same eight corners as its
+                // absolute value, so the server could not tell: refuse it here.
+                if h.iter().any(|&c| c < 0.0) {
+                    return Err(ClientError::InvalidArgument("a half extent is negative"));
+                }
                 for i in 0..8 {
                     out.push(Vertex {
                         x: if i & 1 == 0 { -h.x } else { h.x },
@@ -282,8 +348,13 @@ impl ClientBuilder {
     ///
     /// # Errors
     /// [`ClientError::ServerGone`] if no server serves the name within the
-    /// timeout, [`ClientError::Ipc`] if iceoryx2 cannot set up this process.
+    /// timeout; [`ClientError::VersionMismatch`],
+    /// [`ClientError::Incompatible`], [`ClientError::PermissionDenied`] or
+    /// [`ClientError::TooManyClients`] at once if a service of that name
+    /// exists but this client cannot use it; [`ClientError::Ipc`] if
+    /// iceoryx2 cannot set up this process.
     pub fn connect(self) -> Result<Client, ClientError> {
+        quiet_iceoryx2_notices();
         let node = NodeBuilder::new()
             .name(&NodeName::new("gjkd-client").map_err(ipc_err("node name"))?)
             .create::<ipc::Service>()
@@ -408,8 +479,8 @@ const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
 const YIELD_FOR: Duration = Duration::from_millis(2);
 /// While busy-polling, give the core away this often: a server the kernel
-/// woke onto this core cannot answer while the client holds it (on a busy
-/// 2-core machine that made a client spin out its whole 100 µs).
+/// woke onto this core cannot answer while the client holds it, and on a
+/// machine with few cores the client would spin out its whole `SPIN_FOR`.
 const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {
@@ -458,6 +529,44 @@ impl Client {
         ClientError::ServerGone(self.service.clone())
     }
 
+    /// The error for a service that could not be opened. A missing service
+    /// is a server not (yet) there, unless a server of another protocol
+    /// version serves the name: then waiting would never help.
+    fn open_failed(&self, service: &str, cause: OpenFailure) -> ClientError {
+        match cause {
+            OpenFailure::Missing => {
+                let ours = [
+                    query_service_name(&self.service),
+                    admin_service_name(&self.service),
+                    wake_service_name(&self.service),
+                ];
+                match name_taken_by(&self.service, ours.each_ref().map(String::as_str)) {
+                    Some(NameTakenBy::Version(server)) => ClientError::VersionMismatch {
+                        service: self.service.clone(),
+                        server,
+                        client: gjkd_proto::PROTOCOL_VERSION,
+                    },
+                    Some(NameTakenBy::OtherPattern { name, pattern }) => {
+                        ClientError::Incompatible {
+                            service: name,
+                            cause: format!(
+                                "a {pattern} service, not gjkd's (another program uses the name?)"
+                            ),
+                        }
+                    }
+                    None => self.gone(),
+                }
+            }
+            OpenFailure::Incompatible(cause) => ClientError::Incompatible {
+                service: service.to_owned(),
+                cause,
+            },
+            OpenFailure::Permission => ClientError::PermissionDenied(service.to_owned()),
+            OpenFailure::Full => ClientError::TooManyClients(service.to_owned()),
+            OpenFailure::Other(cause) => ClientError::Ipc(format!("open `{service}`: {cause}")),
+        }
+    }
+
     /// Opens the services and says hello. Drops any previous connection.
     /// `cleanup` first removes what dead processes left behind: a killed
     /// server's services linger until someone does, and a restarted server
@@ -475,20 +584,20 @@ impl Client {
             .request_response::<[Item], [ItemResult]>()
             .response_user_header::<ReplyHeader>()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&query_service_name(&self.service), e.into()))?;
         let admin_service = self
             .node
             .service_builder(&name(admin_service_name(&self.service))?)
             .request_response::<[Vertex], AdminReply>()
             .request_user_header::<AdminRequest>()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&admin_service_name(&self.service), e.into()))?;
         let wake_service = self
             .node
             .service_builder(&name(wake_service_name(&self.service))?)
             .event()
             .open()
-            .map_err(|_| self.gone())?;
+            .map_err(|e| self.open_failed(&wake_service_name(&self.service), e.into()))?;
         if query_service.dynamic_config().number_of_servers() == 0
             || admin_service.dynamic_config().number_of_servers() == 0
         {
@@ -677,10 +786,25 @@ impl Client {
     /// Registers an object at the identity pose, without a name.
     ///
     /// # Errors
-    /// [`ClientError::Rejected`] with the reason for invalid geometry
-    /// ([`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`],
-    /// [`ErrorCode::NonFiniteVertex`], [`ErrorCode::TooManyVertices`], ...),
-    /// and the connection errors of every call.
+    /// - [`ClientError::InvalidArgument`], before anything is sent: a
+    ///   negative half extent, a compound inside a compound, more than
+    ///   [`MAX_PIECES`] pieces, more than `u32::MAX` vertices.
+    /// - [`ClientError::Rejected`], and nothing is stored:
+    ///   [`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`] (negative,
+    ///   NaN or infinite), [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or
+    ///   the shape reaching beyond about 5e300),
+    ///   [`ErrorCode::TooManyVertices`] (over the server's `--max-vertices`),
+    ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
+    ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
+    ///   piece offset), [`ErrorCode::TooManyObjects`] (the server's
+    ///   `--max-objects`), [`ErrorCode::Internal`] (the server could not
+    ///   write the object to its store, for example on a full disk).
+    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`]. **The
+    ///   registration may then have happened**: the request may have
+    ///   reached the server and been stored before the server died or the
+    ///   answer came too late. An object registered under a name can be
+    ///   found again with [`Client::lookup`]; an unnamed one cannot be named
+    ///   by anyone, so register what must not be orphaned with a name.
     pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, ClientError> {
         self.register_with(geometry, None, &Isometry3::identity())
     }
@@ -1006,6 +1130,34 @@ enum Waited {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_negative_half_extent_is_refused_before_sending() {
+        for h in [
+            Vector3::new(-1.0, 1.0, 1.0),
+            Vector3::new(1.0, -0.0001, 1.0),
+            Vector3::new(1.0, 1.0, -f64::MIN_POSITIVE),
+        ] {
+            let mut v = Vec::new();
+            let g = Geometry::Cuboid {
+                half_extents: h,
+                radius: 0.0,
+            };
+            assert_eq!(
+                g.push_convex(&mut v),
+                Err(ClientError::InvalidArgument("a half extent is negative")),
+                "{h:?}"
+            );
+            assert!(v.is_empty(), "nothing encoded for {h:?}");
+        }
+        // Zero (a flat box) and -0.0 are documented as valid.
+        let mut v = Vec::new();
+        let flat = Geometry::Cuboid {
+            half_extents: Vector3::new(1.0, 0.0, -0.0),
+            radius: 0.0,
+        };
+        assert_eq!(flat.push_convex(&mut v), Ok(0.0));
+    }
 
     #[test]
     fn cuboid_vertices_follow_gjk_order() {

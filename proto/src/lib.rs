@@ -50,14 +50,14 @@ use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vect
 /// each other's bytes.
 pub const PROTOCOL_VERSION: u32 = 1;
 
-/// Service name used when none is given.
+/// Service name used when none is given: `"gjkd"`.
 pub const DEFAULT_SERVICE: &str = "gjkd";
 
-/// Default relative tolerance of a query: 100 × machine epsilon, as in the
-/// paper and the `gjk` crate.
+/// Default relative tolerance of a query: 100 × machine epsilon (about
+/// 2.2e-14), as in the paper and the `gjk` crate.
 pub const DEFAULT_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 
-/// Default iteration cap of a query, as in the `gjk` crate.
+/// Default iteration cap of a query: 128, as in the `gjk` crate.
 pub const DEFAULT_MAX_ITERATIONS: u32 = 128;
 
 /// Most pieces a compound may have: the piece table travels in the fixed-size
@@ -108,8 +108,12 @@ impl fmt::Display for ObjectId {
     }
 }
 
-/// What went wrong with one item or one request. `Ok` is 0 so that a zeroed
-/// result reads as success only when the server wrote it.
+/// What went wrong with one item or one request.
+///
+/// `Ok` is 0, so an all-zero [`ItemResult`] (its `Default`) reads as a
+/// successful pose update: trust only results the server wrote. The client's
+/// `query_batch` overwrites one result per item it sends and leaves the rest
+/// of the buffer alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u32)]
 pub enum ErrorCode {
@@ -143,14 +147,16 @@ pub enum ErrorCode {
     Malformed = 10,
     /// The object belongs to another client.
     NotOwner = 11,
-    /// The object was loaded from the server's scene file and cannot be
-    /// changed or removed.
+    /// The object was loaded from the server's scene file: anyone may move
+    /// it (set its pose), nobody may remove it.
     ReadOnly = 12,
     /// A compound has more pieces than [`MAX_PIECES`].
     TooManyPieces = 13,
     /// A compound has no pieces.
     EmptyCompound = 14,
-    /// A vertex has a NaN or infinite coordinate.
+    /// A vertex has a NaN or infinite coordinate, or the shape (vertices
+    /// plus rounding radius) reaches beyond 2^999, about 5e300, from its body
+    /// origin, where queries could overflow.
     NonFiniteVertex = 15,
     /// No object has this name.
     UnknownName = 16,

@@ -66,6 +66,17 @@ pub enum SceneError {
     /// The TOML does not parse or does not match the schema.
     #[error("invalid scene: {0}")]
     Parse(#[from] toml::de::Error),
+    /// A key the format does not have (a misspelt key would otherwise be
+    /// ignored and its default used without a word).
+    #[error("{place}: unknown key `{key}` (allowed here: {allowed})")]
+    UnknownKey {
+        /// Where: the object's name or index, and the piece or pose.
+        place: String,
+        /// The key.
+        key: String,
+        /// The keys allowed in that place.
+        allowed: String,
+    },
     /// An object is not a valid shape.
     #[error("object `{name}`: {reason}")]
     Object {
@@ -241,15 +252,17 @@ impl Scene {
     /// Parses a scene from TOML text.
     ///
     /// # Errors
-    /// [`SceneError::Parse`].
+    /// [`SceneError::Parse`], [`SceneError::UnknownKey`].
     pub fn from_toml(text: &str) -> Result<Self, SceneError> {
-        Ok(toml::from_str(text)?)
+        let table: toml::Table = toml::from_str(text)?;
+        check_keys(&table)?;
+        Ok(Scene::deserialize(table)?)
     }
 
     /// Reads and parses a scene file.
     ///
     /// # Errors
-    /// [`SceneError::Io`], [`SceneError::Parse`].
+    /// [`SceneError::Io`], [`SceneError::Parse`], [`SceneError::UnknownKey`].
     pub fn load(path: &Path) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
             path: path.display().to_string(),
@@ -299,6 +312,72 @@ impl Scene {
         }
         state.drop_scene_objects_except(&ids);
         Ok(ids)
+    }
+}
+
+/// The keys a shape of `kind` takes besides `type`; `None` for an unknown
+/// type, which serde reports with the list of types.
+fn shape_keys(kind: &str) -> Option<&'static [&'static str]> {
+    Some(match kind {
+        "sphere" => &["radius"],
+        "capsule" => &["a", "b", "radius"],
+        "box" => &["half_extents", "radius"],
+        "polytope" => &["vertices", "radius"],
+        "compound" => &["pieces"],
+        _ => return None,
+    })
+}
+
+/// Refuses any key the format does not have, naming it and its place.
+/// serde cannot do this for objects and pieces: their shape keys are
+/// flattened in beside the common ones, and flattening turns
+/// `deny_unknown_fields` off.
+fn check_keys(scene: &toml::Table) -> Result<(), SceneError> {
+    check_table(scene, &["object"], "the scene")?;
+    let Some(toml::Value::Array(objects)) = scene.get("object") else {
+        return Ok(());
+    };
+    for (i, object) in objects.iter().enumerate() {
+        let Some(object) = object.as_table() else {
+            continue;
+        };
+        let place = match object.get("name").and_then(|n| n.as_str()) {
+            Some(name) => format!("object `{name}`"),
+            None => format!("object {i}"),
+        };
+        check_shape(object, &["name", "pose", "type"], &place)?;
+        let Some(toml::Value::Array(pieces)) = object.get("pieces") else {
+            continue;
+        };
+        for (j, piece) in pieces.iter().enumerate() {
+            if let Some(piece) = piece.as_table() {
+                check_shape(piece, &["offset", "type"], &format!("{place}, piece {j}"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_shape(table: &toml::Table, common: &[&str], place: &str) -> Result<(), SceneError> {
+    let Some(keys) = table
+        .get("type")
+        .and_then(|t| t.as_str())
+        .and_then(shape_keys)
+    else {
+        return Ok(());
+    };
+    let allowed: Vec<&str> = common.iter().chain(keys).copied().collect();
+    check_table(table, &allowed, place)
+}
+
+fn check_table(table: &toml::Table, allowed: &[&str], place: &str) -> Result<(), SceneError> {
+    match table.keys().find(|k| !allowed.contains(&k.as_str())) {
+        Some(key) => Err(SceneError::UnknownKey {
+            place: place.to_owned(),
+            key: key.clone(),
+            allowed: allowed.join(", "),
+        }),
+        None => Ok(()),
     }
 }
 
@@ -412,6 +491,63 @@ offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
         let scene = Scene::from_toml(&doc).expect("parses");
         let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
         assert_eq!(scene.install(&mut state).expect("valid").len(), 5);
+    }
+
+    #[test]
+    fn unknown_keys_are_refused_by_name() {
+        let cases = [
+            (
+                "[[object]]\nname='a'\ntype='sphere'\nradious=1\n",
+                "object `a`",
+                "radious",
+            ),
+            (
+                "[[object]]\nname='b'\ntype='box'\nhalf_extents=[1,1,1]\nradius=0\ncolor='red'\n",
+                "object `b`",
+                "color",
+            ),
+            (
+                "[[object]]\ntype='sphere'\nradius=1\nnmae='c'\n",
+                "object 0",
+                "nmae",
+            ),
+            ("objects = []\n", "the scene", "objects"),
+            (
+                "[[object]]\nname='d'\ntype='compound'\n[[object.pieces]]\ntype='sphere'\nradius=1\npose={}\n",
+                "object `d`, piece 0",
+                "pose",
+            ),
+        ];
+        for (text, place, key) in cases {
+            match Scene::from_toml(text) {
+                Err(SceneError::UnknownKey {
+                    place: p, key: k, ..
+                }) => {
+                    assert_eq!((p.as_str(), k.as_str()), (place, key), "{text}");
+                }
+                other => panic!("{text}: expected UnknownKey, got {other:?}"),
+            }
+        }
+        // Inside a pose, serde itself refuses, naming the key.
+        let pose = "[[object]]\nname='e'\ntype='sphere'\nradius=1\npose={translaton=[1,0,0]}\n";
+        let err = Scene::from_toml(pose).expect_err("misspelt pose key");
+        assert!(err.to_string().contains("translaton"), "{err}");
+    }
+
+    #[test]
+    fn the_scene_file_doc_example_loads() {
+        let doc: String = include_str!("../../docs/scene-files.md")
+            .lines()
+            .skip_while(|l| !l.starts_with("```toml"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("```"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let scene = Scene::from_toml(&doc).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        assert_eq!(ids.len(), scene.objects.len());
+        assert!(ids.len() >= 5, "the example shows every shape type");
     }
 
     #[test]

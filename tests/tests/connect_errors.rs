@@ -1,0 +1,116 @@
+//! A client that cannot use the service it finds says why, at once: another
+//! protocol version, another program's service under the name, or none at
+//! all. Each impostor service is made in this process with iceoryx2 itself,
+//! as another build or program would make it.
+
+use std::time::{Duration, Instant};
+
+use gjkd_client::{Client, ClientError};
+use gjkd_e2e::unique_service;
+use gjkd_proto::{PROTOCOL_VERSION, admin_service_name, query_service_name};
+use iceoryx2::prelude::*;
+
+/// Long enough that a test failing by waiting out the timeout would be
+/// obvious in its message, not in a timed assertion.
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(3);
+
+fn node() -> Node<ipc::Service> {
+    NodeBuilder::new()
+        .create::<ipc::Service>()
+        .expect("iceoryx2 node")
+}
+
+fn connect(service: &str) -> (Result<Client, ClientError>, Duration) {
+    let start = Instant::now();
+    let result = Client::builder(service).timeout(CONNECT_TIMEOUT).connect();
+    (result, start.elapsed())
+}
+
+#[test]
+fn a_server_of_another_protocol_version_is_named() {
+    let service = unique_service("other-version");
+    let theirs = PROTOCOL_VERSION + 1;
+    let node = node();
+    let other_admin = admin_service_name(&service)
+        .replace(&format!("/v{PROTOCOL_VERSION}/"), &format!("/v{theirs}/"));
+    let _impostor = node
+        .service_builder(&ServiceName::new(&other_admin).unwrap())
+        .request_response::<u64, u64>()
+        .create()
+        .expect("other version's admin service");
+
+    let (result, waited) = connect(&service);
+    match result {
+        Err(ClientError::VersionMismatch {
+            service: s,
+            server,
+            client,
+        }) => {
+            assert_eq!(s, service);
+            assert_eq!(server, theirs);
+            assert_eq!(client, PROTOCOL_VERSION);
+        }
+        other => panic!("expected VersionMismatch, got {:?}", other.map(|_| ())),
+    }
+    assert!(
+        waited < CONNECT_TIMEOUT,
+        "a version mismatch is final: the client must not wait for a server ({waited:?})"
+    );
+}
+
+#[test]
+fn a_service_with_other_message_types_is_incompatible() {
+    let service = unique_service("other-types");
+    let node = node();
+    let query = query_service_name(&service);
+    let _impostor = node
+        .service_builder(&ServiceName::new(&query).unwrap())
+        .request_response::<u64, u64>()
+        .create()
+        .expect("impostor query service");
+
+    match connect(&service).0 {
+        Err(ClientError::Incompatible { service: s, cause }) => {
+            assert_eq!(s, query);
+            assert!(cause.contains("message types"), "cause: {cause}");
+        }
+        other => panic!("expected Incompatible, got {:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn a_service_of_another_pattern_is_incompatible() {
+    let service = unique_service("other-pattern");
+    let node = node();
+    let query = query_service_name(&service);
+    let _impostor = node
+        .service_builder(&ServiceName::new(&query).unwrap())
+        .publish_subscribe::<u64>()
+        .create()
+        .expect("impostor publish-subscribe service");
+
+    match connect(&service).0 {
+        Err(ClientError::Incompatible { service: s, cause }) => {
+            assert_eq!(s, query);
+            assert!(cause.contains("PublishSubscribe"), "cause: {cause}");
+        }
+        other => panic!("expected Incompatible, got {:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn no_service_at_all_is_a_server_gone() {
+    let service = unique_service("nobody");
+    let start = Instant::now();
+    let result = Client::builder(&service)
+        .timeout(Duration::from_millis(200))
+        .connect();
+    match result {
+        Err(ClientError::ServerGone(s)) => assert_eq!(s, service),
+        other => panic!("expected ServerGone, got {:?}", other.map(|_| ())),
+    }
+    assert!(
+        start.elapsed() >= Duration::from_millis(200),
+        "a missing server is waited for until the connect timeout"
+    );
+}

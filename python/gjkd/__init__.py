@@ -34,7 +34,9 @@ from __future__ import annotations
 from . import local
 from ._codes import ErrorCode, Status
 from ._errors import (
+    AccessDenied,
     Error,
+    Incompatible,
     InvalidInput,
     IpcError,
     NotFound,
@@ -58,6 +60,7 @@ from ._native import (
 from .server import Server
 
 __all__ = [
+    "AccessDenied",
     "DEFAULT_MAX_ITERATIONS",
     "DEFAULT_TOLERANCE",
     "MAX_NAME_LEN",
@@ -68,6 +71,7 @@ __all__ = [
     "Distances",
     "Error",
     "ErrorCode",
+    "Incompatible",
     "InvalidInput",
     "IpcError",
     "Local",

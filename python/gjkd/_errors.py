@@ -19,6 +19,8 @@ __all__ = [
     "Refused",
     "ProtocolError",
     "IpcError",
+    "Incompatible",
+    "AccessDenied",
 ]
 
 
@@ -71,12 +73,23 @@ class NotFound(Error, LookupError):
 
 class Refused(Error):
     """The server refused a valid request: another client's object
-    (``NOT_OWNER``), a read-only scene object, a taken name, a full server,
-    or its own failure (``INTERNAL``)."""
+    (``NOT_OWNER``), a read-only scene object, a taken name, a full server
+    (of objects, or of clients), or its own failure (``INTERNAL``)."""
 
 
 class ProtocolError(Error):
     """The server answered something this client does not understand."""
+
+
+class Incompatible(ProtocolError):
+    """A server serves this name but cannot be spoken to: another protocol
+    version (another gjkd release), or a service made by another program or
+    build. Retrying does not help."""
+
+
+class AccessDenied(Error, PermissionError):
+    """The service belongs to another user, whom this process may not
+    reach (run client and server as the same user)."""
 
 
 class IpcError(Error, OSError):

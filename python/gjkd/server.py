@@ -13,7 +13,7 @@ from types import TracebackType
 from typing import IO, Optional, Sequence, Type, Union
 
 from . import _native
-from ._errors import Error, ServerGone, Timeout
+from ._errors import Error, Incompatible, ServerGone, Timeout
 
 __all__ = ["Server"]
 
@@ -122,7 +122,10 @@ class Server:
                     info = probe.server_info()
                 if info is not None and info["pid"] == self._process.pid:
                     return
-            except (ServerGone, Timeout):
+            except (ServerGone, Timeout, Incompatible):
+                # A service still being set up (or one a killed server left
+                # behind, until the new server has cleaned it up) can look
+                # incompatible for a moment.
                 pass
             if time.monotonic() > deadline:
                 self.kill()

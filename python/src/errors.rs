@@ -24,6 +24,10 @@ pub enum Kind {
     Protocol,
     /// `gjkd.IpcError`.
     Ipc,
+    /// `gjkd.Incompatible`.
+    Incompatible,
+    /// `gjkd.AccessDenied`.
+    AccessDenied,
     /// `gjkd.Error` itself.
     Other,
 }
@@ -38,6 +42,8 @@ impl Kind {
             Kind::Refused => "Refused",
             Kind::Protocol => "ProtocolError",
             Kind::Ipc => "IpcError",
+            Kind::Incompatible => "Incompatible",
+            Kind::AccessDenied => "AccessDenied",
             Kind::Other => "Error",
         }
     }
@@ -151,6 +157,11 @@ pub fn client(py: Python<'_>, e: ClientError, field: Option<&str>) -> PyErr {
         ClientError::InvalidArgument(_) => (Kind::InvalidInput, None),
         ClientError::Protocol(_) => (Kind::Protocol, None),
         ClientError::Ipc(_) => (Kind::Ipc, None),
+        ClientError::VersionMismatch { .. } | ClientError::Incompatible { .. } => {
+            (Kind::Incompatible, None)
+        }
+        ClientError::PermissionDenied(_) => (Kind::AccessDenied, None),
+        ClientError::TooManyClients(_) => (Kind::Refused, None),
         ClientError::ResultBufferTooSmall { .. } => (Kind::Other, None),
     };
     Raise {

@@ -4,7 +4,7 @@
 
 Prints, per pair: ``Client.distances`` in batches of 1, 64 and 1000, the Rust
 client's ``query_batch`` on the same 1000 pairs (built and run from
-``python/bench/batch_cost``), ``gjkd.Local`` warm and cold, ``coal`` and
+``bench/examples/batch_cost.rs``), ``gjkd.Local`` warm and cold, ``coal`` and
 ``python-fcl`` called one pair at a time as their users call them (shapes and
 transforms built before timing, so only the distance call and its result are
 timed); the single-query round trip from Python (p50, p90); and each
@@ -97,10 +97,10 @@ def rust_query_batch(service: str, ha: np.ndarray, hb: np.ndarray, pa: np.ndarra
                      pb: np.ndarray, repeats: int) -> Optional[float]:  # fmt: skip
     """The Rust client's per-pair cost on the same pairs, in µs, or None if
     the Rust example cannot be built here."""
-    target = HERE.parent / "target"
+    target = HERE.parent.parent / "target"
     build = subprocess.run(
-        ["cargo", "build", "--release", "--quiet", "--target-dir", str(target)],
-        cwd=HERE / "batch_cost",
+        ["cargo", "build", "--release", "--quiet", "-p", "gjkd-bench", "--example", "batch_cost"],
+        cwd=HERE,
     )
     if build.returncode != 0:
         print("(the Rust query_batch example did not build: its figure is left out)")
@@ -110,7 +110,7 @@ def rust_query_batch(service: str, ha: np.ndarray, hb: np.ndarray, pa: np.ndarra
         f.write(data.tobytes())
     try:
         out = subprocess.run(
-            [str(target / "release" / "gjkd-batch-cost"), service, f.name, str(repeats)],
+            [str(target / "release" / "examples" / "batch_cost"), service, f.name, str(repeats)],
             capture_output=True,
             text=True,
             check=True,

@@ -12,7 +12,7 @@ use nalgebra::Isometry3;
 /// # Errors
 /// `NonFinitePose` or `BadQuaternion`.
 pub fn check_pose(p: &Pose) -> Result<Isometry3<f64>, ErrorCode> {
-    gjkd_server::state::check_pose(p)
+    gjkd_server::requests::check_pose(p)
 }
 
 /// The server's limits, with defaults.

@@ -2,7 +2,7 @@
 //! `python/bench/compare.py` wrote, against a running server, so that the
 //! Python figures have the Rust ones beside them from the same run.
 //!
-//! `gjkd-batch-cost SERVICE PAIRS_FILE REPEATS`; the file holds `n` (as an
+//! `cargo run --release -p gjkd-bench --example batch_cost SERVICE PAIRS_FILE REPEATS`; the file holds `n` (as an
 //! f64), then per pair the half extents of A and B (6 f64) and the poses of
 //! A and B (`[x, y, z, qx, qy, qz, qw]`, 14 f64), little-endian. Prints one
 //! line: `query_batch_ns_per_pair <median over repeats>`.

@@ -4,8 +4,8 @@
 use nalgebra::{Point3, Vector3};
 
 use super::Status;
-use super::numerical_algorithm::{Exit, Run};
-use super::pair::{Pair, Place, is_identity};
+use super::numerical_algorithm::{Exit, RunOutcome};
+use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::warm_start::{PieceSimplex, WarmStart};
 use crate::johnson::{Simplex, Solution};
 
@@ -52,16 +52,17 @@ pub struct Answer {
 /// infinite or NaN, and NaN survives the sums, whatever their order: a
 /// balanced tree of sums, whose four-wide halves the compiler can vectorise.
 #[inline(always)]
-pub(super) fn is_finite(answer: &Answer) -> bool {
-    let z = |x: f64| x * 0.0;
+pub(super) fn all_finite(answer: &Answer) -> bool {
+    let zeroed = |x: f64| x * 0.0;
     let (pa, pb, n) = (&answer.point_a, &answer.point_b, &answer.normal);
-    let s1 = (z(answer.distance) + z(answer.lower)) + (z(answer.upper) + z(answer.penetration));
-    let s2 = (z(pa.x) + z(pa.y)) + (z(pa.z) + z(pb.x));
-    let s3 = (z(pb.y) + z(pb.z)) + (z(n.x) + z(n.y));
-    ((s1 + s2) + (s3 + z(n.z))) == 0.0
+    let bounds = (zeroed(answer.distance) + zeroed(answer.lower))
+        + (zeroed(answer.upper) + zeroed(answer.penetration));
+    let points = (zeroed(pa.x) + zeroed(pa.y)) + (zeroed(pa.z) + zeroed(pb.x));
+    let rest = (zeroed(pb.y) + zeroed(pb.z)) + (zeroed(n.x) + zeroed(n.y));
+    ((bounds + points) + (rest + zeroed(n.z))) == 0.0
 }
 
-impl Pair<'_> {
+impl ConvexPair<'_> {
     /// A lower bound on the cores' penetration depth once `v` is the origin.
     /// (5.9) needs a tetrahedron around the origin. When the run stopped on a
     /// smaller simplex with `v` exactly zero (the first support point was the
@@ -71,15 +72,15 @@ impl Pair<'_> {
     /// the bound is 0. Either way it is cut by the round-off allowance, since
     /// it must never exceed the truth.
     #[cold]
-    pub(super) fn penetration(&self, simplex: &Simplex, sol: &Solution) -> f64 {
-        let inner = if sol.mask == 0b1111 {
+    pub(super) fn penetration_bound(&self, simplex: &Simplex, solution: &Solution) -> f64 {
+        let inner = if solution.mask == 0b1111 {
             simplex.inner_radius(self.slack)
-        } else if sol.v != Vector3::zeros() {
+        } else if solution.v != Vector3::zeros() {
             0.0
         } else {
             // The two tetrahedra inscribed in a cube between them use all its
             // corners, so one holds any point near a corner of a box-like K.
-            let dirs = [
+            let directions = [
                 Vector3::new(1.0, 1.0, 1.0),
                 Vector3::new(1.0, -1.0, -1.0),
                 Vector3::new(-1.0, 1.0, -1.0),
@@ -88,9 +89,9 @@ impl Pair<'_> {
             let mut tetra = Simplex::empty();
             let mut best = 0.0f64;
             for sign in [1.0, -1.0] {
-                tetra.reset(&dirs.map(|d| self.support(&(d * sign))));
-                if let Some(s) = tetra.solve()
-                    && s.mask == 0b1111
+                tetra.reset(&directions.map(|d| self.support(&(d * sign))));
+                if let Some(solved) = tetra.solve()
+                    && solved.mask == 0b1111
                 {
                     best = best.max(tetra.inner_radius(self.slack));
                 }
@@ -103,7 +104,7 @@ impl Pair<'_> {
     /// The certified `(lower, upper)` bounds of a run, after radii, and the
     /// distance reported between them.
     #[inline]
-    pub(super) fn bounds(&self, run: &Run) -> (f64, f64, f64) {
+    pub(super) fn certified_bounds(&self, run: &RunOutcome) -> (f64, f64, f64) {
         let upper = (run.norm + self.slack_world - self.radii).max(0.0);
         let lower = (run.lower - self.slack_world - self.radii).max(0.0);
         // Not `clamp`: it panics when round-off beyond the slack has put
@@ -116,43 +117,45 @@ impl Pair<'_> {
     /// piece (its shape's pose and, for a compound, the piece's offset); B's
     /// nearest point is placed with it, as A's point minus `v`.
     #[inline(always)]
-    pub(super) fn answer(
+    pub(super) fn to_answer(
         &self,
-        run: &Run,
+        run: &RunOutcome,
         simplex: &Simplex,
-        place_a: Place<'_>,
+        place_a: PiecePlacement<'_>,
         pieces: [u32; 2],
     ) -> Answer {
-        let (pose_a, off_a) = (place_a.pose, place_a.offset);
-        let mut lambda = run.sol.lambda;
-        if run.sol.mask == 0b1111
-            && let Some(l) = simplex.refine_origin(lambda, self.slack)
+        let (pose_a, offset_a) = (place_a.pose, place_a.offset);
+        let mut lambda = run.solution.lambda;
+        if run.solution.mask == 0b1111
+            && let Some(refined) = simplex.refine_origin(lambda, self.slack)
         {
-            lambda = l;
+            lambda = refined;
         }
-        let mut wa = Vector3::zeros();
+        // A's nearest point relative to its centroid, and the vertex pairs
+        // of the simplex's kept points.
+        let mut nearest_a = Vector3::zeros();
         let mut pairs = [[0u32; 2]; 4];
         let mut len = 0;
-        for (i, (vx, l)) in simplex.vertices.iter().zip(lambda).enumerate() {
-            if run.sol.mask & (1 << i) != 0 {
-                wa += self.a.local(vx.ia as usize) * l;
-                pairs[len & 3] = [vx.ia, vx.ib];
+        for (slot, (vertex, weight)) in simplex.vertices.iter().zip(lambda).enumerate() {
+            if run.solution.mask & (1 << slot) != 0 {
+                nearest_a += self.a.local(vertex.ia as usize) * weight;
+                pairs[len & 3] = [vertex.ia, vertex.ib];
                 len += 1;
             }
         }
         // Both nearest points in A's piece frame: B's is A's minus v, since
         // v = Σλ(a_i - b_i) with the same weights. One placement serves both,
         // and their gap is v itself, not the difference of two placements.
-        let (rot, shift) = match off_a {
-            Some(o) if !is_identity(o) => (
-                pose_a.rotation * o.rotation,
-                pose_a.rotation * o.translation.vector + pose_a.translation.vector,
+        let (rotation, shift) = match offset_a {
+            Some(offset) if !is_identity(offset) => (
+                pose_a.rotation * offset.rotation,
+                pose_a.rotation * offset.translation.vector + pose_a.translation.vector,
             ),
             _ => (pose_a.rotation, pose_a.translation.vector),
         };
-        let core_a = Point3::from(rot * (self.a.centroid().coords + wa) + shift);
+        let core_a = Point3::from(rotation * (self.a.centroid().coords + nearest_a) + shift);
         // b - a = -v, in world coordinates.
-        let gap = rot * -run.sol.v;
+        let gap = rotation * -run.solution.v;
         let core_b = core_a + gap;
         let separated = run.norm > self.slack_world;
         let normal = if separated {
@@ -160,24 +163,23 @@ impl Pair<'_> {
         } else {
             Vector3::zeros()
         };
-        let (ra, rb) = (self.a.radius(), self.b.radius());
         let penetration = if !separated {
-            run.inner + self.radii
+            run.core_depth + self.radii
         } else {
             (self.radii - run.norm).max(0.0)
         };
-        let (lower, upper, distance) = self.bounds(run);
+        let (lower, upper, distance) = self.certified_bounds(run);
         Answer {
             distance,
             lower,
             upper,
-            point_a: core_a + normal * ra,
-            point_b: core_b - normal * rb,
+            point_a: core_a + normal * self.a.radius(),
+            point_b: core_b - normal * self.b.radius(),
             normal,
             penetration,
             iterations: run.iterations,
             status: match run.exit {
-                Exit::Status(s) => s,
+                Exit::Status(status) => status,
                 Exit::Pruned => Status::Converged,
             },
             backup_used: run.backup_used,

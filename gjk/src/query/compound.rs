@@ -4,7 +4,7 @@
 use nalgebra::{Isometry3, Vector3};
 
 use super::numerical_algorithm::Exit;
-use super::pair::{Pair, Place, is_identity};
+use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::warm_start::PieceSimplex;
 use super::{Answer, Query, Status, WarmStart};
 use crate::johnson::Simplex;
@@ -59,7 +59,7 @@ pub(super) fn axis_gap(
 /// the target features itself, and the piece pairs' runs, inlined in it,
 /// took 12 % more instructions in SSE2 code (the Section 8 union, warm).
 #[inline(always)]
-pub(super) fn compound<const AVX2: bool>(
+pub(super) fn search_compound<const AVX2: bool>(
     simplex: &mut Simplex,
     query: &Query<'_>,
     rel: &Isometry3<f64>,
@@ -68,39 +68,40 @@ pub(super) fn compound<const AVX2: bool>(
     #[cfg(target_arch = "x86_64")]
     if AVX2 {
         // SAFETY: as in `subalgorithm`.
-        return unsafe { compound_avx2(simplex, query, rel, warm) };
+        return unsafe { search_compound_avx2(simplex, query, rel, warm) };
     }
-    compound_base(simplex, query, rel, warm)
+    search_compound_base(simplex, query, rel, warm)
 }
 
-/// [`compound_of`] for any CPU.
+/// [`search_compound_body`] for any CPU.
 #[inline(never)]
-pub(super) fn compound_base(
+pub(super) fn search_compound_base(
     simplex: &mut Simplex,
     query: &Query<'_>,
     rel: &Isometry3<f64>,
     warm: Option<&WarmStart>,
 ) -> (Answer, f64) {
-    compound_of::<false>(simplex, query, rel, warm)
+    search_compound_body::<false>(simplex, query, rel, warm)
 }
 
-/// [`compound_of`] compiled for AVX2 and FMA (see [`distance_avx2`](super::distance_avx2)); out
-/// of line, so that the convex pair's path around its call stays as it was.
+/// [`search_compound_body`] compiled for AVX2 and FMA (see
+/// [`distance_avx2`](super::distance_avx2)); out of line, so that the convex
+/// pair's path around its call stays as it was.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]
-pub(super) fn compound_avx2(
+pub(super) fn search_compound_avx2(
     simplex: &mut Simplex,
     query: &Query<'_>,
     rel: &Isometry3<f64>,
     warm: Option<&WarmStart>,
 ) -> (Answer, f64) {
-    compound_of::<true>(simplex, query, rel, warm)
+    search_compound_body::<true>(simplex, query, rel, warm)
 }
 
-/// The body of [`compound`], inlined into each of its compiled forms.
+/// The body of [`search_compound`], inlined into each of its compiled forms.
 #[inline(always)]
-pub(super) fn compound_of<const AVX2: bool>(
+pub(super) fn search_compound_body<const AVX2: bool>(
     simplex: &mut Simplex,
     query: &Query<'_>,
     rel: &Isometry3<f64>,
@@ -200,24 +201,27 @@ pub(super) fn compound_of<const AVX2: bool>(
             oa.inv_mul(&ob)
         };
         // Each piece's place in the world, for a piece far from its own
-        // frame's origin (see `Pair::new`); a convex shape's identity
+        // frame's origin (see `ConvexPair::new`); a convex shape's identity
         // offset places its centroid exactly.
         let world = (
-            Place {
+            PiecePlacement {
                 pose: pose_a,
                 offset: Some(&oa),
             },
-            Place {
+            PiecePlacement {
                 pose: pose_b,
                 offset: Some(&offset_b),
             },
         );
-        let pair = Pair::new(ca, cb, &piece_rel, world, options.precision);
+        let pair = ConvexPair::new(ca, cb, &piece_rel, world, options.precision);
         let warm_pairs = warm.and_then(|w| w.for_pieces([i, j]));
-        let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, cutoff);
-        let (pair_lower, pair_upper, pair_distance) = pair.bounds(&run);
+        let run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, cutoff);
+        let (pair_lower, pair_upper, pair_distance) = pair.certified_bounds(&run);
         if pair_upper < kept[1].0 {
-            let entry = (pair_upper, PieceSimplex::of(simplex, run.sol.mask, [i, j]));
+            let entry = (
+                pair_upper,
+                PieceSimplex::from_simplex(simplex, run.solution.mask, [i, j]),
+            );
             if pair_upper < kept[0].0 {
                 kept = [entry, kept[0]];
             } else {
@@ -231,7 +235,7 @@ pub(super) fn compound_of<const AVX2: bool>(
         // deepest pair's bound, whichever pair ends up named, bounds the
         // union's depth (a pair whose rounded shells alone overlap counts too).
         let pair_depth = if run.norm == 0.0 {
-            run.inner + pair.radii
+            run.core_depth + pair.radii
         } else {
             pair.radii - run.norm
         };
@@ -253,10 +257,10 @@ pub(super) fn compound_of<const AVX2: bool>(
             .as_ref()
             .is_none_or(|b| (pair_upper, pair_distance) < (b.upper, b.distance));
         if better || status == Status::Closer {
-            let answer = pair.answer(
+            let answer = pair.to_answer(
                 &run,
                 simplex,
-                Place {
+                PiecePlacement {
                     pose: pose_a,
                     offset: Some(&oa),
                 },

@@ -23,10 +23,10 @@ pub use answer::Answer;
 pub use options::{Options, Precision, Status};
 pub use warm_start::WarmStart;
 
-use answer::is_finite;
-use compound::compound;
-use pair::{Pair, Place};
-use recovery::rare;
+use answer::all_finite;
+use compound::search_compound;
+use pair::{ConvexPair, PiecePlacement};
+use recovery::recover_suspect_answer;
 
 /// Scratch memory of a query (the simplex with its dot products and
 /// cofactors), kept by a caller that makes many queries so that each one
@@ -82,14 +82,14 @@ pub fn distance(
     // Any workspace gives the same answer: a fresh one serves the first
     // query of a thread, and any query while the thread's is out of reach
     // (during thread teardown).
-    let mut ws = SPARE
+    let mut workspace = SPARE
         .try_with(Cell::take)
         .ok()
         .flatten()
         .unwrap_or_else(|| Box::new(Workspace::new()));
-    let answer = distance_in(&mut ws, a, pose_a, b, pose_b, options, warm);
+    let answer = distance_in(&mut workspace, a, pose_a, b, pose_b, options, warm);
     // Dropped instead if the thread-local is gone.
-    let _ = SPARE.try_with(|spare| spare.set(Some(ws)));
+    let _ = SPARE.try_with(|spare| spare.set(Some(workspace)));
     answer
 }
 
@@ -152,18 +152,19 @@ struct Query<'q> {
     pose_b: &'q Isometry3<f64>,
     options: &'q Options,
     warm: Option<&'q WarmStart>,
-    /// This is the second opinion of [`second_opinion`](recovery::second_opinion): asked no further.
+    /// This is the second opinion of
+    /// [`second_opinion`](recovery::second_opinion): asked no further.
     swapped: bool,
 }
 
-/// [`distance_of`] for any CPU, out of line, so that [`distance_in`] stays
+/// [`distance_body`] for any CPU, out of line, so that [`distance_in`] stays
 /// a few instructions of dispatch with no frame of its own.
 #[inline(never)]
 fn distance_base(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
-    distance_of::<false>(workspace, query)
+    distance_body::<false>(workspace, query)
 }
 
-/// [`distance_of`] compiled for AVX2 and FMA: the same operations, each
+/// [`distance_body`] compiled for AVX2 and FMA: the same operations, each
 /// rounded the same way (Rust never fuses a multiply and an add on its own,
 /// and `mul_add` is exact either way), so the same answer bit for bit, in
 /// fewer instructions (three-operand forms, wider moves): 5 to 9 % less
@@ -171,14 +172,14 @@ fn distance_base(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer,
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn distance_avx2(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
-    distance_of::<true>(workspace, query)
+    distance_body::<true>(workspace, query)
 }
 
 /// The body of [`distance_in`], inlined into each of its compiled forms;
 /// `AVX2` says which, so that the subalgorithm's out-of-line parts are
 /// called in the same form.
 #[inline(always)]
-fn distance_of<const AVX2: bool>(
+fn distance_body<const AVX2: bool>(
     workspace: &mut Workspace,
     query: &Query<'_>,
 ) -> Result<Answer, Error> {
@@ -193,7 +194,7 @@ fn distance_of<const AVX2: bool>(
     } = query;
     options.validate()?;
     if let Some(w) = warm
-        && !(w.first.fits(a, b) && w.second.fits(a, b))
+        && !(w.first.fits_shapes(a, b) && w.second.fits_shapes(a, b))
     {
         return Err(Error::WarmStartOutOfRange);
     }
@@ -212,39 +213,49 @@ fn distance_of<const AVX2: bool>(
         // of 0, before shapes were held to MAX_REACH).
         return Err(Error::NonFinitePose);
     }
-    // `stuck`: the interval width beyond which the answer is asked again
+    // `stuck_width`: the interval width beyond which the answer is asked again
     // the other way round (see `second_opinion`).
-    let (answer, stuck) = match (a, b) {
-        (Shape::Convex(ca), Shape::Convex(cb)) => {
-            let place = Place {
+    let (answer, stuck_width) = match (a, b) {
+        (Shape::Convex(convex_a), Shape::Convex(convex_b)) => {
+            let place_a = PiecePlacement {
                 pose: pose_a,
                 offset: None,
             };
-            let place_b = Place {
+            let place_b = PiecePlacement {
                 pose: pose_b,
                 offset: None,
             };
-            let pair = Pair::new(ca, cb, &rel, (place, place_b), options.precision);
+            let pair = ConvexPair::new(
+                convex_a,
+                convex_b,
+                &rel,
+                (place_a, place_b),
+                options.precision,
+            );
             let simplex = &mut workspace.simplex;
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let run = pair.solve_retrying::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
-            let stuck = if swapped {
+            let run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
+            let stuck_width = if swapped {
                 f64::INFINITY
             } else {
                 pair.stuck_width(options.tolerance)
             };
-            (pair.answer(&run, simplex, place, [0, 0]), stuck)
+            (pair.to_answer(&run, simplex, place_a, [0, 0]), stuck_width)
         }
         _ => {
-            let (answer, stuck) = compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
-            (answer, if swapped { f64::INFINITY } else { stuck })
+            let (answer, stuck_width) =
+                search_compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
+            (answer, if swapped { f64::INFINITY } else { stuck_width })
         }
     };
     // The answer goes out as it was built unless one of the three rare
     // checks below needs to change it (kept out of line, so that the common
     // path neither copies nor rewrites it).
-    if answer.lower > answer.upper || !is_finite(&answer) || answer.upper - answer.lower > stuck {
-        return rare::<AVX2>(answer, workspace, query, stuck);
+    if answer.lower > answer.upper
+        || !all_finite(&answer)
+        || answer.upper - answer.lower > stuck_width
+    {
+        return recover_suspect_answer::<AVX2>(answer, workspace, query, stuck_width);
     }
     Ok(answer)
 }

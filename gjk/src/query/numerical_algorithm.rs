@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use super::pair::Pair;
+use super::pair::ConvexPair;
 use super::{Options, Status};
 use crate::johnson::{Simplex, Solution, Vertex};
 
@@ -20,9 +20,10 @@ pub(super) fn subalgorithm<const AVX2: bool>(simplex: &Simplex) -> Option<Soluti
     simplex.solve()
 }
 
-/// [`Simplex::reset`] in the query's compiled form (see [`distance_avx2`](super::distance_avx2)).
+/// [`Simplex::reset`] in the query's compiled form (see
+/// [`distance_avx2`](super::distance_avx2)).
 #[inline(always)]
-pub(super) fn reset<const AVX2: bool>(simplex: &mut Simplex, points: &[Vertex]) {
+pub(super) fn reset_simplex<const AVX2: bool>(simplex: &mut Simplex, points: &[Vertex]) {
     #[cfg(target_arch = "x86_64")]
     if AVX2 {
         // SAFETY: as in `subalgorithm`.
@@ -32,24 +33,25 @@ pub(super) fn reset<const AVX2: bool>(simplex: &mut Simplex, points: &[Vertex]) 
     simplex.reset(points);
 }
 
-/// [`Simplex::push`] in the query's compiled form (see [`distance_avx2`](super::distance_avx2)).
+/// [`Simplex::push`] in the query's compiled form (see
+/// [`distance_avx2`](super::distance_avx2)).
 #[inline(always)]
-pub(super) fn push<const AVX2: bool>(simplex: &mut Simplex, keep: u8, p: Vertex) {
+pub(super) fn push_vertex<const AVX2: bool>(simplex: &mut Simplex, keep: u8, point: Vertex) {
     #[cfg(target_arch = "x86_64")]
     if AVX2 {
         // SAFETY: as in `subalgorithm`.
-        unsafe { simplex.push_avx2(keep, p) };
+        unsafe { simplex.push_avx2(keep, point) };
         return;
     }
-    simplex.push(keep, p);
+    simplex.push(keep, point);
 }
 
 /// One convex pair's run of the Numerical Algorithm.
-pub(super) struct Run {
+pub(super) struct RunOutcome {
     /// Lower bound on the cores' penetration depth (5.9), 0 unless they touch
     /// or intersect.
-    pub(super) inner: f64,
-    pub(super) sol: Solution,
+    pub(super) core_depth: f64,
+    pub(super) solution: Solution,
     /// `|v|`, zero when the cores touch or intersect.
     pub(super) norm: f64,
     /// Best lower bound on the core distance seen, before slack.
@@ -60,10 +62,10 @@ pub(super) struct Run {
 }
 
 /// What a run carries from one iteration to the next.
-pub(super) struct RunState {
+pub(super) struct RunProgress {
     pub(super) iterations: u32,
     /// The last iterate that led to a step, with `|v|²`.
-    pub(super) prev: Option<(Solution, f64)>,
+    pub(super) previous: Option<(Solution, f64)>,
     /// Best lower bound on the core distance seen, before slack.
     pub(super) lower: f64,
     pub(super) backup_used: bool,
@@ -73,14 +75,14 @@ pub(super) struct RunState {
     pub(super) level_v2: f64,
 }
 
-impl RunState {
-    /// The nearer of `sol` (with `|v|² = v2`) and the last iterate that led
+impl RunProgress {
+    /// The nearer of `solution` (with `|v|² = v2`) and the last iterate that led
     /// to a step, whose vertices the step kept in their slots.
     #[inline(always)]
-    pub(super) fn nearer(&self, sol: Solution, v2: f64) -> Solution {
-        match self.prev {
-            Some((p, p2)) if p2 < v2 => p,
-            _ => sol,
+    pub(super) fn nearer_iterate(&self, solution: Solution, v2: f64) -> Solution {
+        match self.previous {
+            Some((previous, previous_v2)) if previous_v2 < v2 => previous,
+            _ => solution,
         }
     }
 }
@@ -93,7 +95,7 @@ pub(super) enum Exit {
     Pruned,
 }
 
-impl Pair<'_> {
+impl ConvexPair<'_> {
     /// The Numerical Algorithm, steps (1) to (6): one run, its lengths in the
     /// world's units (the simplex's points stay in the scaled frame).
     #[inline(always)]
@@ -103,13 +105,13 @@ impl Pair<'_> {
         options: &Options,
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
-    ) -> Run {
+    ) -> RunOutcome {
         let mut run = self.solve_scaled::<AVX2>(simplex, options, warm, cutoff);
-        if self.inv_k != 1.0 {
-            run.norm *= self.inv_k;
-            run.lower *= self.inv_k;
-            run.inner *= self.inv_k;
-            run.sol.v *= self.inv_k;
+        if self.inv_scale != 1.0 {
+            run.norm *= self.inv_scale;
+            run.lower *= self.inv_scale;
+            run.core_depth *= self.inv_scale;
+            run.solution.v *= self.inv_scale;
         }
         run
     }
@@ -119,7 +121,7 @@ impl Pair<'_> {
     ///
     /// The common iteration (the subalgorithm succeeds, the support point is
     /// new, `|v|` descends and no end is reached) is taken in this loop, which
-    /// keeps few values live; any other outcome goes to [`step`](Self::step),
+    /// keeps few values live; any other outcome goes to [`step_in_full`](Self::step_in_full),
     /// out of line, which takes steps (3) to (6) in full from the same state.
     /// Both take the same decisions on the same values, so the split changes
     /// the time of a query, never its answer.
@@ -130,85 +132,99 @@ impl Pair<'_> {
         options: &Options,
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
-    ) -> Run {
+    ) -> RunOutcome {
         // Step (1): V0 from the warm start, else the single point s_K(z̄2 - z̄1).
         match warm {
             Some(pairs) => {
-                let mut pts = [Vertex::default(); 4];
-                for (p, &[i, j]) in pts.iter_mut().zip(pairs) {
-                    *p = self.vertex(i as usize, j as usize);
+                let mut points = [Vertex::default(); 4];
+                for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
+                    *point = self.difference_vertex(index_a as usize, index_b as usize);
                 }
-                reset::<AVX2>(simplex, &pts[..pairs.len()]);
+                reset_simplex::<AVX2>(simplex, &points[..pairs.len()]);
             }
-            None => simplex.start(self.support(&self.t)),
+            None => simplex.start(self.support(&self.centroid_gap)),
         }
-        let eps_d = options.tolerance * self.d;
+        let eps_d = options.tolerance * self.size_bound;
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
-        let mut st = RunState {
+        let mut state = RunProgress {
             iterations: 0,
-            prev: None,
+            previous: None,
             lower: 0.0,
             backup_used: false,
             flat_steps: 0,
             level_v2: f64::INFINITY,
         };
         loop {
-            st.iterations += 1;
+            state.iterations += 1;
             // Step (2).
-            let Some(sol) = subalgorithm::<AVX2>(simplex) else {
-                st.backup_used = true;
-                let sol = simplex.backup();
-                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, true, None) {
+            let Some(solution) = subalgorithm::<AVX2>(simplex) else {
+                state.backup_used = true;
+                let solution = simplex.backup();
+                match self.step_in_full::<AVX2>(
+                    simplex, options, cutoff, &mut state, solution, true, None,
+                ) {
                     Some(run) => return run,
                     None => continue,
                 }
             };
-            let v2 = sol.v.norm_squared();
+            let v2 = solution.v.norm_squared();
             let norm = v2.sqrt();
             // Overflow (NaN fails the first test) and touching cores. The
             // cores' meeting, the end of every intersecting query, is taken
             // here as `step` would take it, without its call.
             if !(norm > self.slack && norm.is_finite()) {
                 if norm <= self.slack {
-                    return self.finish(simplex, &st, Status::Converged, sol, 0.0);
+                    return self.end_run(simplex, &state, Status::Converged, solution, 0.0);
                 }
-                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, None) {
+                match self.step_in_full::<AVX2>(
+                    simplex, options, cutoff, &mut state, solution, false, None,
+                ) {
                     Some(run) => return run,
                     None => continue,
                 }
             }
             // Step (3).
-            let s = self.support(&-sol.v);
-            let vs = sol.v.dot(&s.y);
-            let lower = st.lower.max(vs / norm - self.single_slack);
-            let g = v2 - vs;
+            let support_point = self.support(&-solution.v);
+            let v_dot_support = solution.v.dot(&support_point.y);
+            let lower = state.lower.max(v_dot_support / norm - self.single_slack);
+            let g = v2 - v_dot_support;
             if g <= stop_d * norm || norm <= eps_d {
-                return self.finish(simplex, &st, Status::Converged, sol, lower);
+                return self.end_run(simplex, &state, Status::Converged, solution, lower);
             }
             // Anything but a plain descent by a new point, and every other
             // way to end, is decided by `step`, from the start of step (3).
-            let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
-            let descends = match st.prev {
+            let repeat = simplex.has_pair(simplex.all, support_point.ia, support_point.ib);
+            let descends = match state.previous {
                 None => true,
-                Some((_, p2)) => v2 < p2,
+                Some((_, previous_v2)) => v2 < previous_v2,
             };
             if repeat
                 || !descends
-                || sol.mask == 0b1111
-                || self.cut(lower, norm, cutoff, options.margin).is_some()
-                || st.iterations >= options.max_iterations
+                || solution.mask == 0b1111
+                || self
+                    .exit_decided_by_bounds(lower, norm, cutoff, options.margin)
+                    .is_some()
+                || state.iterations >= options.max_iterations
             {
-                match self.step::<AVX2>(simplex, options, cutoff, &mut st, sol, false, Some(s)) {
+                match self.step_in_full::<AVX2>(
+                    simplex,
+                    options,
+                    cutoff,
+                    &mut state,
+                    solution,
+                    false,
+                    Some(support_point),
+                ) {
                     Some(run) => return run,
                     None => continue,
                 }
             }
             // Step (4).
-            st.lower = lower;
-            st.prev = Some((sol, v2));
-            push::<AVX2>(simplex, sol.mask, s);
+            state.lower = lower;
+            state.previous = Some((solution, v2));
+            push_vertex::<AVX2>(simplex, solution.mask, support_point);
         }
     }
 
@@ -219,14 +235,14 @@ impl Pair<'_> {
     /// bounds decide it. `lower` is the run's lower bound, `norm` its `|v|`,
     /// both before slack and in the scaled frame.
     #[inline(always)]
-    pub(super) fn cut(
+    pub(super) fn exit_decided_by_bounds(
         &self,
         lower: f64,
         norm: f64,
         cutoff: f64,
         margin: Option<f64>,
     ) -> Option<Exit> {
-        let lower_cert = (lower - self.slack) * self.inv_k - self.radii;
+        let lower_cert = (lower - self.slack) * self.inv_scale - self.radii;
         if lower_cert > cutoff {
             return Some(Exit::Pruned);
         }
@@ -234,7 +250,7 @@ impl Pair<'_> {
         if lower_cert.max(0.0) > m {
             return Some(Exit::Status(Status::Farther));
         }
-        if ((norm + self.slack) * self.inv_k - self.radii).max(0.0) <= m {
+        if ((norm + self.slack) * self.inv_scale - self.radii).max(0.0) <= m {
             return Some(Exit::Status(Status::Closer));
         }
         None
@@ -243,55 +259,55 @@ impl Pair<'_> {
     /// A run's end: its bounds and, when the cores touch or intersect, the
     /// penetration bound.
     #[inline(always)]
-    pub(super) fn finish(
+    pub(super) fn end_run(
         &self,
         simplex: &Simplex,
-        st: &RunState,
+        state: &RunProgress,
         exit: Status,
-        sol: Solution,
+        solution: Solution,
         lower: f64,
-    ) -> Run {
-        let norm = sol.v.norm();
-        Run {
-            inner: if norm <= self.slack {
-                self.penetration(simplex, &sol)
+    ) -> RunOutcome {
+        let norm = solution.v.norm();
+        RunOutcome {
+            core_depth: if norm <= self.slack {
+                self.penetration_bound(simplex, &solution)
             } else {
                 0.0
             },
-            sol,
+            solution,
             norm,
             lower,
-            iterations: st.iterations,
+            iterations: state.iterations,
             exit: Exit::Status(exit),
-            backup_used: st.backup_used,
+            backup_used: state.backup_used,
         }
     }
 
     /// Steps (3) to (6) of the Numerical Algorithm for the subalgorithm's
-    /// `sol` (from the Backup Procedure when `by_backup`), in full: the ends,
+    /// `solution` (from the Backup Procedure when `by_backup`), in full: the ends,
     /// repeats, flat steps, refinement and the Backup Procedure. `support`,
-    /// when given, is `s_K(-v)` already found for this `sol`. `None` once a
+    /// when given, is `s_K(-v)` already found for this `solution`. `None` once a
     /// point has been added to the simplex (the next iteration begins),
     /// `Some` when the run ends.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn step<const AVX2: bool>(
+    pub(super) fn step_in_full<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
         cutoff: f64,
-        st: &mut RunState,
-        mut sol: Solution,
+        state: &mut RunProgress,
+        mut solution: Solution,
         mut by_backup: bool,
         mut support: Option<Vertex>,
-    ) -> Option<Run> {
-        let eps_d = options.tolerance * self.d;
+    ) -> Option<RunOutcome> {
+        let eps_d = options.tolerance * self.size_bound;
         let stop_d = eps_d + self.single_slack;
         let mut refined = false;
         let mut inside_asked = false;
         let mut regrown = false;
         loop {
-            let v2 = sol.v.norm_squared();
+            let v2 = solution.v.norm_squared();
             let norm = v2.sqrt();
             if !norm.is_finite() {
                 // The subalgorithm overflowed. Fuzzing found points
@@ -301,51 +317,51 @@ impl Pair<'_> {
                 // make every bound below meaningless. Keep the last
                 // finite iterate, or else a single vertex: each is a
                 // point of the hull, so |v| stays an upper bound.
-                st.backup_used = true;
-                let best = match st.prev {
-                    Some((p, _)) => p,
+                state.backup_used = true;
+                let best = match state.previous {
+                    Some((previous, _)) => previous,
                     None => {
-                        let i = simplex.all.trailing_zeros().min(3) as usize;
+                        let first = simplex.all.trailing_zeros().min(3) as usize;
                         let mut lambda = [0.0; 4];
-                        lambda[i] = 1.0;
+                        lambda[first] = 1.0;
                         Solution {
-                            mask: 1 << i,
-                            v: simplex.vertices[i].y,
+                            mask: 1 << first,
+                            v: simplex.vertices[first].y,
                             lambda,
                         }
                     }
                 };
-                return Some(Run {
-                    inner: 0.0,
-                    sol: best,
+                return Some(RunOutcome {
+                    core_depth: 0.0,
+                    solution: best,
                     norm: best.v.norm(),
-                    lower: st.lower,
-                    iterations: st.iterations,
+                    lower: state.lower,
+                    iterations: state.iterations,
                     exit: Exit::Status(Status::ToleranceNotMet),
-                    backup_used: st.backup_used,
+                    backup_used: state.backup_used,
                 });
             }
             if norm <= self.slack {
                 // v is the origin up to round-off: the cores touch or
                 // intersect, and nothing finer can be certified.
-                return Some(self.finish(simplex, st, Status::Converged, sol, 0.0));
+                return Some(self.end_run(simplex, state, Status::Converged, solution, 0.0));
             }
             // Step (3): the stopping rule, and the bounds of Theorem 4.1.
-            let s = match support.take() {
-                Some(s) => s,
-                None => self.support(&-sol.v),
+            let support_point = match support.take() {
+                Some(support_point) => support_point,
+                None => self.support(&-solution.v),
             };
-            let vs = sol.v.dot(&s.y);
-            st.lower = st.lower.max(vs / norm - self.single_slack);
-            let lower = st.lower;
-            let g = v2 - vs;
+            let v_dot_support = solution.v.dot(&support_point.y);
+            state.lower = state.lower.max(v_dot_support / norm - self.single_slack);
+            let lower = state.lower;
+            let g = v2 - v_dot_support;
             // (6.2): g <= ε·D². Near contact that rule alone lets |v|
             // exceed the distance by up to √ε·D (nearly parallel edges do
             // this), so once it holds the run goes on while |v| still
             // descends, and stops early only when the certified interval,
             // of width g/|v|, is within ε·D. A support point already in V̂
             // leaves nothing to add: g is then the error of v itself.
-            let paper_met = g <= eps_d * self.d + self.single_slack * norm;
+            let paper_met = g <= eps_d * self.size_bound + self.single_slack * norm;
             // The error of |v| is at most min(|v|, g/|v|): stop once that
             // is within ε·D, or within the round-off allowance when the
             // support point repeats a vertex of V̂. Beyond that, a repeat
@@ -353,25 +369,25 @@ impl Pair<'_> {
             // (a thin simplex: nearly parallel edges, or nearly collinear
             // points of K at contact): refinement, then steps (4) to (6).
             if g <= stop_d * norm || norm <= eps_d {
-                return Some(self.finish(simplex, st, Status::Converged, sol, lower));
+                return Some(self.end_run(simplex, state, Status::Converged, solution, lower));
             }
-            let repeat = simplex.has_pair(simplex.all, s.ia, s.ib);
+            let repeat = simplex.has_pair(simplex.all, support_point.ia, support_point.ib);
             if repeat && g <= self.slack * norm {
-                return Some(self.finish(simplex, st, Status::Converged, sol, lower));
+                return Some(self.end_run(simplex, state, Status::Converged, solution, lower));
             }
             // Cutoff and margin are the world's: compared there.
-            match self.cut(lower, norm, cutoff, options.margin) {
+            match self.exit_decided_by_bounds(lower, norm, cutoff, options.margin) {
                 Some(Exit::Pruned) => {
-                    let mut run = self.finish(simplex, st, Status::Converged, sol, lower);
+                    let mut run = self.end_run(simplex, state, Status::Converged, solution, lower);
                     run.exit = Exit::Pruned;
                     return Some(run);
                 }
                 Some(Exit::Status(status)) => {
-                    return Some(self.finish(simplex, st, status, sol, lower));
+                    return Some(self.end_run(simplex, state, status, solution, lower));
                 }
                 None => {}
             }
-            if st.iterations >= options.max_iterations {
+            if state.iterations >= options.max_iterations {
                 // Converged only where step (5) below would end the run
                 // too: (6.2) alone holds for a |v| up to √ε·D off, which
                 // a run without the cap goes on to remove (nearly parallel
@@ -384,8 +400,8 @@ impl Pair<'_> {
                     Status::IterationCap
                 };
                 // The nearer of the last two iterates (see step 5).
-                let best = st.nearer(sol, v2);
-                return Some(self.finish(simplex, st, status, best, lower));
+                let best = state.nearer_iterate(solution, v2);
+                return Some(self.end_run(simplex, state, status, best, lower));
             }
             // A step that does not descend refines v before it is taken or
             // given up (as a repeat does, below). Along a long thin edge of
@@ -398,11 +414,11 @@ impl Pair<'_> {
             // refined v picks the point a step in exact arithmetic would.
             if !refined
                 && !repeat
-                && matches!(st.prev, Some((_, p2)) if v2 >= p2)
-                && let Some(r) = simplex.refine(sol)
+                && matches!(state.previous, Some((_, previous_v2)) if v2 >= previous_v2)
+                && let Some(refined_solution) = simplex.refine(solution)
             {
                 refined = true;
-                sol = r;
+                solution = refined_solution;
                 continue;
             }
             // Step (4): descend while |v| decreases and V̂ is not full. A
@@ -418,38 +434,38 @@ impl Pair<'_> {
             // on, and the next step descends by a few per cent. Counted
             // over the whole run, four such pairs of steps ended it at
             // 1.548e-3, the truth 1.5335e-3 (mid_sets seed 8574, pair 7841).
-            let budget = if v2 < st.level_v2 * (1.0 - 1.0 / 1_048_576.0) {
+            let budget = if v2 < state.level_v2 * (1.0 - 1.0 / 1_048_576.0) {
                 0
             } else {
-                st.flat_steps
+                state.flat_steps
             };
             let mut not_down = false;
-            let descended = match st.prev {
+            let descended = match state.previous {
                 None => true,
-                Some((_, p2)) if v2 < p2 => true,
-                Some((p, p2)) => {
-                    let grew = sol.mask.count_ones() > p.mask.count_ones();
-                    let flat = grew && v2 <= p2 * (1.0 + 8.0 * f64::EPSILON);
+                Some((_, previous_v2)) if v2 < previous_v2 => true,
+                Some((previous, previous_v2)) => {
+                    let grew = solution.mask.count_ones() > previous.mask.count_ones();
+                    let flat = grew && v2 <= previous_v2 * (1.0 + 8.0 * f64::EPSILON);
                     // |v| up by no more than its round-off while the new
                     // support point, not yet in Y, lies beyond v's plane
                     // by more than the tolerance: near contact, Johnson's
                     // v of a new face can be εD worse than the refined v
                     // of the last, and stopping there leaves |v| at
                     // (6.2)'s √ε·D (nearly parallel edges touching).
-                    let level = norm <= p2.sqrt() + self.slack;
+                    let level = norm <= previous_v2.sqrt() + self.slack;
                     not_down = true;
                     (flat || level) && budget < 4
                 }
             };
-            if descended && sol.mask.count_ones() <= 3 && !repeat {
+            if descended && solution.mask.count_ones() <= 3 && !repeat {
                 // Only a step taken counts against the budget: a repeat
                 // refined within the iteration is the same step.
                 if not_down {
-                    st.flat_steps = budget + 1;
-                    st.level_v2 = v2;
+                    state.flat_steps = budget + 1;
+                    state.level_v2 = v2;
                 }
-                st.prev = Some((sol, v2));
-                push::<AVX2>(simplex, sol.mask, s);
+                state.previous = Some((solution, v2));
+                push_vertex::<AVX2>(simplex, solution.mask, support_point);
                 return None;
             }
             // Stuck with four points and a face chosen: a nearly flat
@@ -458,7 +474,7 @@ impl Pair<'_> {
             // objects of size 2, the support point repeating the dropped
             // vertex). Refinement and the Backup Procedure work from the same
             // cofactors; the exact orientation tests do not. Asked once.
-            if simplex.all == 0b1111 && sol.mask != 0b1111 && !inside_asked {
+            if simplex.all == 0b1111 && solution.mask != 0b1111 && !inside_asked {
                 inside_asked = true;
                 if let Some(lambda) = simplex.origin_weights() {
                     let origin = Solution {
@@ -466,7 +482,7 @@ impl Pair<'_> {
                         v: Vector3::zeros(),
                         lambda,
                     };
-                    return Some(self.finish(simplex, st, Status::Converged, origin, lower));
+                    return Some(self.end_run(simplex, state, Status::Converged, origin, lower));
                 }
             }
             // The support point repeats a vertex the subalgorithm dropped,
@@ -476,10 +492,12 @@ impl Pair<'_> {
             // allows; its support point then leads on. Asked once.
             if repeat && !regrown {
                 regrown = true;
-                if let Some(r) = simplex.regrow(sol, s.ia, s.ib) {
-                    let r2 = r.v.norm_squared();
-                    if r2 <= v2 * (1.0 + 8.0 * f64::EPSILON) {
-                        sol = r;
+                if let Some(regrown_solution) =
+                    simplex.regrow(solution, support_point.ia, support_point.ib)
+                {
+                    let regrown_v2 = regrown_solution.v.norm_squared();
+                    if regrown_v2 <= v2 * (1.0 + 8.0 * f64::EPSILON) {
+                        solution = regrown_solution;
                         continue;
                     }
                 }
@@ -491,7 +509,7 @@ impl Pair<'_> {
             // Backup Procedure comes after, if needed.
             let refined_sol = if repeat && !refined {
                 refined = true;
-                simplex.refine(sol)
+                simplex.refine(solution)
             } else {
                 None
             };
@@ -518,11 +536,11 @@ impl Pair<'_> {
                 // A step that failed to descend (round-off in a
                 // degenerate simplex) leaves the previous iterate, whose
                 // slots the push kept, as the better upper bound.
-                let best = st.nearer(sol, v2);
-                return Some(self.finish(simplex, st, status, best, lower));
+                let best = state.nearer_iterate(solution, v2);
+                return Some(self.end_run(simplex, state, status, best, lower));
             }
             match refined_sol {
-                Some(r) => sol = r,
+                Some(refined) => solution = refined,
                 None => {
                     // Step (6): redo v_k with the Backup Procedure. Its v
                     // comes from the same kind of cofactors, so it may be
@@ -531,10 +549,10 @@ impl Pair<'_> {
                     // [0, 4.7e-9] on the Backup Procedure's thin triangle,
                     // the support point repeating one of its vertices, while
                     // the refined v leads on to the truth, 4.8e-11.
-                    sol = simplex.backup();
+                    solution = simplex.backup();
                     by_backup = true;
                     refined = false;
-                    st.backup_used = true;
+                    state.backup_used = true;
                 }
             }
         }

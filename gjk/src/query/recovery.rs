@@ -2,9 +2,9 @@
 //! stuck query asked again with A and B swapped, bounds that contradict
 //! each other and numbers that overflowed.
 
-use super::numerical_algorithm::{Exit, Run};
-use super::pair::Pair;
-use super::{Answer, Options, Query, Status, Workspace, distance_in, distance_of, is_finite};
+use super::numerical_algorithm::{Exit, RunOutcome};
+use super::pair::ConvexPair;
+use super::{Answer, Options, Query, Status, Workspace, all_finite, distance_body, distance_in};
 use crate::Error;
 use crate::johnson::Simplex;
 
@@ -34,7 +34,7 @@ pub(super) fn second_opinion<const AVX2: bool>(
         warm: None,
         swapped: true,
     };
-    let Ok(second) = distance_of::<AVX2>(workspace, &other) else {
+    let Ok(second) = distance_body::<AVX2>(workspace, &other) else {
         return first;
     };
     let lower = first.lower.max(second.lower);
@@ -63,27 +63,27 @@ pub(super) fn second_opinion<const AVX2: bool>(
     best
 }
 
-/// The rare ends of [`distance_of`]: bounds that contradict each other, a
-/// number that overflowed ([`repair`]), or a run stuck with an interval
-/// wider than `stuck` ([`second_opinion`]).
+/// The rare ends of [`distance_body`]: bounds that contradict each other, a
+/// number that overflowed ([`mend_bounds_or_reject_overflow`]), or a run
+/// stuck with an interval wider than `stuck_width` ([`second_opinion`]).
 #[cold]
 #[inline(never)]
-pub(super) fn rare<const AVX2: bool>(
+pub(super) fn recover_suspect_answer<const AVX2: bool>(
     answer: Answer,
     workspace: &mut Workspace,
     query: &Query<'_>,
-    stuck: f64,
+    stuck_width: f64,
 ) -> Result<Answer, Error> {
-    let answer = repair(answer, workspace, query)?;
+    let answer = mend_bounds_or_reject_overflow(answer, workspace, query)?;
     let converging = matches!(answer.status, Status::Converged | Status::ToleranceNotMet);
-    if converging && answer.upper - answer.lower > stuck {
+    if converging && answer.upper - answer.lower > stuck_width {
         return Ok(second_opinion::<AVX2>(answer, workspace, query));
     }
     Ok(answer)
 }
 
 /// Bounds that contradict each other, or a number that overflowed.
-pub(super) fn repair(
+pub(super) fn mend_bounds_or_reject_overflow(
     mut answer: Answer,
     workspace: &mut Workspace,
     query: &Query<'_>,
@@ -96,23 +96,30 @@ pub(super) fn repair(
         // bound is given up (0) rather than returning an interval that
         // cannot hold.
         if query.warm.is_some() {
-            let q = query;
-            return distance_in(workspace, q.a, q.pose_a, q.b, q.pose_b, q.options, None);
+            let Query {
+                a,
+                pose_a,
+                b,
+                pose_b,
+                options,
+                ..
+            } = *query;
+            return distance_in(workspace, a, pose_a, b, pose_b, options, None);
         }
         answer.lower = 0.0;
         answer.distance = answer.distance.min(answer.upper);
         answer.status = Status::ToleranceNotMet;
     }
-    if !is_finite(&answer) {
+    if !all_finite(&answer) {
         // Finite inputs whose combination overflows f64 (coordinates near 1e308).
         return Err(Error::NonFinitePose);
     }
     Ok(answer)
 }
 
-impl Pair<'_> {
+impl ConvexPair<'_> {
     /// [`solve`](Self::solve), then, when a warm start ended with a loose
-    /// interval, once more cold ([`cold_again`](Self::cold_again)): single
+    /// interval, once more cold ([`rerun_cold`](Self::rerun_cold)): single
     /// pairs and a compound's piece pairs alike. Only a run that meant to
     /// converge is asked again. A pruned run only had to prove that its pair
     /// cannot win; an early exit on the margin and the iteration cap end
@@ -121,20 +128,20 @@ impl Pair<'_> {
     /// longer than without one, and came back with the cold run's coarser
     /// distance).
     #[inline(always)]
-    pub(super) fn solve_retrying<const AVX2: bool>(
+    pub(super) fn solve_or_rerun_cold<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
-    ) -> Run {
+    ) -> RunOutcome {
         let run = self.solve::<AVX2>(simplex, options, warm, cutoff);
         let meant_to_converge = matches!(
             run.exit,
             Exit::Status(Status::Converged | Status::ToleranceNotMet)
         );
-        if warm.is_some() && meant_to_converge && self.loose(&run, options.tolerance) {
-            return self.cold_again::<AVX2>(run, simplex, options, cutoff);
+        if warm.is_some() && meant_to_converge && self.interval_is_loose(&run, options.tolerance) {
+            return self.rerun_cold::<AVX2>(run, simplex, options, cutoff);
         }
         run
     }
@@ -142,8 +149,8 @@ impl Pair<'_> {
     /// Whether the run's certified interval is wider than the tolerance
     /// allows: (6.2) alone ended it, near contact.
     #[inline(always)]
-    pub(super) fn loose(&self, run: &Run, tolerance: f64) -> bool {
-        let (lower, upper, _) = self.bounds(run);
+    pub(super) fn interval_is_loose(&self, run: &RunOutcome, tolerance: f64) -> bool {
+        let (lower, upper, _) = self.certified_bounds(run);
         upper - lower > self.tight_width(tolerance)
     }
 
@@ -151,7 +158,7 @@ impl Pair<'_> {
     /// a converged run: the slack at both ends and the 4 ε·D of step (5).
     #[inline(always)]
     pub(super) fn tight_width(&self, tolerance: f64) -> f64 {
-        2.0 * self.slack_world + 4.0 * tolerance * self.d * self.inv_k
+        2.0 * self.slack_world + 4.0 * tolerance * self.size_bound * self.inv_scale
     }
 
     /// The interval width so much beyond what the tolerance allows (100
@@ -173,13 +180,13 @@ impl Pair<'_> {
     /// bound, certified too, still counts.
     #[cold]
     #[inline(never)]
-    pub(super) fn cold_again<const AVX2: bool>(
+    pub(super) fn rerun_cold<const AVX2: bool>(
         &self,
-        warm: Run,
+        warm: RunOutcome,
         simplex: &mut Simplex,
         options: &Options,
         cutoff: f64,
-    ) -> Run {
+    ) -> RunOutcome {
         let mut run = self.solve::<AVX2>(simplex, options, None, cutoff);
         run.lower = run.lower.max(warm.lower);
         run.iterations = run.iterations.saturating_add(warm.iterations);

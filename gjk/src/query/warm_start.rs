@@ -21,28 +21,28 @@ impl PieceSimplex {
     /// (an empty entry always fits). Branch-free over the pairs: one
     /// comparison each, folded into one flag.
     #[inline]
-    pub(super) fn fits(&self, a: &Shape, b: &Shape) -> bool {
+    pub(super) fn fits_shapes(&self, a: &Shape, b: &Shape) -> bool {
         if self.len == 0 {
             return true;
         }
-        let (Some(ca), Some(cb)) = (
+        let (Some(convex_a), Some(convex_b)) = (
             a.convex_piece(self.pieces[0] as usize),
             b.convex_piece(self.pieces[1] as usize),
         ) else {
             return false;
         };
-        let (na, nb) = (ca.len(), cb.len());
+        let (len_a, len_b) = (convex_a.len(), convex_b.len());
         let mut ok = self.len <= 4;
         for &[i, j] in self.pairs() {
-            ok &= (i as usize) < na;
-            ok &= (j as usize) < nb;
+            ok &= (i as usize) < len_a;
+            ok &= (j as usize) < len_b;
         }
         ok
     }
 
     /// The index pairs of `mask`'s vertices in `simplex`.
     #[inline]
-    pub(super) fn of(simplex: &Simplex, mask: u8, pieces: [u32; 2]) -> Self {
+    pub(super) fn from_simplex(simplex: &Simplex, mask: u8, pieces: [u32; 2]) -> Self {
         let mut out = PieceSimplex {
             pieces,
             ..Default::default()
@@ -118,15 +118,15 @@ impl WarmStart {
     /// The kept simplexes: the nearest pair's (possibly empty), then the
     /// runner-up's if any.
     #[inline]
-    pub(super) fn entries(&self) -> impl Iterator<Item = &PieceSimplex> {
+    pub(super) fn kept_simplexes(&self) -> impl Iterator<Item = &PieceSimplex> {
         std::iter::once(&self.first).chain((self.second.len > 0).then_some(&self.second))
     }
 
     /// The index pairs kept for the piece pair `pieces`, if any.
     #[inline]
     pub(super) fn for_pieces(&self, pieces: [u32; 2]) -> Option<&[[u32; 2]]> {
-        self.entries()
-            .find(|e| e.len > 0 && e.pieces == pieces)
-            .map(|e| e.pairs())
+        self.kept_simplexes()
+            .find(|kept| kept.len > 0 && kept.pieces == pieces)
+            .map(|kept| kept.pairs())
     }
 }

@@ -3,6 +3,7 @@
 
 mod answer;
 mod compound;
+mod full_step;
 mod numerical_algorithm;
 mod options;
 mod pair;

@@ -169,61 +169,13 @@ impl Convex {
     /// [`Error::InvalidRadius`] for a negative or non-finite radius.
     pub fn new(vertices: impl Into<Vec<Point3<f64>>>, radius: f64) -> Result<Self, Error> {
         let vertices = vertices.into();
-        if vertices.is_empty() {
-            return Err(Error::EmptyVertices);
-        }
-        if u32::try_from(vertices.len()).is_err() {
-            return Err(Error::TooManyVertices(vertices.len()));
-        }
-        if let Some(index) = vertices
-            .iter()
-            .position(|v| !v.coords.iter().all(|c| c.is_finite()))
-        {
-            return Err(Error::NonFiniteVertex(index));
-        }
-        if !(radius.is_finite() && radius >= 0.0) {
-            return Err(Error::InvalidRadius(radius));
-        }
-        // Two-pass mean around the first vertex: summing raw coordinates of a set
-        // far from the origin would lose the digits that matter.
-        let base = vertices[0];
-        let n = vertices.len() as f64;
-        let mean_offset = vertices
-            .iter()
-            .fold(Vector3::zeros(), |acc, v| acc + (v - base))
-            / n;
-        let centroid = base + mean_offset;
-        if !centroid.coords.iter().all(|c| c.is_finite()) {
-            // Finite vertices whose spread overflows f64.
-            return Err(Error::NonFiniteVertex(0));
-        }
+        check_input(&vertices, radius)?;
+        let centroid = centroid_of(&vertices)?;
+        let ((mut xs, mut ys, mut zs), widest) = relative_coordinates(&vertices, &centroid)?;
         let len = vertices.len();
-        let (mut xs, mut ys, mut zs) = (
-            Vec::with_capacity(len),
-            Vec::with_capacity(len),
-            Vec::with_capacity(len),
-        );
-        let mut widest: f64 = 0.0;
-        for v in &vertices {
-            let d = v - centroid;
-            widest = widest.max(d.amax());
-            xs.push(d.x);
-            ys.push(d.y);
-            zs.push(d.z);
-        }
-        if !widest.is_finite() {
-            return Err(Error::NonFiniteVertex(0));
-        }
-        // Squared lengths scaled by a power of two (exact), so that sets near
-        // 1e-300 or 1e300 neither underflow to a size of 0 nor overflow.
-        let (k, inv_k) = pow2_scale(widest);
-        let mut size2: f64 = 0.0;
-        for i in 0..len {
-            size2 = size2.max(Vector3::new(xs[i] * k, ys[i] * k, zs[i] * k).norm_squared());
-        }
-        let size = size2.sqrt() * inv_k;
+        let size = largest_length(&xs, &ys, &zs, widest)?;
         let centroid_norm = robust_norm(&centroid.coords);
-        if !size.is_finite() || centroid_norm + size > MAX_REACH {
+        if centroid_norm + size > MAX_REACH {
             return Err(Error::NonFiniteVertex(0));
         }
         // Pad the scan arrays to whole vector steps with copies of vertex 0:
@@ -235,43 +187,7 @@ impl Convex {
                 coord.resize(padded, coord[0]);
             }
         }
-        let base = if len == 1 {
-            Kind::Point
-        } else if is_box(&xs, &ys, &zs) {
-            Kind::Box
-        } else if len < 8 {
-            Kind::Few
-        } else {
-            scan_kind()
-        };
-        // Sets from CONES_MIN_VERTICES to below CONES_MAX_VERTICES get the
-        // cube map, unless their size is outside the range its margins are
-        // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
-        // the block search.
-        let scanned = base == Kind::Scan || is_avx2(base);
-        let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
-            Cones::new(&xs, &ys, &zs, len, size).map(Box::new)
-        } else {
-            None
-        };
-        let kind = match (&cones, base) {
-            (Some(_), Kind::Scan) => Kind::Cones { fused: false },
-            (Some(_), _) => Kind::Cones { fused: true },
-            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => Kind::Blocks,
-            (None, k) => k,
-        };
-        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
-        // The f32 scan only where the exact search is the portable scan of
-        // every vertex: against the AVX2 scan, the cube map and the block
-        // search it is slower at every size measured (0.86× at 16 vertices,
-        // 0.4× at 512, docs/speed-accuracy.md), and `Single` then takes the
-        // exact search. Indices ride in i32 lanes in the f32 scan.
-        let single =
-            if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
-                Single::of(&xs, &ys, &zs, size)
-            } else {
-                None
-            };
+        let search = SupportSearch::choose(&xs, &ys, &zs, len, size);
         Ok(Self {
             vertices,
             radius,
@@ -281,10 +197,10 @@ impl Convex {
             xs,
             ys,
             zs,
-            kind,
-            single,
-            blocks,
-            cones,
+            kind: search.kind,
+            single: search.single,
+            blocks: search.blocks,
+            cones: search.cones,
         })
     }
 
@@ -529,6 +445,150 @@ impl Convex {
         // SAFETY: i < xs.len() (checked just above) == ys.len() == zs.len().
         let (y, z) = unsafe { (*self.ys.get_unchecked(i), *self.zs.get_unchecked(i)) };
         Vector3::new(x, y, z)
+    }
+}
+
+/// The checks of [`Convex::new`] on its input, before any arithmetic.
+fn check_input(vertices: &[Point3<f64>], radius: f64) -> Result<(), Error> {
+    if vertices.is_empty() {
+        return Err(Error::EmptyVertices);
+    }
+    if u32::try_from(vertices.len()).is_err() {
+        return Err(Error::TooManyVertices(vertices.len()));
+    }
+    if let Some(index) = vertices
+        .iter()
+        .position(|v| !v.coords.iter().all(|c| c.is_finite()))
+    {
+        return Err(Error::NonFiniteVertex(index));
+    }
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(Error::InvalidRadius(radius));
+    }
+    Ok(())
+}
+
+/// The mean of `vertices` (at least one), in two passes around the first
+/// vertex: summing raw coordinates of a set far from the origin would lose
+/// the digits that matter.
+fn centroid_of(vertices: &[Point3<f64>]) -> Result<Point3<f64>, Error> {
+    let base = vertices[0];
+    let count = vertices.len() as f64;
+    let mean_offset = vertices
+        .iter()
+        .fold(Vector3::zeros(), |acc, v| acc + (v - base))
+        / count;
+    let centroid = base + mean_offset;
+    if !centroid.coords.iter().all(|c| c.is_finite()) {
+        // Finite vertices whose spread overflows f64.
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(centroid)
+}
+
+/// The scan arrays: each coordinate of every vertex relative to the
+/// centroid, one array per axis.
+type ScanArrays = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// `vertices` relative to `centroid`, as scan arrays, and the largest
+/// coordinate among them (absolute).
+fn relative_coordinates(
+    vertices: &[Point3<f64>],
+    centroid: &Point3<f64>,
+) -> Result<(ScanArrays, f64), Error> {
+    let len = vertices.len();
+    let (mut xs, mut ys, mut zs) = (
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+    );
+    let mut widest: f64 = 0.0;
+    for v in vertices {
+        let d = v - centroid;
+        widest = widest.max(d.amax());
+        xs.push(d.x);
+        ys.push(d.y);
+        zs.push(d.z);
+    }
+    if !widest.is_finite() {
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(((xs, ys, zs), widest))
+}
+
+/// The largest length among the scan arrays' points, `D(coZ - z̄)` of
+/// (6.4), whose largest coordinate is `widest`. Squared lengths are scaled
+/// by a power of two (exact), so that sets near 1e-300 or 1e300 neither
+/// underflow to a size of 0 nor overflow.
+fn largest_length(xs: &[f64], ys: &[f64], zs: &[f64], widest: f64) -> Result<f64, Error> {
+    let (scale, inv_scale) = pow2_scale(widest);
+    let mut size2: f64 = 0.0;
+    for ((x, y), z) in xs.iter().zip(ys).zip(zs) {
+        size2 = size2.max(Vector3::new(x * scale, y * scale, z * scale).norm_squared());
+    }
+    let size = size2.sqrt() * inv_scale;
+    if !size.is_finite() {
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(size)
+}
+
+/// How a shape's support point is found, with the copies of its vertices
+/// that the search needs.
+struct SupportSearch {
+    kind: Kind,
+    single: Option<Box<Single>>,
+    blocks: Option<Box<Blocks>>,
+    cones: Option<Box<Cones>>,
+}
+
+impl SupportSearch {
+    /// The search for the `len` vertices of size `size` in the (padded)
+    /// scan arrays.
+    fn choose(xs: &[f64], ys: &[f64], zs: &[f64], len: usize, size: f64) -> Self {
+        let base = if len == 1 {
+            Kind::Point
+        } else if is_box(xs, ys, zs) {
+            Kind::Box
+        } else if len < 8 {
+            Kind::Few
+        } else {
+            scan_kind()
+        };
+        // Sets from CONES_MIN_VERTICES to below CONES_MAX_VERTICES get the
+        // cube map, unless their size is outside the range its margins are
+        // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
+        // the block search.
+        let scanned = base == Kind::Scan || is_avx2(base);
+        let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
+            Cones::new(xs, ys, zs, len, size).map(Box::new)
+        } else {
+            None
+        };
+        let kind = match (&cones, base) {
+            (Some(_), Kind::Scan) => Kind::Cones { fused: false },
+            (Some(_), _) => Kind::Cones { fused: true },
+            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => Kind::Blocks,
+            (None, other) => other,
+        };
+        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(xs, ys, zs, len)));
+        // The f32 scan only where the exact search is the portable scan of
+        // every vertex: against the AVX2 scan, the cube map and the block
+        // search it is slower at every size measured (0.86× at 16 vertices,
+        // 0.4× at 512, docs/speed-accuracy.md), and `Single` then takes the
+        // exact search. Indices ride in i32 lanes in the f32 scan.
+        let single =
+            if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
+                Single::of(xs, ys, zs, size)
+            } else {
+                None
+            };
+        SupportSearch {
+            kind,
+            single,
+            blocks,
+            cones,
+        }
     }
 }
 
@@ -1246,11 +1306,79 @@ pub(crate) mod tests {
         }
     }
 
+    /// `n` points of a cloud of size `scale` at `offset` on x. Flat sets put
+    /// every other vertex within 3e-7 of the plane x = scale, far from the
+    /// centroid: with directions near +x, near-ties that f32 cannot
+    /// resolve, which is what the slack is for.
+    fn cloud(rng: &mut Rng, n: usize, scale: f64, offset: f64, flat: bool) -> Vec<Point3<f64>> {
+        (0..n)
+            .map(|i| {
+                let x = if flat && i % 2 == 0 {
+                    1.0 + 3e-7 * rng.next()
+                } else if flat {
+                    rng.next().min(0.0)
+                } else {
+                    rng.next()
+                };
+                Point3::new(
+                    offset + x * scale,
+                    rng.next() * scale,
+                    rng.next() * scale * 1e-3,
+                )
+            })
+            .collect()
+    }
+
+    /// The `k`-th direction of a test on a cloud of size `scale`: near +x
+    /// for a flat cloud, and by turns with a tiny component, signed zeros,
+    /// huge and subnormal.
+    fn direction(rng: &mut Rng, k: usize, flat: bool, scale: f64) -> Vector3<f64> {
+        let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
+        if flat {
+            d = Vector3::new(1.0, d.y * 1e-9, d.z * 1e-9);
+        }
+        match k % 5 {
+            1 => d.y *= 1e-300,
+            2 => d = Vector3::new(0.0, -0.0, d.z),
+            // Subnormal: 1/max overflows, the f64 scan takes over.
+            4 => d *= 1e-310,
+            // Large, but not so large that the reference overflows.
+            3 => d *= 1e120 / scale.max(1.0),
+            _ => {}
+        }
+        d
+    }
+
+    /// The f32 scan's picks for `d` on `c` (which has its f32 copy): through
+    /// the support search, and straight from the portable and, where the
+    /// CPU has them, the AVX2 f32 scans.
+    fn single_picks(c: &Convex, d: &Vector3<f64>) -> Vec<usize> {
+        let s = c.single.as_deref().expect("an f32 copy");
+        let d32 = {
+            let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
+            let u = d * (1.0 / m);
+            [u.x as f32, u.y as f32, u.z as f32]
+        };
+        let mut picks = vec![c.support_index_single(d)];
+        let scalable = d32.iter().all(|x| x.is_finite());
+        if scalable {
+            picks.push(scan_single(&s.xs, &s.ys, &s.zs, d32));
+        }
+        #[cfg(target_arch = "x86_64")]
+        if scalable
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the features were checked just above.
+            picks.push(unsafe { scan_single_avx2(&s.xs, &s.ys, &s.zs, d32) });
+        }
+        picks
+    }
+
     /// The f32 scan's choice is within `SINGLE_SLACK · size · |d|` of the
     /// true support value, on both code paths, at every scale f64 allows,
     /// far from the origin, for directions with components of wildly
-    /// different sizes (and ±0); and shapes that keep the exact support
-    /// return the exact support.
+    /// different sizes (and ±0).
     #[test]
     fn single_precision_support_is_within_its_slack() {
         let mut rng = Rng(0x5eed_1234_abcd_0001);
@@ -1260,27 +1388,7 @@ pub(crate) mod tests {
             // Sizes are found through squared lengths, so 1e±150 is the range.
             for scale in [1e-140, 1e-9, 1.0, 1e9, 1e140] {
                 for (offset, flat) in [(0.0, false), (1e9, false), (0.0, true), (1e9, true)] {
-                    // Flat sets put every other vertex within 3e-7 of the
-                    // plane x = scale, far from the centroid, and directions
-                    // near +x: near-ties that f32 cannot resolve, which is
-                    // what the slack is for.
-                    let pts: Vec<Point3<f64>> = (0..n)
-                        .map(|i| {
-                            let x = if flat && i % 2 == 0 {
-                                1.0 + 3e-7 * rng.next()
-                            } else if flat {
-                                rng.next().min(0.0)
-                            } else {
-                                rng.next()
-                            };
-                            Point3::new(
-                                offset + x * scale,
-                                rng.next() * scale,
-                                rng.next() * scale * 1e-3,
-                            )
-                        })
-                        .collect();
-                    let mut c = Convex::new(pts, 0.0).unwrap();
+                    let mut c = Convex::new(cloud(&mut rng, n, scale, offset, flat), 0.0).unwrap();
                     if offset * 1e-6 > scale {
                         // The vertices collapsed onto a few values.
                         continue;
@@ -1293,41 +1401,10 @@ pub(crate) mod tests {
                     }
                     assert!(c.has_single(), "n {n} scale {scale:e}");
                     for k in 0..64 {
-                        let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
-                        if flat {
-                            d = Vector3::new(1.0, d.y * 1e-9, d.z * 1e-9);
-                        }
-                        match k % 5 {
-                            1 => d.y *= 1e-300,
-                            2 => d = Vector3::new(0.0, -0.0, d.z),
-                            // Subnormal: 1/max overflows, the f64 scan takes over.
-                            4 => d *= 1e-310,
-                            // Large, but not so large that the reference overflows.
-                            3 => d *= 1e120 / scale.max(1.0),
-                            _ => {}
-                        }
+                        let d = direction(&mut rng, k, flat, scale);
                         let best = c.local(brute(&c, &d)).dot(&d);
                         let slack = SINGLE_SLACK * c.size() * d.norm();
-                        let s = c.single.as_deref().unwrap();
-                        let d32 = {
-                            let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
-                            let u = d * (1.0 / m);
-                            [u.x as f32, u.y as f32, u.z as f32]
-                        };
-                        let mut picks = vec![c.support_index_single(&d)];
-                        let scalable = d32.iter().all(|x| x.is_finite());
-                        if scalable {
-                            picks.push(scan_single(&s.xs, &s.ys, &s.zs, d32));
-                        }
-                        #[cfg(target_arch = "x86_64")]
-                        if scalable
-                            && std::arch::is_x86_feature_detected!("avx2")
-                            && std::arch::is_x86_feature_detected!("fma")
-                        {
-                            // SAFETY: the features were checked just above.
-                            picks.push(unsafe { scan_single_avx2(&s.xs, &s.ys, &s.zs, d32) });
-                        }
-                        for i in picks {
+                        for i in single_picks(&c, &d) {
                             assert!(i < c.len());
                             let got = c.local(i).dot(&d);
                             worst = worst.max((best - got) / (c.size() * d.norm()));
@@ -1342,11 +1419,15 @@ pub(crate) mod tests {
             }
         }
         assert!(checked > 3000, "{checked}");
-        // The flat sets did produce misses (about 2e-8 here), so the bound
-        // was tested, not just the easy picks.
+        // The flat sets did produce misses, so the bound was tested, not
+        // just the easy picks.
         assert!(worst > 0.0);
-        // Directions whose largest component is near f64::MAX (1/m would be
-        // subnormal) go to the exact scan.
+    }
+
+    /// Directions whose largest component is near f64::MAX (1/m would be
+    /// subnormal), or that are subnormal themselves, go to the exact scan.
+    #[test]
+    fn single_precision_leaves_extreme_directions_to_the_exact_scan() {
         let mut ring = Convex::new(
             (0..40)
                 .map(|i| {
@@ -1365,7 +1446,13 @@ pub(crate) mod tests {
         ] {
             assert_eq!(ring.support_index_single(&d), ring.scan_index(&d), "{d:?}");
         }
-        // Small and closed-form shapes keep the exact support.
+    }
+
+    /// Small and closed-form shapes keep the exact support under
+    /// `Precision::Single`; so do sets large enough for the cube map or the
+    /// block search, which are faster.
+    #[test]
+    fn shapes_without_an_f32_copy_keep_the_exact_support() {
         let small = Convex::new(
             (0..15)
                 .map(|i| Point3::new(i as f64, (i * i) as f64, 1.0))
@@ -1374,8 +1461,6 @@ pub(crate) mod tests {
         )
         .unwrap();
         let cube = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.0).unwrap();
-        // So do sets large enough for the cube map or the block search,
-        // which are faster.
         let large = Convex::new(
             (0..SINGLE_MAX_VERTICES)
                 .map(|i| {

@@ -781,8 +781,8 @@ impl Simplex {
             return vols.iter().all(|&v| (v > 0.0) == (total > 0.0));
         }
         // Each volume's test again, for the rare exact path: carrying the
-        // four flags through the common path costs more (13 instructions an
-        // intersecting query, measured).
+        // four flags through the common path costs every intersecting query
+        // more than the rare recomputation does.
         self.holds_origin_exactly(&vols.map(|v| (v, v * v > bound)))
     }
 
@@ -919,7 +919,7 @@ impl Simplex {
             return Some(self.solution(ALL));
         }
         // First the face that drops the old vertex most aligned with the
-        // newest point: it holds the answer about 80% of the time.
+        // newest point: it most often holds the answer.
         let (mem, len) = const { MEMBERS[ALL & !(1 << N)] };
         let mut drop = mem[0] as usize & 3;
         for &i in &mem[1..len as usize] {
@@ -1166,8 +1166,8 @@ impl Simplex {
     /// whose weight (1e-16) moves `v` across the set by more than `v`'s own
     /// round-off while `|v|` changes by less. A needle lying along a prism's
     /// edge, the support search then tied between the edge's two faces by
-    /// the sign of that sideways error, stopped at 5.6e-5 of a truth of
-    /// 1.6e-11 (`mid_sets` seed 8554, pair 164). `None` when `y_j` is not a
+    /// the sign of that sideways error, stopped far short of its distance
+    /// (the `mid_sets` sweep found it). `None` when `y_j` is not a
     /// dropped vertex, when the grown subset would be the whole tetrahedron
     /// (see [`origin_weights`](Self::origin_weights)), or when
     /// [`refine`](Self::refine) declines.
@@ -1289,7 +1289,7 @@ mod tests {
         assert!((s.total(0b0111) - a).abs() < 1e-12 * a);
     }
 
-    /// The triangle of `mid_sets` seed 8554 (see `regrow`): a needle's edge
+    /// The needle's triangle of `regrow`'s documentation: an edge
     /// of K 5.55e-5 from the origin and a vertex 1.3e5 away whose weight in
     /// the nearest point is about 1e-16.
     #[test]

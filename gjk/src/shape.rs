@@ -81,9 +81,8 @@ pub(crate) const SINGLE_MIN_VERTICES: usize = 16;
 
 /// Shapes with this many vertices or more keep the exact block search under
 /// [`Precision::Single`](crate::Precision::Single): around here it catches
-/// up with the f32 scan of every vertex, and beyond it is faster (measured
-/// A/B on round and box-shaped clouds, cold: 0.86–1.01× the f32 scan at
-/// 1 024 vertices, 1.24–1.26× at 2 048, 2.9–5× at 16 384 to 100 000).
+/// up with the f32 scan of every vertex on round and box-shaped clouds
+/// (cold), and beyond it is faster, by more the larger the set.
 pub(crate) const SINGLE_MAX_VERTICES: usize = 1024;
 
 /// The f32 copy of a shape's scan arrays.
@@ -158,9 +157,8 @@ impl Convex {
     ///
     /// Sets of 512 vertices or more also get an index for the support
     /// search: the vertices sorted into blocks of nearby points (a copy,
-    /// 28 bytes a vertex), built in O(n log n): about 15 ms for 100 000
-    /// vertices, against 2 ms without it, measured on this project's
-    /// 2-core machine.
+    /// 28 bytes a vertex), built in O(n log n), which makes building a large
+    /// shape several times slower than without it.
     ///
     /// # Errors
     /// [`Error::EmptyVertices`] for no vertices, [`Error::TooManyVertices`] past
@@ -574,8 +572,8 @@ impl SupportSearch {
         let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(xs, ys, zs, len)));
         // The f32 scan only where the exact search is the portable scan of
         // every vertex: against the AVX2 scan, the cube map and the block
-        // search it is slower at every size measured (0.86× at 16 vertices,
-        // 0.4× at 512, docs/speed-accuracy.md), and `Single` then takes the
+        // search it is slower at every size measured (docs/speed-accuracy.md),
+        // and `Single` then takes the
         // exact search. Indices ride in i32 lanes in the f32 scan.
         let single =
             if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
@@ -822,7 +820,7 @@ pub(crate) fn scan_top(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> 
         }
     }
     // Through u32: the index is exact and small, and the unsigned 64-bit
-    // conversion costs a dozen instructions without AVX-512.
+    // conversion takes a sequence of instructions without AVX-512.
     let mut idx = top_i as u32 as usize;
     for i in n - n % LANES..n {
         let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
@@ -853,15 +851,15 @@ fn scan_few(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize
     (top, idx)
 }
 
-/// Sets with fewer vertices keep the scan. Measured on the paper's family
-/// (`paper_compare`, one run each way): with the map from 32 vertices, pairs
-/// with its 40- to 60-vertex polytopes took up to 10 % longer (a query's
-/// directions cluster at face normals, where a cell lists a whole face) and
-/// the 100-vertex pairs 12 % less; from 64, only the latter.
+/// Sets with fewer vertices keep the scan. On the paper's family
+/// (`paper_compare`), the map from 32 vertices slowed the pairs of its 40- to
+/// 60-vertex polytopes (a query's directions cluster at face normals, where
+/// a cell lists a whole face) while it sped up the 100-vertex pairs; from
+/// 64, only the latter remains.
 pub(crate) const CONES_MIN_VERTICES: usize = 64;
 
 /// Sets of this many vertices or more keep the block search: the map's
-/// construction grows with the vertices (about 17 ms at 4 096).
+/// construction grows with the vertices.
 pub(crate) const CONES_MAX_VERTICES: usize = 4096;
 
 /// Whether `kind` is the AVX2 scan.
@@ -901,7 +899,7 @@ fn scan_kind() -> Kind {
 /// [`scan_top`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
 /// lanes, so the two compare-and-select chains overlap, and the comparison
 /// mask used as it is (the compiler's own vectorisation of [`scan_top`] spends
-/// five instructions per step converting it to booleans and back). Dot
+/// instructions on every step converting it to booleans and back). Dot
 /// products are fused multiply-adds, so they may differ from [`scan_top`]'s in
 /// the last bit; either vertex of such a near-tie is a valid support point.
 #[cfg(target_arch = "x86_64")]
@@ -976,7 +974,7 @@ pub(crate) unsafe fn scan_avx2_top(
     let mut top = _mm256_cvtsd_f64(v);
     let top_i = _mm256_cvtsd_f64(ix);
     // Through u32: the index is exact and small, and the unsigned 64-bit
-    // conversion costs a dozen instructions without AVX-512.
+    // conversion takes a sequence of instructions without AVX-512.
     let mut idx = top_i as u32 as usize;
     for i in full..n {
         let dot = zs[i].mul_add(d.z, ys[i].mul_add(d.y, xs[i] * d.x));
@@ -1055,7 +1053,8 @@ unsafe fn scan_avx2(c: &Convex, d: &Vector3<f64>) -> usize {
         }
     };
     // The other steps two at a time, an odd one out first: one loop test and
-    // two counter updates for 16 vertices (about 1 % of a family query).
+    // two counter updates for 16 vertices, a share of a small query that
+    // shows.
     let mut i = 8;
     if n.is_multiple_of(16) {
         take(i, _mm256_set1_epi64x(8));

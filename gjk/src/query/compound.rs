@@ -60,10 +60,11 @@ pub(super) fn axis_gap(
 /// With the answer, the interval width beyond which it counts as stuck (see
 /// [`second_opinion`](super::recovery::second_opinion)).
 ///
-/// Run out of line in the query's compiled form (see [`distance_avx2`](super::distance_avx2)): a
-/// function of its own is compiled for the baseline CPU unless it carries
-/// the target features itself, and the piece pairs' runs, inlined in it,
-/// took 12 % more instructions in SSE2 code (the Section 8 union, warm).
+/// Run out of line in the query's compiled form (see
+/// [`distance_avx2`](super::distance_avx2)): a function of its own is
+/// compiled for the baseline CPU unless it carries the target features
+/// itself, and the piece pairs' runs, inlined in it, take more instructions
+/// in SSE2 code.
 #[inline(always)]
 pub(super) fn search_compound<const AVX2: bool>(
     simplex: &mut Simplex,

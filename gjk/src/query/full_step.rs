@@ -100,10 +100,10 @@ impl ConvexPair<'_> {
             // K, v's error along the edge (ε times its length) can outweigh
             // v itself in the support search, and on a face of K normal to
             // v, whose points all tie, it alone picks the support point: a
-            // needle of length 1.7 touching a lattice's face cycled between
-            // two such points, each step level, and ended at 4.2e-10 against
-            // a truth below 1.6e-17 (mid_sets seed 8593, pair 1844). The
-            // refined v picks the point a step in exact arithmetic would.
+            // needle touching a lattice's face cycled between two such
+            // points, each step level, and ended far above its distance.
+            // The refined v picks the point a step in exact arithmetic
+            // would.
             if !tried.refined
                 && !it.repeat
                 && matches!(state.previous, Some((_, previous_v2)) if v2 >= previous_v2)
@@ -247,8 +247,8 @@ impl ConvexPair<'_> {
             // Converged only where step (5) below would end the run
             // too: (6.2) alone holds for a |v| up to √ε·D off, which
             // a run without the cap goes on to remove (nearly parallel
-            // edges 6.19e-6 apart, capped at 2 iterations, stopped at
-            // 6.23e-6 called converged).
+            // edges capped at two iterations were called converged short
+            // of their distance).
             let tight = norm - lower <= 4.0 * stop_d;
             let status = if it.paper_met && tight {
                 Status::Converged
@@ -272,9 +272,8 @@ impl ConvexPair<'_> {
     /// points, size 5e5, 1.5e-3 from a disk), v's round-off, times
     /// the points' distance, picks a support point that the next
     /// subalgorithm drops: the step is level, its refined v leads
-    /// on, and the next step descends by a few per cent. Counted
-    /// over the whole run, four such pairs of steps ended it at
-    /// 1.548e-3, the truth 1.5335e-3 (mid_sets seed 8574, pair 7841).
+    /// on, and the next step descends. Counted over the whole run,
+    /// four such pairs of steps ended it short of its distance.
     /// Whether the step was taken (the support point pushed).
     #[inline(always)]
     fn take_descent_step<const AVX2: bool>(
@@ -384,11 +383,11 @@ impl ConvexPair<'_> {
         // for a v that is off by up to √ε·D) and refinement is left,
         // or unless the interval is still wider than the tolerance:
         // near contact (6.2) holds for a v up to √ε·D off, and a
-        // descent too small to show through v's round-off (|v| 1e9
-        // times below |y|) stops the steps there. A cluster touching
-        // a lattice surface ended so at 1.6e-13 in [0, 1.6e-13], the
-        // truth 2e-17 (mid_sets seed 8526, pair 2624); the Backup
-        // Procedure's subset leads on to it.
+        // descent too small to show through v's round-off (|v| far
+        // below |y|) stops the steps there. A cluster touching a
+        // lattice surface ended so with an interval far wider than the
+        // tolerance; the Backup Procedure's subset leads on to the
+        // distance.
         let tight = it.norm - it.lower <= 4.0 * tolerance.stop_d;
         if refined_solution.is_none() && (tried.by_backup || (it.paper_met && !it.repeat && tight))
         {
@@ -409,10 +408,9 @@ impl ConvexPair<'_> {
                 // Step (6): redo v_k with the Backup Procedure. Its v
                 // comes from the same kind of cofactors, so it may be
                 // refined once too: a cluster against a box surface
-                // (mid_sets seed 8531, pair 5372) ended at 4.7e-9 in
-                // [0, 4.7e-9] on the Backup Procedure's thin triangle,
-                // the support point repeating one of its vertices, while
-                // the refined v leads on to the truth, 4.8e-11.
+                // ended far from its distance on the Backup Procedure's
+                // thin triangle, the support point repeating one of its
+                // vertices, while the refined v leads on to it.
                 *solution = simplex.backup();
                 tried.by_backup = true;
                 tried.refined = false;

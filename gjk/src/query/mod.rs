@@ -50,10 +50,9 @@ impl Workspace {
 thread_local! {
     /// [`distance`]'s workspace, one a thread, lent out for each query. A
     /// fresh one would cost each query the zeroing and moving of its 800
-    /// bytes: 125 instructions, 4 % of a separated query of the paper's
-    /// family (callgrind). Boxed, so that lending it moves a pointer, and the
-    /// answer is returned outside the thread-local's closure, which would
-    /// copy it twice more.
+    /// bytes, a visible share of a small query. Boxed, so that lending it
+    /// moves a pointer, and the answer is returned outside the
+    /// thread-local's closure, which would copy it twice more.
     static SPARE: Cell<Option<Box<Workspace>>> = const { Cell::new(None) };
 }
 
@@ -168,8 +167,8 @@ fn distance_base(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer,
 /// [`distance_body`] compiled for AVX2 and FMA: the same operations, each
 /// rounded the same way (Rust never fuses a multiply and an add on its own,
 /// and `mul_add` is exact either way), so the same answer bit for bit, in
-/// fewer instructions (three-operand forms, wider moves): 5 to 9 % less
-/// time on the paper's family, measured.
+/// fewer instructions (three-operand forms, wider moves), hence in less
+/// time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn distance_avx2(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {

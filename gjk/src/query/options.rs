@@ -42,8 +42,8 @@ pub enum Precision {
     /// portable scan of every vertex. Everywhere else the exact search is
     /// used, since it is the faster: the AVX2 scan, the cube map of 64 to
     /// 4 095 vertices and the block search all beat the f32 scan of every
-    /// vertex (measured: 0.86× at 16 vertices, 0.58× at 256, 0.4× at 512;
-    /// `docs/speed-accuracy.md`). Where the f32 scan is used, the support
+    /// vertex (`docs/speed-accuracy.md` has the figures). Where the f32
+    /// scan is used, the support
     /// point may fall short of the true one by 2⁻²⁰ of the shape's size, so
     /// the distance is exact to the tolerance plus about 1e-6 times the two
     /// sizes' sum, and the lower bound is lowered by that much. The f32 copy

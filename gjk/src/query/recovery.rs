@@ -11,9 +11,9 @@ use crate::johnson::Simplex;
 /// A query that ended with an interval wider than the tolerance (stuck,
 /// its support point tied between far points by `v`'s round-off), asked
 /// once more with the shapes swapped: B's frame rounds differently, and a
-/// needle along a prism's edge (`mid_sets` seed 8554, pair 164, vertex
-/// lists repeated) that stopped at 5.55e-5 of a truth below 1.6e-11 gives
-/// 1.5e-11 that way. Unions too: their piece pairs run the same way, and
+/// needle along a prism's edge (vertex lists repeated) that stopped far
+/// short of its distance reaches it that way. Unions too: their piece
+/// pairs run the same way, and
 /// the needle as a union's piece stopped where it did alone. Both answers
 /// are certified, so the nearer upper bound wins and the lower bounds
 /// combine. Cold, as a warm start names the pairs the other way round;
@@ -164,9 +164,9 @@ impl ConvexPair<'_> {
     /// The interval width so much beyond what the tolerance allows (100
     /// times [`tight_width`](Self::tight_width)) that a second opinion is worth a
     /// second run: a stuck run, not one that (6.2) ended a few round-offs
-    /// short. At 1 time that width, 4.5 % of the randomised sweep's runs
-    /// and 3 % of the paper's family's would be asked again; from 10 times
-    /// on, none of the family's.
+    /// short. At that width itself, a few per cent of the runs of the
+    /// randomised sweep and of the paper's family would be asked again;
+    /// from ten times on, none of the family's.
     #[inline(always)]
     pub(super) fn stuck_width(&self, tolerance: f64) -> f64 {
         100.0 * self.tight_width(tolerance)

@@ -49,16 +49,16 @@ pub struct Convex {
     zs: Vec<f64>,
     /// How the support point is found: a scan in general, a closed form for
     /// the shapes whose support function is one.
-    kind: Kind,
+    kind: SupportKind,
     /// The scanned vertices again in f32, divided by `size` so that every
     /// coordinate lies in [-1, 1] (no overflow, whatever the shape's scale),
     /// for [`Precision::Single`](crate::Precision::Single). None for shapes
     /// that gain nothing from it: closed-form supports, fewer than
     /// [`SINGLE_MIN_VERTICES`] vertices, and [`SINGLE_MAX_VERTICES`] or more.
-    single: Option<Box<Single>>,
-    /// The block search's reordered copy, for [`Kind::Blocks`].
+    single: Option<Box<F32Copy>>,
+    /// The block search's reordered copy, for [`SupportKind::Blocks`].
     blocks: Option<Box<Blocks>>,
-    /// The cube map of candidate lists, for [`Kind::Cones`].
+    /// The cube map of candidate lists, for [`SupportKind::Cones`].
     cones: Option<Box<Cones>>,
 }
 
@@ -87,13 +87,13 @@ pub(crate) const SINGLE_MAX_VERTICES: usize = 1024;
 
 /// The f32 copy of a shape's scan arrays.
 #[derive(Clone, Debug, PartialEq)]
-struct Single {
+struct F32Copy {
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
 }
 
-impl Single {
+impl F32Copy {
     /// The copy of centroid-relative arrays of a set of size `size`, each
     /// coordinate divided by it; `None` where that cannot be done exactly
     /// enough or the indices would not fit the scan's i32 lanes.
@@ -107,7 +107,7 @@ impl Single {
         }
         let inv = 1.0 / size;
         let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
-        Some(Box::new(Single {
+        Some(Box::new(F32Copy {
             xs: to32(xs),
             ys: to32(ys),
             zs: to32(zs),
@@ -124,7 +124,7 @@ pub(crate) const SINGLE_SLACK: f64 = 1.0 / (1u64 << 20) as f64;
 
 /// The support function's form, decided once from the vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
+enum SupportKind {
     /// One vertex: a sphere's core.
     Point,
     /// Eight vertices `(±h.x, ±h.y, ±h.z)` about the centroid, vertex `i`
@@ -139,12 +139,12 @@ enum Kind {
     /// AVX2 and FMA (checked once, here): the vector scan, called directly.
     #[cfg(target_arch = "x86_64")]
     Avx2,
-    /// As [`Kind::Avx2`] on a CPU without them: the portable scan.
+    /// As [`SupportKind::Avx2`] on a CPU without them: the portable scan.
     Scan,
     /// [`CONES_MIN_VERTICES`] to [`CONES_MAX_VERTICES`] (less one): the cube map's few candidates
     /// for the direction (see [`crate::cones`]), scanned with the arithmetic
     /// of the scan the shape would otherwise use (fused when `fused`, the
-    /// [`Kind::Avx2`] scan's), so the same vertex; that scan for the
+    /// [`SupportKind::Avx2`] scan's), so the same vertex; that scan for the
     /// directions the map declines.
     Cones { fused: bool },
     /// Larger sets: the block search, exact and the scan's own choice, which
@@ -296,25 +296,25 @@ impl Convex {
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
         match self.kind {
             // A sphere's core: nothing to scan.
-            Kind::Point => 0,
+            SupportKind::Point => 0,
             // A box's support is its direction's sign pattern. A zero
             // component is a tie between the two faces, given to the lower
             // index as the scan would.
-            Kind::Box => {
+            SupportKind::Box => {
                 usize::from(d.x > 0.0) | usize::from(d.y > 0.0) << 1 | usize::from(d.z > 0.0) << 2
             }
             // A handful of products: cheaper here than a call.
-            Kind::Few => scan_few(&self.xs, &self.ys, &self.zs, d).1,
+            SupportKind::Few => scan_few(&self.xs, &self.ys, &self.zs, d).1,
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: Kind::Avx2 is only chosen on a CPU with AVX2 and FMA.
-            Kind::Avx2 => unsafe { scan_avx2(self, d) },
-            Kind::Scan => self.scan_portable(d),
-            Kind::Cones { fused } => self.cones_index(d, fused),
-            Kind::Blocks => self.search_index(d),
+            // SAFETY: SupportKind::Avx2 is only chosen on a CPU with AVX2 and FMA.
+            SupportKind::Avx2 => unsafe { scan_avx2(self, d) },
+            SupportKind::Scan => self.scan_portable(d),
+            SupportKind::Cones { fused } => self.cones_index(d, fused),
+            SupportKind::Blocks => self.search_index(d),
         }
     }
 
-    /// [`support_index`](Self::support_index) for [`Kind::Cones`]: the
+    /// [`support_index`](Self::support_index) for [`SupportKind::Cones`]: the
     /// direction's candidates with the scan's arithmetic, or for a direction
     /// the map declines, the scan itself.
     #[inline(always)]
@@ -325,7 +325,7 @@ impl Convex {
         #[cfg(target_arch = "x86_64")]
         if fused {
             // SAFETY: `fused` is only set on a CPU with AVX2 and FMA (it
-            // replaces Kind::Avx2).
+            // replaces SupportKind::Avx2).
             return unsafe { cones_fused(self, cones, d) };
         }
         let _ = fused;
@@ -335,7 +335,7 @@ impl Convex {
         }
     }
 
-    /// [`scan_top`]'s index for [`Kind::Scan`], out of line: the query
+    /// [`scan_top`]'s index for [`SupportKind::Scan`], out of line: the query
     /// inlines only the arms that need no call.
     #[inline(never)]
     fn scan_portable(&self, d: &Vector3<f64>) -> usize {
@@ -534,8 +534,8 @@ fn largest_length(xs: &[f64], ys: &[f64], zs: &[f64], widest: f64) -> Result<f64
 /// How a shape's support point is found, with the copies of its vertices
 /// that the search needs.
 struct SupportSearch {
-    kind: Kind,
-    single: Option<Box<Single>>,
+    kind: SupportKind,
+    single: Option<Box<F32Copy>>,
     blocks: Option<Box<Blocks>>,
     cones: Option<Box<Cones>>,
 }
@@ -545,11 +545,11 @@ impl SupportSearch {
     /// scan arrays.
     fn choose(xs: &[f64], ys: &[f64], zs: &[f64], len: usize, size: f64) -> Self {
         let base = if len == 1 {
-            Kind::Point
+            SupportKind::Point
         } else if is_box(xs, ys, zs) {
-            Kind::Box
+            SupportKind::Box
         } else if len < 8 {
-            Kind::Few
+            SupportKind::Few
         } else {
             scan_kind()
         };
@@ -557,30 +557,31 @@ impl SupportSearch {
         // cube map, unless their size is outside the range its margins are
         // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
         // the block search.
-        let scanned = base == Kind::Scan || is_avx2(base);
+        let scanned = base == SupportKind::Scan || is_avx2(base);
         let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
             Cones::new(xs, ys, zs, len, size).map(Box::new)
         } else {
             None
         };
         let kind = match (&cones, base) {
-            (Some(_), Kind::Scan) => Kind::Cones { fused: false },
-            (Some(_), _) => Kind::Cones { fused: true },
-            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => Kind::Blocks,
+            (Some(_), SupportKind::Scan) => SupportKind::Cones { fused: false },
+            (Some(_), _) => SupportKind::Cones { fused: true },
+            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => SupportKind::Blocks,
             (None, other) => other,
         };
-        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(xs, ys, zs, len)));
+        let blocks = (kind == SupportKind::Blocks).then(|| Box::new(Blocks::new(xs, ys, zs, len)));
         // The f32 scan only where the exact search is the portable scan of
         // every vertex: against the AVX2 scan, the cube map and the block
         // search it is slower at every size measured (docs/speed-accuracy.md),
         // and `Single` then takes the
         // exact search. Indices ride in i32 lanes in the f32 scan.
-        let single =
-            if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
-                Single::of(xs, ys, zs, size)
-            } else {
-                None
-            };
+        let single = if kind == SupportKind::Scan
+            && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
+        {
+            F32Copy::of(xs, ys, zs, size)
+        } else {
+            None
+        };
         SupportSearch {
             kind,
             single,
@@ -863,9 +864,9 @@ pub(crate) const CONES_MIN_VERTICES: usize = 64;
 pub(crate) const CONES_MAX_VERTICES: usize = 4096;
 
 /// Whether `kind` is the AVX2 scan.
-fn is_avx2(kind: Kind) -> bool {
+fn is_avx2(kind: SupportKind) -> bool {
     #[cfg(target_arch = "x86_64")]
-    if kind == Kind::Avx2 {
+    if kind == SupportKind::Avx2 {
         return true;
     }
     let _ = kind;
@@ -886,14 +887,14 @@ fn cones_fused(c: &Convex, cones: &Cones, d: &Vector3<f64>) -> usize {
 }
 
 /// The kind of a set of 8 vertices or more that the block search leaves to
-/// the scan: [`Kind::Avx2`] if this CPU has AVX2 and FMA, the vector scan's
-/// requirements, else [`Kind::Scan`].
-fn scan_kind() -> Kind {
+/// the scan: [`SupportKind::Avx2`] if this CPU has AVX2 and FMA, the vector scan's
+/// requirements, else [`SupportKind::Scan`].
+fn scan_kind() -> SupportKind {
     #[cfg(target_arch = "x86_64")]
     if crate::has_avx2_fma() {
-        return Kind::Avx2;
+        return SupportKind::Avx2;
     }
-    Kind::Scan
+    SupportKind::Scan
 }
 
 /// [`scan_top`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
@@ -1224,7 +1225,7 @@ pub(crate) mod tests {
     use super::*;
 
     /// The support index by brute force: the first vertex of largest `v·d`.
-    fn brute(c: &Convex, d: &Vector3<f64>) -> usize {
+    fn brute_force_support(c: &Convex, d: &Vector3<f64>) -> usize {
         let mut best = 0;
         for i in 1..c.len() {
             if c.local(i).dot(d) > c.local(best).dot(d) {
@@ -1243,12 +1244,12 @@ pub(crate) mod tests {
             Vector3::new(0.5, 2.0, 0.0),
         ] {
             let b = Convex::cuboid(half, 0.1).unwrap();
-            assert_eq!(b.kind, Kind::Box);
+            assert_eq!(b.kind, SupportKind::Box);
             for &x in &comps {
                 for &y in &comps {
                     for &z in &comps {
                         let d = Vector3::new(x, y, z);
-                        let (i, j) = (b.support_index(&d), brute(&b, &d));
+                        let (i, j) = (b.support_index(&d), brute_force_support(&b, &d));
                         assert_eq!(b.local(i).dot(&d), b.local(j).dot(&d), "{d:?}");
                         // A flat axis, or a component lost in the sum,
                         // ties the two faces: either is a support point.
@@ -1277,9 +1278,9 @@ pub(crate) mod tests {
         for (verts, kind) in [
             (swapped, scan_kind()),
             (skew, scan_kind()),
-            (shifted, Kind::Box),
-            (b.vertices()[..1].to_vec(), Kind::Point),
-            (b.vertices()[..2].to_vec(), Kind::Few),
+            (shifted, SupportKind::Box),
+            (b.vertices()[..1].to_vec(), SupportKind::Point),
+            (b.vertices()[..2].to_vec(), SupportKind::Few),
         ] {
             let c = Convex::new(verts, 0.0).unwrap();
             assert_eq!(c.kind, kind);
@@ -1288,7 +1289,11 @@ pub(crate) mod tests {
                 Vector3::new(-1.0, 0.0, 0.0),
                 Vector3::new(0.0, 0.0, 0.0),
             ] {
-                assert_eq!(c.support_index(&d), brute(&c, &d), "{kind:?} {d:?}");
+                assert_eq!(
+                    c.support_index(&d),
+                    brute_force_support(&c, &d),
+                    "{kind:?} {d:?}"
+                );
             }
         }
     }
@@ -1396,12 +1401,12 @@ pub(crate) mod tests {
                     // the portable scan; built here on any CPU, so that the
                     // f32 path is tested everywhere.
                     if c.single.is_none() {
-                        c.single = Single::of(&c.xs, &c.ys, &c.zs, c.size);
+                        c.single = F32Copy::of(&c.xs, &c.ys, &c.zs, c.size);
                     }
                     assert!(c.has_single(), "n {n} scale {scale:e}");
                     for k in 0..64 {
                         let d = direction(&mut rng, k, flat, scale);
-                        let best = c.local(brute(&c, &d)).dot(&d);
+                        let best = c.local(brute_force_support(&c, &d)).dot(&d);
                         let slack = SINGLE_SLACK * c.size() * d.norm();
                         for i in single_picks(&c, &d) {
                             assert!(i < c.len());
@@ -1437,7 +1442,7 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
-        ring.single = Single::of(&ring.xs, &ring.ys, &ring.zs, ring.size);
+        ring.single = F32Copy::of(&ring.xs, &ring.ys, &ring.zs, ring.size);
         assert!(ring.has_single());
         for d in [
             Vector3::new(1.7e308, 3e307, -2e307),
@@ -1470,11 +1475,14 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
-        assert!(matches!(large.kind, Kind::Blocks | Kind::Cones { .. }));
+        assert!(matches!(
+            large.kind,
+            SupportKind::Blocks | SupportKind::Cones { .. }
+        ));
         for c in [small, cube, large] {
             assert!(!c.has_single());
             let d = Vector3::new(0.3, -0.8, 0.1);
-            assert_eq!(c.support_index_single(&d), brute(&c, &d));
+            assert_eq!(c.support_index_single(&d), brute_force_support(&c, &d));
         }
     }
 
@@ -1542,7 +1550,7 @@ pub(crate) mod tests {
                     })
                     .collect();
                 let c = Convex::new(pts, 0.0).unwrap();
-                if matches!(c.kind, Kind::Box | Kind::Point) {
+                if matches!(c.kind, SupportKind::Box | SupportKind::Point) {
                     continue;
                 }
                 for k in 0..40 {

@@ -115,18 +115,17 @@ impl WarmStart {
         }
     }
 
-    /// The kept simplexes: the nearest pair's (possibly empty), then the
-    /// runner-up's if any.
-    #[inline]
-    pub(super) fn kept_simplexes(&self) -> impl Iterator<Item = &PieceSimplex> {
-        std::iter::once(&self.first).chain((self.second.len > 0).then_some(&self.second))
-    }
-
-    /// The index pairs kept for the piece pair `pieces`, if any.
-    #[inline]
+    /// The index pairs kept for the piece pair `pieces`, if any: the
+    /// nearest pair's simplex, else the runner-up's. A plain loop over the
+    /// two: as an iterator chain, the query's hot path kept the iterator's
+    /// machinery once this file became a codegen unit of its own.
+    #[inline(always)]
     pub(super) fn for_pieces(&self, pieces: [u32; 2]) -> Option<&[[u32; 2]]> {
-        self.kept_simplexes()
-            .find(|kept| kept.len > 0 && kept.pieces == pieces)
-            .map(|kept| kept.pairs())
+        for kept in [&self.first, &self.second] {
+            if kept.len > 0 && kept.pieces == pieces {
+                return Some(kept.pairs());
+            }
+        }
+        None
     }
 }

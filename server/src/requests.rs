@@ -638,7 +638,7 @@ mod tests {
         }
     }
 
-    /// The input `fuzz/` found (`gjk/tests/fuzz_regressions.rs`), through
+    /// The input `fuzz/` found (`testkit/tests/fuzz_regressions.rs`), through
     /// the server: a warm query across poses with 1e108 and 1e100
     /// coordinates. It used to panic inside gjk (answered `Internal` by the
     /// serving loop's catch_unwind); now it is answered with ordered bounds.
@@ -698,7 +698,7 @@ mod tests {
         // minimum over vertex-triangle and edge-edge distances evaluated in
         // 60-digit arithmetic (mpmath). This test pinned 7e100..8e100 for
         // both until the run was scaled: the first answer was then spoilt by
-        // overflowing cofactors. (The f64 brute force of `bench::reference`
+        // overflowing cofactors. (The f64 brute force of `gjkd_testkit::reference`
         // is off by 1e-5 here, in world coordinates of 1e108.)
         let truths = [3.5e100, 7.582268067529549e100];
         for ((pa, pb), truth) in [(p, p), (p, turned)].into_iter().zip(truths) {

@@ -27,7 +27,7 @@ if [ "${GJKD_PY_INSTALL:-develop}" = pip ]; then
   "$venv/bin/python" -m pip install --quiet "$here"
 else
   echo "== maturin develop (dev profile, shared target directory)"
-  (cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet --skip-install)
+  (cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet)
 fi
 echo "== pytest"
 cd "$here"

@@ -54,6 +54,10 @@ class ErrorCode(enum.IntEnum):
     """The server holds as many objects as it accepts."""
     INTERNAL = 19
     """The server failed in a way that is its own fault; it keeps serving."""
+    STORAGE_FULL = 20
+    """The server's disk has no room to store a registration or removal: the
+    change was not made. Queries and pose updates are still served; the same
+    call succeeds once there is room again, without a server restart."""
 
 
 class Status(enum.IntEnum):

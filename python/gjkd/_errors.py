@@ -74,7 +74,8 @@ class NotFound(Error, LookupError):
 class Refused(Error):
     """The server refused a valid request: another client's object
     (``NOT_OWNER``), a read-only scene object, a taken name, a full server
-    (of objects, or of clients), or its own failure (``INTERNAL``)."""
+    (of objects, or of clients), a full disk (``STORAGE_FULL``: retry once
+    there is room), or its own failure (``INTERNAL``)."""
 
 
 class ProtocolError(Error):

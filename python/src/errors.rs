@@ -53,9 +53,12 @@ impl Kind {
         use ErrorCode as E;
         match code {
             E::UnknownObject | E::UnknownName => Kind::NotFound,
-            E::NotOwner | E::ReadOnly | E::NameTaken | E::TooManyObjects | E::Internal => {
-                Kind::Refused
-            }
+            E::NotOwner
+            | E::ReadOnly
+            | E::NameTaken
+            | E::TooManyObjects
+            | E::Internal
+            | E::StorageFull => Kind::Refused,
             E::Ok => Kind::Other,
             _ => Kind::InvalidInput,
         }

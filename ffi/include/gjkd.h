@@ -218,7 +218,7 @@ typedef uint32_t gjkd_precision;
 typedef struct gjkd_client gjkd_client;
 
 // What the server said about itself at the last (re)connection.
-typedef struct gjkd_server_info {
+typedef struct gjkd_info {
   // The server's protocol version (`GJKD_PROTOCOL_VERSION`).
   uint32_t protocol;
   // Wait strategy: 1 spin, 2 block, 3 adaptive.
@@ -235,10 +235,10 @@ typedef struct gjkd_server_info {
   uint64_t max_objects;
   // Process id of the server.
   uint64_t pid;
-} gjkd_server_info;
+} gjkd_info;
 
 // The server's counters.
-typedef struct gjkd_stats {
+typedef struct gjkd_server_stats {
   // Objects held.
   uint64_t objects;
   // Query requests answered.
@@ -261,7 +261,7 @@ typedef struct gjkd_stats {
   uint64_t clients;
   // Writes of the server's state that failed.
   uint64_t persist_errors;
-} gjkd_stats;
+} gjkd_server_stats;
 
 // Options of a query. Start from `gjkd_query_options_default()`; passing
 // NULL where options are asked for means the defaults.
@@ -440,7 +440,7 @@ enum gjkd_status gjkd_close(struct gjkd_client *client);
 //
 // # Safety
 // `client` is NULL or a live handle; `out_info` is NULL or writable.
-enum gjkd_status gjkd_server_info(struct gjkd_client *client, struct gjkd_server_info *out_info);
+enum gjkd_status gjkd_server_info(struct gjkd_client *client, struct gjkd_info *out_info);
 
 // The server's counters, into `*out_stats` (one round trip).
 //
@@ -449,7 +449,7 @@ enum gjkd_status gjkd_server_info(struct gjkd_client *client, struct gjkd_server
 //
 // # Safety
 // `client` is NULL or a live handle; `out_stats` is NULL or writable.
-enum gjkd_status gjkd_stats(struct gjkd_client *client, struct gjkd_stats *out_stats);
+enum gjkd_status gjkd_stats(struct gjkd_client *client, struct gjkd_server_stats *out_stats);
 
 // The message of the last call on this thread that failed, in English
 // (`""` if none failed yet). Owned by the library: valid until the next

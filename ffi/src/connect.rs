@@ -10,7 +10,7 @@ use rust_client::{Client, ErrorCode};
 use crate::args::{opt_str, out};
 use crate::handle::{gjkd_client, with_client};
 use crate::status::{self, Failure, gjkd_status, guard};
-use crate::types::{gjkd_query_options, gjkd_server_info, gjkd_stats};
+use crate::types::{gjkd_info, gjkd_query_options, gjkd_server_stats};
 
 /// A positive, finite number of seconds.
 fn seconds(s: f64, what: &str) -> Result<Duration, Failure> {
@@ -107,7 +107,7 @@ pub unsafe extern "C" fn gjkd_close(client: *mut gjkd_client) -> gjkd_status {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn gjkd_server_info(
     client: *mut gjkd_client,
-    out_info: *mut gjkd_server_info,
+    out_info: *mut gjkd_info,
 ) -> gjkd_status {
     guard("gjkd_server_info", || {
         // SAFETY: the caller's promises.
@@ -137,7 +137,7 @@ pub unsafe extern "C" fn gjkd_server_info(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn gjkd_stats(
     client: *mut gjkd_client,
-    out_stats: *mut gjkd_stats,
+    out_stats: *mut gjkd_server_stats,
 ) -> gjkd_status {
     guard("gjkd_stats", || {
         // SAFETY: the caller's promises.

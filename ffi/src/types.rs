@@ -343,7 +343,7 @@ pub struct gjkd_results {
 /// What the server said about itself at the last (re)connection.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct gjkd_server_info {
+pub struct gjkd_info {
     /// The server's protocol version (`GJKD_PROTOCOL_VERSION`).
     pub protocol: u32,
     /// Wait strategy: 1 spin, 2 block, 3 adaptive.
@@ -362,9 +362,9 @@ pub struct gjkd_server_info {
     pub pid: u64,
 }
 
-impl From<ServerInfo> for gjkd_server_info {
+impl From<ServerInfo> for gjkd_info {
     fn from(i: ServerInfo) -> Self {
-        gjkd_server_info {
+        gjkd_info {
             protocol: i.protocol,
             wait: i.wait,
             max_batch: i.max_batch,
@@ -380,7 +380,7 @@ impl From<ServerInfo> for gjkd_server_info {
 /// The server's counters.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct gjkd_stats {
+pub struct gjkd_server_stats {
     /// Objects held.
     pub objects: u64,
     /// Query requests answered.
@@ -405,9 +405,9 @@ pub struct gjkd_stats {
     pub persist_errors: u64,
 }
 
-impl From<ServerStats> for gjkd_stats {
+impl From<ServerStats> for gjkd_server_stats {
     fn from(s: ServerStats) -> Self {
-        gjkd_stats {
+        gjkd_server_stats {
             objects: s.objects,
             requests: s.requests,
             items: s.items,

@@ -40,7 +40,7 @@ static gjkd_pose at(double x, double y, double z) {
 int main(int argc, char **argv) {
     const char *service = argc > 1 ? argv[1] : "gjkd";
     gjkd_client *client = NULL;
-    check(gjkd_connect(service, 1.0, 5.0, &client), "gjkd_connect");
+    check(gjkd_connect(service, 1.0, 10.0, &client), "gjkd_connect");
 
     /* Shapes, registered once; a box under a name others can look up. */
     const double half[3] = {1.0, 1.0, 1.0};

@@ -27,7 +27,7 @@ void expect(const char *what, double got, double want) {
 
 int main(int argc, char **argv) {
     try {
-        gjkd::Client client(argc > 1 ? argv[1] : "gjkd", 1.0, 5.0);
+        gjkd::Client client(argc > 1 ? argv[1] : "gjkd", 1.0, 10.0);
 
         // Shapes, registered once, at their initial poses.
         gjkd::Id box = client.register_box({1, 1, 1}, 0.0, gjkd::identity(), "basic-cpp-box");

@@ -1,0 +1,94 @@
+//! Building C and C++ programs against this crate's static library, with
+//! the system compiler (`$CC` / `$CXX`, default `cc` / `c++`).
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// `target/<profile>`, where cargo put `libgjkd_c.a` for this test run.
+pub fn profile_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("test executable lives in target/<profile>/deps")
+        .to_path_buf()
+}
+
+/// Where the programs are built: under `target/<profile>`, out of the
+/// source tree.
+pub fn build_dir() -> PathBuf {
+    let dir = profile_dir().join("gjkd-c-programs");
+    std::fs::create_dir_all(&dir).expect("create the build folder");
+    dir
+}
+
+/// The crate's folder.
+pub fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The static library of this build. Cargo builds every crate type of the
+/// library before the tests, so it is there.
+pub fn static_lib() -> PathBuf {
+    let lib = profile_dir().join("libgjkd_c.a");
+    assert!(lib.exists(), "{} missing: cargo build -p gjkd-c", lib.display());
+    lib
+}
+
+/// The system libraries a Rust static library needs (rustc's
+/// `--print native-static-libs` on Linux).
+pub const NATIVE_LIBS: [&str; 7] = ["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"];
+
+/// Compiles `sources` (paths relative to the crate) into `name`, linked
+/// with the static library; C++ when `cxx`. Panics with the compiler's
+/// output on failure.
+pub fn compile(sources: &[&str], name: &str, cxx: bool) -> PathBuf {
+    let (var, default, std) = if cxx {
+        ("CXX", "c++", "-std=c++17")
+    } else {
+        ("CC", "cc", "-std=c99")
+    };
+    let compiler = std::env::var(var).unwrap_or_else(|_| default.into());
+    let exe = build_dir().join(name);
+    let mut cmd = Command::new(&compiler);
+    cmd.args([std, "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-g"])
+        .arg("-I")
+        .arg(crate_dir().join("include"));
+    for s in sources {
+        cmd.arg(crate_dir().join(s));
+    }
+    cmd.arg(static_lib()).args(NATIVE_LIBS).arg("-o").arg(&exe);
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("run the compiler `{compiler}`: {e}"));
+    assert!(
+        out.status.success(),
+        "{compiler} failed on {sources:?}:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    exe
+}
+
+/// Runs `exe` with `args`; its output, after checking it succeeded.
+pub fn run_ok(exe: &Path, args: &[&str]) -> String {
+    let out = run(exe, args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{} failed ({}):\n{stdout}\n{}",
+        exe.display(),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// Runs `exe` with `args`.
+pub fn run(exe: &Path, args: &[&str]) -> Output {
+    Command::new(exe)
+        .args(args)
+        .env_remove("IOX2_LOG_LEVEL")
+        .output()
+        .unwrap_or_else(|e| panic!("start {}: {e}", exe.display()))
+}

@@ -32,13 +32,25 @@ pub fn crate_dir() -> PathBuf {
 /// library before the tests, so it is there.
 pub fn static_lib() -> PathBuf {
     let lib = profile_dir().join("libgjkd_c.a");
-    assert!(lib.exists(), "{} missing: cargo build -p gjkd-c", lib.display());
+    assert!(
+        lib.exists(),
+        "{} missing: cargo build -p gjkd-c",
+        lib.display()
+    );
     lib
 }
 
 /// The system libraries a Rust static library needs (rustc's
 /// `--print native-static-libs` on Linux).
-pub const NATIVE_LIBS: [&str; 7] = ["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"];
+pub const NATIVE_LIBS: [&str; 7] = [
+    "-lgcc_s",
+    "-lutil",
+    "-lrt",
+    "-lpthread",
+    "-lm",
+    "-ldl",
+    "-lc",
+];
 
 /// Compiles `sources` (paths relative to the crate) into `name`, linked
 /// with the static library; C++ when `cxx`. Panics with the compiler's

@@ -39,7 +39,7 @@ fn install(dir: &Path) -> std::path::PathBuf {
     ok(Command::new("bash")
         .arg(common::crate_dir().join("install.sh"))
         .arg("--from")
-        .arg(common::profile_dir())
+        .arg(common::lib_dir())
         .arg(&prefix));
     for f in [
         "include/gjkd.h",

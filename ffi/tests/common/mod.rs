@@ -28,10 +28,22 @@ pub fn crate_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The static library of this build. Cargo builds every crate type of the
-/// library before the tests, so it is there.
+/// The folder holding this build's `libgjkd_c.a` and `libgjkd_c.so`.
+/// Cargo builds every crate type of the library before the tests, into
+/// `deps/` (it copies them up to `target/<profile>` only for a
+/// `cargo build` of the library itself).
+pub fn lib_dir() -> PathBuf {
+    let deps = profile_dir().join("deps");
+    if deps.join("libgjkd_c.a").exists() {
+        deps
+    } else {
+        profile_dir()
+    }
+}
+
+/// The static library of this build.
 pub fn static_lib() -> PathBuf {
-    let lib = profile_dir().join("libgjkd_c.a");
+    let lib = lib_dir().join("libgjkd_c.a");
     assert!(
         lib.exists(),
         "{} missing: cargo build -p gjkd-c",

@@ -215,3 +215,89 @@ pub fn status_name(raw: i32) -> &'static CStr {
         .and_then(|i| NAMES.get(i).copied())
         .unwrap_or(c"GJKD_ERR_UNKNOWN")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn message() -> String {
+        // SAFETY: last_message points to a live NUL-terminated string.
+        unsafe { CStr::from_ptr(last_message()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    #[test]
+    fn a_panic_is_caught_and_reported() {
+        let status = guard("gjkd_test", || panic!("boom {}", 7));
+        assert_eq!(status, GJKD_ERR_PANIC);
+        assert_eq!(message(), "gjkd_test: internal error: boom 7");
+        assert_eq!(last_code(), 0);
+    }
+
+    #[test]
+    fn a_failure_sets_message_and_code_and_success_leaves_them() {
+        let status = guard("gjkd_test", || {
+            Err(Failure::rejected(ErrorCode::NameTaken, "row 3: "))
+        });
+        assert_eq!(status, GJKD_ERR_REJECTED);
+        assert_eq!(
+            message(),
+            "gjkd_test: row 3: refused: name already taken (GJKD_CODE_NAME_TAKEN)"
+        );
+        assert_eq!(last_code(), ErrorCode::NameTaken.raw());
+        assert_eq!(guard("gjkd_other", || Ok(())), GJKD_OK);
+        assert_eq!(last_code(), ErrorCode::NameTaken.raw());
+        // A NUL inside a message cannot end it early.
+        guard("gjkd_test", || Err(Failure::invalid("a\0b")));
+        assert_eq!(message(), "gjkd_test: ab");
+        assert_eq!(last_code(), 0);
+    }
+
+    #[test]
+    fn client_errors_map_to_their_statuses() {
+        use std::time::Duration;
+        let cases = [
+            (ClientError::ServerGone("s".into()), GJKD_ERR_SERVER_GONE),
+            (
+                ClientError::Timeout(Duration::from_secs(1)),
+                GJKD_ERR_TIMEOUT,
+            ),
+            (ClientError::InvalidArgument("x"), GJKD_ERR_INVALID_ARGUMENT),
+            (ClientError::Protocol("p".into()), GJKD_ERR_PROTOCOL),
+            (
+                ClientError::VersionMismatch {
+                    service: "s".into(),
+                    server: 2,
+                    client: 1,
+                },
+                GJKD_ERR_VERSION_MISMATCH,
+            ),
+            (
+                ClientError::Incompatible {
+                    service: "s".into(),
+                    cause: "c".into(),
+                },
+                GJKD_ERR_INCOMPATIBLE,
+            ),
+            (
+                ClientError::PermissionDenied("s".into()),
+                GJKD_ERR_PERMISSION_DENIED,
+            ),
+            (
+                ClientError::TooManyClients("s".into()),
+                GJKD_ERR_TOO_MANY_CLIENTS,
+            ),
+            (ClientError::Ipc("i".into()), GJKD_ERR_IPC),
+        ];
+        for (e, want) in cases {
+            let words = e.to_string();
+            let f = Failure::from(e);
+            assert_eq!(f.status, want);
+            assert_eq!(f.message, words);
+            assert_eq!(f.code, 0);
+        }
+        let f = Failure::from(ClientError::Rejected(ErrorCode::UnknownObject));
+        assert_eq!((f.status, f.code), (GJKD_ERR_REJECTED, 1));
+    }
+}

@@ -5,6 +5,7 @@ use iceoryx2::config::Config;
 use iceoryx2::prelude::*;
 use iceoryx2::service::builder::event::EventOpenError;
 use iceoryx2::service::builder::request_response::RequestResponseOpenError;
+use iceoryx2::service::static_config::messaging_pattern::MessagingPattern;
 
 /// The classes of open failure that lead to different [`ClientError`]s.
 ///
@@ -93,6 +94,17 @@ pub(crate) enum NameTakenBy {
     },
 }
 
+/// Whether a service named `name` (one of ours) has the pattern gjkd
+/// gives that name: event for the wake service, request-response for the
+/// others.
+fn is_ours(name: &str, pattern: &MessagingPattern) -> bool {
+    if name.ends_with("/wake") {
+        matches!(pattern, MessagingPattern::Event(_))
+    } else {
+        matches!(pattern, MessagingPattern::RequestResponse(_))
+    }
+}
+
 /// Who holds `service`'s names (any protocol version) in a way that keeps
 /// this client from using them, if anyone does.
 pub(crate) fn name_taken_by(service: &str, ours: [&str; 3]) -> Option<NameTakenBy> {
@@ -107,10 +119,15 @@ pub(crate) fn name_taken_by(service: &str, ours: [&str; 3]) -> Option<NameTakenB
             .and_then(|v| v.parse::<u32>().ok());
         found = match version {
             Some(v) if v != gjkd_proto::PROTOCOL_VERSION => Some(NameTakenBy::Version(v)),
-            _ if ours.contains(&name) => Some(NameTakenBy::OtherPattern {
-                name: name.to_owned(),
-                pattern: format!("{:?}", config.messaging_pattern()),
-            }),
+            // Our own service, of the pattern we asked for, seen here
+            // because a server created it between our open and this scan:
+            // not taken, the next attempt opens it.
+            _ if ours.contains(&name) && !is_ours(name, config.messaging_pattern()) => {
+                Some(NameTakenBy::OtherPattern {
+                    name: name.to_owned(),
+                    pattern: format!("{:?}", config.messaging_pattern()),
+                })
+            }
             _ => None,
         };
         if found.is_some() {

@@ -1,5 +1,7 @@
-//! Building C and C++ programs against this crate's static library, with
-//! the system compiler (`$CC` / `$CXX`, default `cc` / `c++`).
+//! Building C and C++ programs against this crate's shared library, with
+//! the system compiler (`$CC` / `$CXX`, default `cc` / `c++`). (Linking the
+//! static library is checked by `tests/install.rs`; statically linked, each
+//! test program would take tens of megabytes.)
 
 #![allow(dead_code)]
 
@@ -52,20 +54,9 @@ pub fn static_lib() -> PathBuf {
     lib
 }
 
-/// The system libraries a Rust static library needs (rustc's
-/// `--print native-static-libs` on Linux).
-pub const NATIVE_LIBS: [&str; 7] = [
-    "-lgcc_s",
-    "-lutil",
-    "-lrt",
-    "-lpthread",
-    "-lm",
-    "-ldl",
-    "-lc",
-];
-
 /// Compiles `sources` (paths relative to the crate) into `name`, linked
-/// with the static library; C++ when `cxx`. Panics with the compiler's
+/// with the shared library (found at run time through an rpath); C++ when
+/// `cxx`. Panics with the compiler's
 /// output on failure.
 pub fn compile(sources: &[&str], name: &str, cxx: bool) -> PathBuf {
     let (var, default, std) = if cxx {
@@ -82,7 +73,15 @@ pub fn compile(sources: &[&str], name: &str, cxx: bool) -> PathBuf {
     for s in sources {
         cmd.arg(crate_dir().join(s));
     }
-    cmd.arg(static_lib()).args(NATIVE_LIBS).arg("-o").arg(&exe);
+    let lib_dir = static_lib()
+        .parent()
+        .expect("the library is in a folder")
+        .to_path_buf();
+    cmd.arg("-L")
+        .arg(&lib_dir)
+        .arg(format!("-Wl,-rpath,{}", lib_dir.display()))
+        .args(["-lgjkd_c", "-lm", "-o"])
+        .arg(&exe);
     let out = cmd
         .output()
         .unwrap_or_else(|e| panic!("run the compiler `{compiler}`: {e}"));

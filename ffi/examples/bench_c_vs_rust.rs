@@ -268,9 +268,11 @@ fn main() {
         .skip(1)
         .map(|a| a.parse().expect("a number"))
         .collect();
-    let rounds = args.first().copied().unwrap_or(5);
-    let singles = args.get(1).copied().unwrap_or(20_000);
-    let batches = args.get(2).copied().unwrap_or(200);
+    // Many short rounds, so that a slow spell of a shared machine falls on
+    // both sides alike.
+    let rounds = args.first().copied().unwrap_or(15);
+    let singles = args.get(1).copied().unwrap_or(10_000);
+    let batches = args.get(2).copied().unwrap_or(60);
     let profile: PathBuf = std::env::current_exe()
         .ok()
         .and_then(|e| e.parent()?.parent().map(Path::to_path_buf))

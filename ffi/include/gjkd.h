@@ -678,9 +678,10 @@ enum gjkd_status gjkd_distance(struct gjkd_client *client,
 //   `gjkd_error_code` in `out->error[i]`, zeros elsewhere, and the other
 //   pairs are answered: the call still returns `GJKD_OK`.
 //
-// Batches larger than the server takes are split. Allocates nothing once
-// the handle has seen a batch of this size. A count of 0 does nothing
-// (every array may then be NULL).
+// Batches larger than the server takes are split. The pairs go straight
+// into shared memory and the answers straight into `out`: nothing is
+// allocated per pair. A count of 0 does nothing (every array may then be
+// NULL).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pairs`, `out`,
 // `out->distance`, `out->error`), `GJKD_ERR_WRONG_THREAD`,

@@ -1,12 +1,12 @@
-//! The opaque handle behind `gjkd_client*`: the Rust client, the thread
-//! it belongs to, and the buffers batches reuse.
+//! The opaque handle behind `gjkd_client*`: the Rust client and the
+//! thread it belongs to.
 
 #![allow(non_camel_case_types)]
 
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use rust_client::{Client, Item, ItemResult};
+use rust_client::{Client, ClientError, ErrorCode, Item, ItemResult};
 
 use crate::status::{Failure, gjkd_status};
 
@@ -20,10 +20,6 @@ pub struct gjkd_client {
     pub client: Client,
     /// The thread that created the handle (iceoryx2 ports are bound to it).
     owner: u64,
-    /// Items of the chunk being sent, kept across calls.
-    pub items: Vec<Item>,
-    /// Their results, kept across calls.
-    pub results: Vec<ItemResult>,
 }
 
 /// A number per thread, for telling the owner thread from others without
@@ -47,8 +43,6 @@ impl gjkd_client {
         gjkd_client {
             client,
             owner: thread_token(),
-            items: Vec::new(),
-            results: Vec::new(),
         }
     }
 
@@ -59,34 +53,32 @@ impl gjkd_client {
             .map_or(DEFAULT_MAX_BATCH, |i| (i.max_batch as usize).max(1))
     }
 
-    /// Sends `self.items` in chunks the server takes, writing each chunk's
-    /// results with `sink(first_index, results)`.
+    /// Sends the `n` items `item(i)` in chunks the server takes, each
+    /// made straight into shared memory, and hands each chunk's results,
+    /// straight from shared memory, to `sink(first_index, results)`.
     ///
     /// # Errors
     /// The first whole-request failure; chunks before it were answered.
-    pub fn run(&mut self, mut sink: impl FnMut(usize, &[ItemResult])) -> Result<(), Failure> {
-        let n = self.items.len();
+    pub fn run(
+        &mut self,
+        n: usize,
+        item: impl Fn(usize) -> Item,
+        mut sink: impl FnMut(usize, &[ItemResult]),
+    ) -> Result<(), Failure> {
         let mut start = 0;
         while start < n {
             let max = self.max_batch();
             let end = n.min(start + max);
-            if self.results.len() < end - start {
-                self.results.resize(end - start, ItemResult::default());
-            }
-            let results = &mut self.results[..end - start];
-            match self.client.query_batch(&self.items[start..end], results) {
-                Ok(()) => {}
+            let outcome =
+                self.client
+                    .query_batch_with(end - start, |k| item(start + k), |r| sink(start, r));
+            match outcome {
+                Ok(()) => start = end,
                 // The server may have restarted with a smaller limit: the
                 // client knows the new one after its reconnect.
-                Err(rust_client::ClientError::Rejected(rust_client::ErrorCode::BatchTooLarge))
-                    if self.max_batch() < max =>
-                {
-                    continue;
-                }
+                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
                 Err(e) => return Err(e.into()),
             }
-            sink(start, &self.results[..end - start]);
-            start = end;
         }
         Ok(())
     }

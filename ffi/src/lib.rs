@@ -9,9 +9,10 @@
 //! [`gjkd_last_error`] (thread-local), a server's refusal code in
 //! [`gjkd_last_error_code`]. No panic crosses the boundary: each entry
 //! point runs in `catch_unwind`, and a caught panic is `GJKD_ERR_PANIC`.
-//! The handle is bound to the thread that created it (iceoryx2 ports are),
-//! and batch calls reuse buffers kept in it, so that a batch of a size seen
-//! before allocates nothing.
+//! The handle is bound to the thread that created it (iceoryx2 ports are).
+//! Batch calls make their items straight into the request's shared memory
+//! and copy the answers straight from the response's into the caller's
+//! arrays, with no buffer in between (`Client::query_batch_with`).
 //!
 //! The semantics are the Rust client's (`gjkd-client`) and the names follow
 //! the Python API's (`gjkd.Client`): `register_sphere`, `set_poses`,

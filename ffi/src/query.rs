@@ -81,14 +81,14 @@ unsafe fn set_poses(
                     };
                     checked_pose(p, &what)?;
                 }
-                c.items.clear();
-                c.items.extend(ids.iter().zip(poses).map(|(&id, p)| {
-                    let mut item = Item::set_pose(ObjectId::from_raw(id), &Default::default());
-                    item.pose_a = p.wire();
-                    item
-                }));
+                let template = Item::set_pose(ObjectId::from_raw(0), &Default::default());
+                let item = |i: usize| Item {
+                    a: ids[i],
+                    pose_a: poses[i].wire(),
+                    ..template
+                };
                 let mut failed: Option<(usize, ErrorCode)> = None;
-                c.run(|start, results| {
+                c.run(count, item, |start, results| {
                     if failed.is_none()
                         && let Some(k) = results.iter().position(|r| r.error != 0)
                     {
@@ -233,39 +233,30 @@ impl<'a> Outputs<'a> {
 
     /// Writes `results` into rows `start..`.
     fn write(&mut self, start: usize, results: &[ItemResult]) {
-        fn put<T: Copy>(
-            dst: &mut Option<&mut [T]>,
-            start: usize,
-            results: &[ItemResult],
-            f: impl Fn(&ItemResult) -> T,
-        ) {
+        /// `dst[i] = value` when the caller asked for that field.
+        #[inline(always)]
+        fn put<T>(dst: &mut Option<&mut [T]>, i: usize, value: T) {
             if let Some(d) = dst {
-                for (d, r) in d[start..start + results.len()].iter_mut().zip(results) {
-                    *d = f(r);
-                }
+                d[i] = value;
             }
         }
-        let rows = start..start + results.len();
-        for ((d, e), r) in self.distance[rows.clone()]
-            .iter_mut()
-            .zip(&mut self.error[rows])
-            .zip(results)
-        {
-            *d = r.distance;
-            *e = r.error;
+        // One pass over the results, each row written whole while it is
+        // in cache, rather than a pass per field.
+        for (i, r) in (start..).zip(results) {
+            self.distance[i] = r.distance;
+            self.error[i] = r.error;
+            put(&mut self.lower, i, r.lower);
+            put(&mut self.upper, i, r.upper);
+            put(&mut self.penetration, i, r.penetration);
+            put(&mut self.point_a, i, r.point_a);
+            put(&mut self.point_b, i, r.point_b);
+            put(&mut self.normal, i, r.normal);
+            put(&mut self.status, i, r.status);
+            put(&mut self.iterations, i, r.iterations);
+            put(&mut self.pieces, i, r.pieces);
+            let warm = r.flags & gjkd_proto::result_flags::WARM_STARTED != 0;
+            put(&mut self.warm_started, i, warm);
         }
-        put(&mut self.lower, start, results, |r| r.lower);
-        put(&mut self.upper, start, results, |r| r.upper);
-        put(&mut self.penetration, start, results, |r| r.penetration);
-        put(&mut self.point_a, start, results, |r| r.point_a);
-        put(&mut self.point_b, start, results, |r| r.point_b);
-        put(&mut self.normal, start, results, |r| r.normal);
-        put(&mut self.status, start, results, |r| r.status);
-        put(&mut self.iterations, start, results, |r| r.iterations);
-        put(&mut self.pieces, start, results, |r| r.pieces);
-        put(&mut self.warm_started, start, results, |r| {
-            r.flags & gjkd_proto::result_flags::WARM_STARTED != 0
-        });
     }
 }
 
@@ -280,9 +271,10 @@ impl<'a> Outputs<'a> {
 ///   `gjkd_error_code` in `out->error[i]`, zeros elsewhere, and the other
 ///   pairs are answered: the call still returns `GJKD_OK`.
 ///
-/// Batches larger than the server takes are split. Allocates nothing once
-/// the handle has seen a batch of this size. A count of 0 does nothing
-/// (every array may then be NULL).
+/// Batches larger than the server takes are split. The pairs go straight
+/// into shared memory and the answers straight into `out`: nothing is
+/// allocated per pair. A count of 0 does nothing (every array may then be
+/// NULL).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pairs`, `out`,
 /// `out->distance`, `out->error`), `GJKD_ERR_WRONG_THREAD`,
@@ -316,8 +308,8 @@ pub unsafe extern "C" fn gjkd_distances(
                 let poses_a = optional(poses_a, count, "poses_a")?;
                 let poses_b = optional(poses_b, count, "poses_b")?;
                 let mut outputs = Outputs::new(results, count)?;
-                c.items.clear();
-                c.items.extend(pairs.iter().enumerate().map(|(i, &[a, b])| {
+                let item = |i: usize| {
+                    let [a, b] = pairs[i];
                     pair_item(
                         &template,
                         a,
@@ -325,8 +317,8 @@ pub unsafe extern "C" fn gjkd_distances(
                         poses_a.map(|p| &p[i]),
                         poses_b.map(|p| &p[i]),
                     )
-                }));
-                c.run(|start, results| outputs.write(start, results))
+                };
+                c.run(count, item, |start, results| outputs.write(start, results))
             })
         }
     })

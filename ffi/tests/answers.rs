@@ -260,7 +260,7 @@ fn batches_and_single_pairs_equal_the_rust_clients_answers() {
         gjkd_error_code::GJKD_CODE_UNKNOWN_OBJECT as u32
     );
     assert!(
-        got.pieces.iter().any(|&p| p == 1),
+        got.pieces.contains(&1),
         "a compound's second piece is named"
     );
 

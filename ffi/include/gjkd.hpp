@@ -166,6 +166,8 @@ public:
                     double connect_timeout_s = 0.0) {
         check(gjkd_connect(service.c_str(), timeout_s, connect_timeout_s, &handle_));
     }
+    /// Closes the connection. Destroy a Client on the thread that created
+    /// it: gjkd_close() refuses other threads, and the handle would leak.
     ~Client() { gjkd_close(handle_); }
     Client(const Client &) = delete;
     Client &operator=(const Client &) = delete;

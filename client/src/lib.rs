@@ -1084,18 +1084,56 @@ impl Client {
                 got: results.len(),
             });
         }
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            |payload| results[..payload.len()].copy_from_slice(payload),
+        )
+    }
+
+    /// As [`Client::query_batch`], but item `i` of the `count` items is
+    /// made by `item(i)` and written straight into the request's shared
+    /// memory, and the results are handed to `read` straight from the
+    /// response's (`read` is called once, with `count` results, if the
+    /// request succeeds). For bindings whose callers keep items and
+    /// results in layouts of their own: neither needs a buffer in between.
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`].
+    pub fn query_batch_with(
+        &mut self,
+        count: usize,
+        item: impl FnMut(usize) -> Item,
+        read: impl FnOnce(&[ItemResult]),
+    ) -> Result<(), ClientError> {
+        self.round_trip(count, Source::Fn(item), read)
+    }
+
+    /// Sends `count` items from `source` as one request and hands the
+    /// results to `read`.
+    fn round_trip<F: FnMut(usize) -> Item>(
+        &mut self,
+        count: usize,
+        source: Source<'_, F>,
+        read: impl FnOnce(&[ItemResult]),
+    ) -> Result<(), ClientError> {
         let deadline = Instant::now() + self.timeout;
         self.ensure_connected(deadline)?;
         let conn = self.conn.as_ref().ok_or_else(|| self.gone())?;
+        let mut read = Some(read);
         let outcome = (|| {
             if conn.query_service.dynamic_config().number_of_servers() == 0 {
                 return Err(Waited::Gone);
             }
-            let pending = conn
+            let loan = conn
                 .query
-                .loan_slice_uninit(items.len())
-                .map_err(|e| Waited::Failed(ipc_err("query loan")(e)))?
-                .write_from_slice(items)
+                .loan_slice_uninit(count)
+                .map_err(|e| Waited::Failed(ipc_err("query loan")(e)))?;
+            let request = match source {
+                Source::Slice(items) => loan.write_from_slice(items),
+                Source::Fn(item) => loan.write_from_fn(item),
+            };
+            let pending = request
                 .send()
                 .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
             if conn.notify_queries {
@@ -1113,19 +1151,29 @@ impl Client {
                     return Err(ClientError::Rejected(code));
                 }
                 let payload = response.payload();
-                if payload.len() != items.len() {
+                if payload.len() != count {
                     return Err(ClientError::Protocol(format!(
                         "{} results for {} items",
                         payload.len(),
-                        items.len()
+                        count
                     )));
                 }
-                results[..payload.len()].copy_from_slice(payload);
+                if let Some(read) = read.take() {
+                    read(payload);
+                }
                 Ok(Some(()))
             })
         })();
         self.settle(outcome)
     }
+}
+
+/// Where the items of a request come from.
+enum Source<'a, F> {
+    /// A caller's slice, copied as it is.
+    Slice(&'a [Item]),
+    /// Made one by one into the request.
+    Fn(F),
 }
 
 /// How waiting for an answer ended, short of an answer.

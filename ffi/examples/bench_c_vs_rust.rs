@@ -1,0 +1,321 @@
+//! Benchmark (not a test): the C API beside the Rust client on the same
+//! pairs, against one `gjkd serve --wait spin` server, in one run.
+//!
+//! ```text
+//! cargo run --release -p gjkd-c --example bench_c_vs_rust -- [ROUNDS [SINGLES [BATCHES]]]
+//! ```
+//!
+//! It writes `PAIRS` random box pairs, starts the server (pinned to CPU 1;
+//! this process and the C program on CPU 0, so that a spinning server never
+//! shares a core with its client), compiles `bench/round_trip.c` against
+//! this build's `libgjkd_c.a`, and in each round runs the C program then
+//! the same measurements in Rust: the p50 of a single-pair round trip
+//! (`gjkd_distance` / `Client::distance`, pair 0 at its stored poses) and
+//! the median per-pair cost of a batch of all pairs, each with its own
+//! poses (`gjkd_distances` / `Client::query_batch`, items built once).
+//! Prints each round and the medians over rounds.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use rust_client::{Client, Item, ItemResult, ObjectId, QueryOptions};
+
+const PAIRS: usize = 1000;
+
+/// Pins thread or process `pid` (0: the calling thread) to `cpu`.
+fn pin(pid: libc::pid_t, cpu: usize) -> bool {
+    // SAFETY: a zeroed cpu_set_t is the empty set; CPU_SET writes inside it.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_SET(cpu, &mut set);
+        libc::sched_setaffinity(pid, size_of::<libc::cpu_set_t>(), &set) == 0
+    }
+}
+
+/// splitmix64: the same pairs on every run.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+
+    /// A pose `[x, y, z, qx, qy, qz, qw]` within `extent` of the origin.
+    fn pose(&mut self, extent: f64) -> [f64; 7] {
+        let t = [(); 3].map(|()| self.range(-extent, extent));
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(
+            self.range(-1.0, 1.0),
+            self.range(-1.0, 1.0),
+            self.range(-1.0, 1.0),
+            self.range(-1.0, 1.0),
+        ));
+        let c = q.coords;
+        [t[0], t[1], t[2], c.x, c.y, c.z, c.w]
+    }
+}
+
+/// Per pair: half extents of A and B, pose of A, pose of B.
+fn pairs() -> Vec<[f64; 20]> {
+    let mut rng = Rng(0x5eed_c0de);
+    (0..PAIRS)
+        .map(|_| {
+            let mut row = [0.0; 20];
+            for h in &mut row[..6] {
+                *h = rng.range(0.2, 1.0);
+            }
+            row[6..13].copy_from_slice(&rng.pose(0.5));
+            row[13..20].copy_from_slice(&rng.pose(4.0));
+            row
+        })
+        .collect()
+}
+
+fn isometry(p: &[f64]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p[0], p[1], p[2]),
+        UnitQuaternion::new_unchecked(Quaternion::new(p[6], p[3], p[4], p[5])),
+    )
+}
+
+fn write_pairs(rows: &[[f64; 20]], path: &Path) {
+    let mut bytes = (rows.len() as f64).to_le_bytes().to_vec();
+    for v in rows.iter().flatten() {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, bytes).expect("write the pairs file");
+}
+
+/// Compiles the C side against this build's static library.
+fn compile(profile: &Path, out: &Path) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let status = Command::new(std::env::var("CC").unwrap_or_else(|_| "cc".into()))
+        .args(["-std=c99", "-O2", "-Wall"])
+        .arg("-I")
+        .arg(dir.join("include"))
+        .arg(dir.join("bench/round_trip.c"))
+        // Built into deps/ for an example (not copied up).
+        .arg(profile.join("deps/libgjkd_c.a"))
+        .args([
+            "-lgcc_s",
+            "-lutil",
+            "-lrt",
+            "-lpthread",
+            "-lm",
+            "-ldl",
+            "-lc",
+            "-o",
+        ])
+        .arg(out)
+        .status()
+        .expect("run cc");
+    assert!(status.success(), "compiling round_trip.c failed");
+}
+
+/// Runs the C side once: (single p50 ns, batch ns per pair).
+fn run_c(exe: &Path, service: &str, file: &Path, singles: usize, batches: usize) -> (f64, f64) {
+    let out = Command::new(exe)
+        .arg(service)
+        .arg(file)
+        .arg(singles.to_string())
+        .arg(batches.to_string())
+        .output()
+        .expect("run round_trip");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "round_trip failed: {text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let value = |key: &str| -> f64 {
+        text.lines()
+            .find_map(|l| l.strip_prefix(key))
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or_else(|| panic!("no {key} in {text}"))
+    };
+    (value("single_p50_ns"), value("batch_ns_per_pair"))
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The Rust side: the same pairs registered by a Rust client.
+struct RustSide {
+    client: Client,
+    a: ObjectId,
+    b: ObjectId,
+    items: Vec<Item>,
+    results: Vec<ItemResult>,
+}
+
+impl RustSide {
+    fn new(service: &str, rows: &[[f64; 20]]) -> Self {
+        let mut client = Client::builder(service)
+            .timeout(Duration::from_secs(5))
+            .connect_timeout(Duration::from_secs(20))
+            .connect()
+            .expect("connect");
+        let mut items = Vec::with_capacity(rows.len());
+        let mut first = None;
+        for r in rows {
+            let a = client
+                .register_cuboid(Vector3::new(r[0], r[1], r[2]), 0.0)
+                .expect("register");
+            let b = client
+                .register_cuboid(Vector3::new(r[3], r[4], r[5]), 0.0)
+                .expect("register");
+            first.get_or_insert((a, b));
+            let opts = QueryOptions::default();
+            items.push(Item::distance_at(
+                a,
+                &isometry(&r[6..13]),
+                b,
+                &isometry(&r[13..20]),
+                &opts,
+            ));
+        }
+        let (a, b) = first.expect("at least one pair");
+        client
+            .set_pose(a, &isometry(&rows[0][6..13]))
+            .expect("pose");
+        client
+            .set_pose(b, &isometry(&rows[0][13..20]))
+            .expect("pose");
+        let results = vec![ItemResult::default(); items.len()];
+        RustSide {
+            client,
+            a,
+            b,
+            items,
+            results,
+        }
+    }
+
+    fn single_p50(&mut self, n: usize) -> f64 {
+        let opts = QueryOptions::default();
+        for _ in 0..n / 10 + 100 {
+            self.client
+                .distance(self.a, self.b, &opts)
+                .expect("warm-up");
+        }
+        let mut t: Vec<f64> = (0..n)
+            .map(|_| {
+                let start = Instant::now();
+                let r = self.client.distance(self.a, self.b, &opts);
+                let ns = start.elapsed().as_nanos() as f64;
+                r.expect("distance");
+                ns
+            })
+            .collect();
+        median(&mut t)
+    }
+
+    fn batch_per_pair(&mut self, n: usize) -> f64 {
+        for _ in 0..20 {
+            self.client
+                .query_batch(&self.items, &mut self.results)
+                .expect("warm-up");
+        }
+        let per = self.items.len() as f64;
+        let mut t: Vec<f64> = (0..n)
+            .map(|_| {
+                let start = Instant::now();
+                let r = self.client.query_batch(&self.items, &mut self.results);
+                let ns = start.elapsed().as_nanos() as f64 / per;
+                r.expect("batch");
+                ns
+            })
+            .collect();
+        median(&mut t)
+    }
+}
+
+fn spawn_server(service: &str) -> Child {
+    let child = Command::new(gjkd_e2e::gjkd_binary())
+        .args([
+            "serve",
+            "--service",
+            service,
+            "--wait",
+            "spin",
+            "--no-persist",
+        ])
+        .env("RUST_LOG", "warn")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("spawn gjkd serve");
+    // The serving loop runs on the process's main thread.
+    if let Ok(pid) = libc::pid_t::try_from(child.id()) {
+        pin(pid, 1);
+    }
+    child
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    // Many short rounds, so that a slow spell of a shared machine falls on
+    // both sides alike.
+    let rounds = args.first().copied().unwrap_or(15);
+    let singles = args.get(1).copied().unwrap_or(10_000);
+    let batches = args.get(2).copied().unwrap_or(60);
+    let profile: PathBuf = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent()?.parent().map(Path::to_path_buf))
+        .expect("target/<profile>/examples");
+    let work = profile.join("gjkd-c-bench");
+    std::fs::create_dir_all(&work).expect("work folder");
+    let (file, exe) = (work.join("pairs.bin"), work.join("round_trip"));
+    let rows = pairs();
+    write_pairs(&rows, &file);
+    compile(&profile, &exe);
+    let service = gjkd_e2e::unique_service("ffi-bench");
+    let mut server = spawn_server(&service);
+    let pinned = pin(0, 0);
+    let mut rust = RustSide::new(&service, &rows);
+    println!(
+        "{PAIRS} box pairs, {rounds} rounds of {singles} single round trips and {batches} batches; client on CPU 0, server on CPU 1: {pinned}"
+    );
+    println!("round   C single p50  Rust single p50   C batch/pair  Rust batch/pair   (ns)");
+    let (mut cs, mut rs, mut cb, mut rb) = (vec![], vec![], vec![], vec![]);
+    for round in 0..rounds {
+        let (c_single, c_batch) = run_c(&exe, &service, &file, singles, batches);
+        let r_single = rust.single_p50(singles);
+        let r_batch = rust.batch_per_pair(batches);
+        println!("{round:>5} {c_single:>14.0} {r_single:>16.0} {c_batch:>14.1} {r_batch:>16.1}");
+        cs.push(c_single);
+        rs.push(r_single);
+        cb.push(c_batch);
+        rb.push(r_batch);
+    }
+    let (cs, rs, cb, rb) = (
+        median(&mut cs),
+        median(&mut rs),
+        median(&mut cb),
+        median(&mut rb),
+    );
+    println!("median {cs:>13.0} {rs:>16.0} {cb:>14.1} {rb:>16.1}");
+    println!(
+        "single: C - Rust = {:+.0} ns (target <= +200); batch: C / Rust = {:.3} (target <= 1.1)",
+        cs - rs,
+        cb / rb
+    );
+    drop(rust);
+    let _ = server.kill();
+    let _ = server.wait();
+    let _ = std::fs::remove_dir_all(&work);
+}

@@ -1,0 +1,309 @@
+// gjkd.hpp: a header-only C++17 wrapper of the gjkd C API (gjkd.h).
+//
+// gjkd::Client owns a gjkd_client* (RAII, movable, not copyable) and turns
+// every failed call into a gjkd::Error carrying the gjkd_status, the
+// server's gjkd_error_code (for GJKD_ERR_REJECTED) and the message. Batches
+// take pointer + count, std::vector, or (C++20) std::span, and write into
+// a gjkd::Distances the caller keeps and reuses. Like the handle it wraps,
+// a Client belongs to the thread that created it.
+//
+//   gjkd::Client client("gjkd");
+//   gjkd::Id box = client.register_box({1, 1, 1});
+//   gjkd::Id ball = client.register_sphere(0.5, gjkd::at(3, 0, 0));
+//   double d = client.distance(box, ball).distance;   // 1.5
+#ifndef GJKD_HPP
+#define GJKD_HPP
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#if __cplusplus >= 202002L && __has_include(<span>)
+#include <span>
+#define GJKD_HAS_SPAN 1
+#endif
+
+#include "gjkd.h"
+
+namespace gjkd {
+
+/// Object id.
+using Id = gjkd_id;
+/// Pose: translation, then unit quaternion [qx, qy, qz, qw].
+using Pose = gjkd_pose;
+/// Answer of one pair query.
+using Answer = gjkd_answer;
+/// Query options; start from default_options().
+using Options = gjkd_query_options;
+/// A convex shape (see sphere(), capsule(), box(), polytope()).
+using Shape = gjkd_shape;
+/// A piece of a compound: an offset and a convex shape.
+using Piece = gjkd_piece;
+/// Three doubles.
+using Vec3 = std::array<double, 3>;
+
+/// A failed call: what gjkd_status it returned, the server's code for
+/// GJKD_ERR_REJECTED (GJKD_CODE_OK otherwise), and the message.
+class Error : public std::runtime_error {
+public:
+    Error(gjkd_status status, uint32_t code, const std::string &message)
+        : std::runtime_error(message), status_(status), code_(code) {}
+    /// The call's status.
+    gjkd_status status() const noexcept { return status_; }
+    /// The server's gjkd_error_code, for GJKD_ERR_REJECTED.
+    uint32_t code() const noexcept { return code_; }
+
+private:
+    gjkd_status status_;
+    uint32_t code_;
+};
+
+/// Throws the thread's last error if `status` is not GJKD_OK.
+inline void check(gjkd_status status) {
+    if (status != GJKD_OK) {
+        throw Error(status, gjkd_last_error_code(), gjkd_last_error());
+    }
+}
+
+/// The identity pose.
+inline Pose identity() { return Pose{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}}; }
+
+/// A translation by (x, y, z), no rotation.
+inline Pose at(double x, double y, double z) {
+    return Pose{{x, y, z}, {0.0, 0.0, 0.0, 1.0}};
+}
+
+/// The default query options.
+inline Options default_options() { return gjkd_query_options_default(); }
+
+/// A ball of `radius`.
+inline Shape sphere(double radius) {
+    return Shape{GJKD_SHAPE_SPHERE, radius, {0, 0, 0}, {0, 0, 0}, nullptr, 0};
+}
+
+/// The segment a-b grown by `radius`.
+inline Shape capsule(const Vec3 &a, const Vec3 &b, double radius) {
+    return Shape{GJKD_SHAPE_CAPSULE, radius, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, nullptr, 0};
+}
+
+/// A box of half extents `h`, edges rounded by `radius`.
+inline Shape box(const Vec3 &h, double radius = 0.0) {
+    return Shape{GJKD_SHAPE_BOX, radius, {h[0], h[1], h[2]}, {0, 0, 0}, nullptr, 0};
+}
+
+/// The hull of `count` points (3 doubles each at `xyz`) grown by `radius`.
+/// The points are read when the shape is registered, not copied here.
+inline Shape polytope(const double *xyz, std::size_t count, double radius = 0.0) {
+    return Shape{GJKD_SHAPE_POLYTOPE, radius, {0, 0, 0}, {0, 0, 0}, xyz, count};
+}
+
+/// Output arrays of Client::distances(), owned here and reused across
+/// calls of the same or a smaller size. Row i answers pair i.
+class Distances {
+public:
+    Distances() = default;
+    /// Room for `n` rows.
+    explicit Distances(std::size_t n) { resize(n); }
+
+    /// Room for `n` rows (allocates only when growing).
+    void resize(std::size_t n) {
+        distance.resize(n);
+        lower.resize(n);
+        upper.resize(n);
+        penetration.resize(n);
+        point_a.resize(n);
+        point_b.resize(n);
+        normal.resize(n);
+        status.resize(n);
+        iterations.resize(n);
+        error.resize(n);
+    }
+
+    /// Rows.
+    std::size_t size() const noexcept { return distance.size(); }
+
+    /// The C view of the arrays.
+    gjkd_results view() noexcept {
+        gjkd_results r{};
+        r.distance = distance.data();
+        r.lower = lower.data();
+        r.upper = upper.data();
+        r.penetration = penetration.data();
+        r.point_a = point_a.empty() ? nullptr : point_a[0].data();
+        r.point_b = point_b.empty() ? nullptr : point_b[0].data();
+        r.normal = normal.empty() ? nullptr : normal[0].data();
+        r.status = status.data();
+        r.iterations = iterations.data();
+        r.error = error.data();
+        return r;
+    }
+
+    std::vector<double> distance;    ///< Distances.
+    std::vector<double> lower;       ///< Certified lower bounds.
+    std::vector<double> upper;       ///< Certified upper bounds.
+    std::vector<double> penetration; ///< Lower bounds on penetration depth.
+    std::vector<Vec3> point_a;       ///< Nearest points on A.
+    std::vector<Vec3> point_b;       ///< Nearest points on B.
+    std::vector<Vec3> normal;        ///< Unit normals from A towards B.
+    std::vector<uint32_t> status;    ///< gjkd_query_status values.
+    std::vector<uint32_t> iterations; ///< Iterations.
+    std::vector<uint32_t> error;     ///< gjkd_error_code values, 0 if answered.
+};
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
+
+/// A connection to a gjkd server. Every method throws gjkd::Error on
+/// failure; see gjkd.h for each call's errors.
+class Client {
+public:
+    /// Connects to `service`, waiting up to `connect_timeout_s` seconds (0:
+    /// `timeout_s`) for a server; `timeout_s` bounds every later call.
+    explicit Client(const std::string &service = "gjkd", double timeout_s = 1.0,
+                    double connect_timeout_s = 0.0) {
+        check(gjkd_connect(service.c_str(), timeout_s, connect_timeout_s, &handle_));
+    }
+    /// Closes the connection. Destroy a Client on the thread that created
+    /// it: gjkd_close() refuses other threads, and the handle would leak.
+    ~Client() { gjkd_close(handle_); }
+    Client(const Client &) = delete;
+    Client &operator=(const Client &) = delete;
+    Client(Client &&other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    Client &operator=(Client &&other) noexcept {
+        if (this != &other) {
+            gjkd_close(handle_);
+            handle_ = std::exchange(other.handle_, nullptr);
+        }
+        return *this;
+    }
+
+    /// The C handle, for calls this wrapper lacks; still owned here.
+    gjkd_client *native_handle() const noexcept { return handle_; }
+
+    /// Registers `shape` at `pose`, under `name` if not null.
+    Id register_shape(const Shape &shape, const Pose &pose = identity(),
+                      const char *name = nullptr) {
+        Id id = 0;
+        check(gjkd_register(handle_, &shape, name, &pose, &id));
+        return id;
+    }
+    /// Registers a ball.
+    Id register_sphere(double radius, const Pose &pose = identity(), const char *name = nullptr) {
+        return register_shape(sphere(radius), pose, name);
+    }
+    /// Registers a capsule.
+    Id register_capsule(const Vec3 &a, const Vec3 &b, double radius,
+                        const Pose &pose = identity(), const char *name = nullptr) {
+        return register_shape(capsule(a, b, radius), pose, name);
+    }
+    /// Registers a box.
+    Id register_box(const Vec3 &half_extents, double radius = 0.0,
+                    const Pose &pose = identity(), const char *name = nullptr) {
+        return register_shape(box(half_extents, radius), pose, name);
+    }
+    /// Registers the hull of `vertices` grown by `radius`.
+    Id register_polytope(const std::vector<Vec3> &vertices, double radius = 0.0,
+                         const Pose &pose = identity(), const char *name = nullptr) {
+        const double *xyz = vertices.empty() ? nullptr : vertices[0].data();
+        return register_shape(polytope(xyz, vertices.size(), radius), pose, name);
+    }
+    /// Registers a union of convex pieces.
+    Id register_compound(const std::vector<Piece> &pieces, const Pose &pose = identity(),
+                         const char *name = nullptr) {
+        Id id = 0;
+        check(gjkd_register_compound(handle_, pieces.data(), pieces.size(), name, &pose, &id));
+        return id;
+    }
+    /// Removes an object this client registered.
+    void remove(Id id) { check(gjkd_remove(handle_, id)); }
+    /// The id of the object named `name`.
+    Id lookup(const std::string &name) {
+        Id id = 0;
+        check(gjkd_lookup(handle_, name.c_str(), &id));
+        return id;
+    }
+
+    /// Stores the pose of `id`.
+    void set_pose(Id id, const Pose &pose) { check(gjkd_set_pose(handle_, id, &pose)); }
+    /// Stores `count` poses in one round trip.
+    void set_poses(const Id *ids, const Pose *poses, std::size_t count) {
+        check(gjkd_set_poses(handle_, ids, poses, count));
+    }
+    /// Stores poses[i] for ids[i] (the sizes must agree).
+    void set_poses(const std::vector<Id> &ids, const std::vector<Pose> &poses) {
+        same_size(ids.size(), poses.size());
+        set_poses(ids.data(), poses.data(), ids.size());
+    }
+
+    /// The distance between `a` and `b` at their stored poses, or at
+    /// `pose_a` / `pose_b` if not null.
+    Answer distance(Id a, Id b, const Pose *pose_a = nullptr, const Pose *pose_b = nullptr,
+                    const Options *options = nullptr) {
+        Answer answer{};
+        check(gjkd_distance(handle_, a, b, pose_a, pose_b, options, &answer));
+        return answer;
+    }
+
+    /// The distances of `count` pairs (`2 * count` ids) into `out`, resized
+    /// to `count` rows. Rows that fail carry their code in `out.error`.
+    void distances(const Id *pairs, std::size_t count, Distances &out,
+                   const Pose *poses_a = nullptr, const Pose *poses_b = nullptr,
+                   const Options *options = nullptr) {
+        if (out.size() != count) out.resize(count);
+        gjkd_results view = out.view();
+        check(gjkd_distances(handle_, pairs, count, poses_a, poses_b, options, &view));
+    }
+    /// The distances of `pairs` into `out`.
+    void distances(const std::vector<std::array<Id, 2>> &pairs, Distances &out,
+                   const Options *options = nullptr) {
+        const Id *ids = pairs.empty() ? nullptr : pairs[0].data();
+        distances(ids, pairs.size(), out, nullptr, nullptr, options);
+    }
+
+#ifdef GJKD_HAS_SPAN
+    /// Stores poses[i] for ids[i] (C++20).
+    void set_poses(std::span<const Id> ids, std::span<const Pose> poses) {
+        same_size(ids.size(), poses.size());
+        set_poses(ids.data(), poses.data(), ids.size());
+    }
+    /// The distances of `pairs` into `out` (C++20).
+    void distances(std::span<const std::array<Id, 2>> pairs, Distances &out,
+                   const Options *options = nullptr) {
+        const Id *ids = pairs.empty() ? nullptr : pairs[0].data();
+        distances(ids, pairs.size(), out, nullptr, nullptr, options);
+    }
+#endif
+
+    /// What the server said about itself at the last (re)connection.
+    gjkd_info server_info() {
+        gjkd_info info{};
+        check(gjkd_server_info(handle_, &info));
+        return info;
+    }
+    /// The server's counters.
+    gjkd_server_stats stats() {
+        gjkd_server_stats s{};
+        check(gjkd_stats(handle_, &s));
+        return s;
+    }
+
+private:
+    static void same_size(std::size_t a, std::size_t b) {
+        if (a != b) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "set_poses: " + std::to_string(a) + " ids for " + std::to_string(b) +
+                            " poses");
+        }
+    }
+
+    gjkd_client *handle_ = nullptr;
+};
+
+static_assert(sizeof(std::array<Id, 2>) == 2 * sizeof(Id), "a pair is two packed ids");
+
+} // namespace gjkd
+
+#endif // GJKD_HPP

@@ -1,0 +1,59 @@
+//! # gjkd-c
+//!
+//! The C ABI of the gjkd client, for C and C++ programs: a `cdylib`
+//! (`libgjkd_c.so`) and a `staticlib` (`libgjkd_c.a`) with the header
+//! `include/gjkd.h`, generated from this crate by cbindgen, and a
+//! header-only C++17 wrapper `include/gjkd.hpp`.
+//!
+//! Every function returns a [`gjkd_status`]; a failure's words are in
+//! [`gjkd_last_error`] (thread-local), a server's refusal code in
+//! [`gjkd_last_error_code`]. No panic crosses the boundary: each entry
+//! point runs in `catch_unwind`, and a caught panic is `GJKD_ERR_PANIC`.
+//! The handle is bound to the thread that created it (iceoryx2 ports are).
+//! Batch calls make their items straight into the request's shared memory
+//! and copy the answers straight from the response's into the caller's
+//! arrays, with no buffer in between (`Client::query_batch_with`).
+//!
+//! The semantics are the Rust client's (`gjkd-client`) and the names follow
+//! the Python API's (`gjkd.Client`): `register_sphere`, `set_poses`,
+//! `distance`, `distances`, ...
+
+#![warn(missing_docs)]
+// The C names are the API.
+#![allow(non_camel_case_types)]
+
+mod args;
+mod connect;
+mod handle;
+mod objects;
+mod query;
+mod status;
+mod types;
+
+pub use connect::*;
+pub use handle::gjkd_client;
+pub use objects::*;
+pub use query::*;
+pub use status::gjkd_status;
+pub use types::*;
+
+/// The wire protocol version this library speaks; a server of another
+/// version is refused with `GJKD_ERR_VERSION_MISMATCH`.
+pub const GJKD_PROTOCOL_VERSION: u32 = 1;
+const _: () = assert!(GJKD_PROTOCOL_VERSION == gjkd_proto::PROTOCOL_VERSION);
+
+/// Default relative tolerance of a query: 100 × machine epsilon.
+pub const GJKD_DEFAULT_TOLERANCE: f64 = 2.220446049250313e-14;
+const _: () = assert!(GJKD_DEFAULT_TOLERANCE == gjkd_proto::DEFAULT_TOLERANCE);
+
+/// Default iteration cap of a query.
+pub const GJKD_DEFAULT_MAX_ITERATIONS: u32 = 128;
+const _: () = assert!(GJKD_DEFAULT_MAX_ITERATIONS == gjkd_proto::DEFAULT_MAX_ITERATIONS);
+
+/// Most pieces of a compound.
+pub const GJKD_MAX_PIECES: usize = 64;
+const _: () = assert!(GJKD_MAX_PIECES == gjkd_proto::MAX_PIECES);
+
+/// Longest object name, in bytes of UTF-8 (not counting the NUL).
+pub const GJKD_MAX_NAME_LEN: usize = 64;
+const _: () = assert!(GJKD_MAX_NAME_LEN == gjkd_proto::MAX_NAME_LEN);

@@ -1,0 +1,109 @@
+/*
+ * leak_check.c: many calls of the C API, failing and succeeding, for
+ * valgrind to check that nothing leaks. Arguments: SERVICE CALLS.
+ *
+ * Most calls fail before reaching the server (each failure builds a new
+ * last-error message and frees the old one); one in ROUND_TRIP_EVERY is a
+ * round trip (a set_poses batch, a distances batch, a failed lookup), and
+ * a few handles are opened and closed.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gjkd.h"
+
+enum { BATCH = 16, ROUND_TRIP_EVERY = 100, HANDLES = 3 };
+
+static void must(gjkd_status s, const char *what) {
+    if (s != GJKD_OK) {
+        fprintf(stderr, "%s: %s\n", what, gjkd_last_error());
+        exit(2);
+    }
+}
+
+static void must_fail(gjkd_status s, gjkd_status want, const char *what) {
+    if (s != want || gjkd_last_error()[0] == '\0') {
+        fprintf(stderr, "%s: got %s, wanted %s\n", what, gjkd_status_name(s),
+                gjkd_status_name(want));
+        exit(3);
+    }
+}
+
+int main(int argc, char **argv) {
+    if (argc < 3) {
+        fprintf(stderr, "usage: leak_check SERVICE CALLS\n");
+        return 2;
+    }
+    const char *service = argv[1];
+    long calls = atol(argv[2]);
+    for (int h = 0; h < HANDLES; h++) {
+        gjkd_client *extra = NULL;
+        must(gjkd_connect(service, 5.0, 10.0, &extra), "connect extra");
+        must(gjkd_close(extra), "close extra");
+    }
+    gjkd_client *c = NULL;
+    must(gjkd_connect(service, 5.0, 10.0, &c), "connect");
+
+    gjkd_id ids[BATCH], pairs[2 * BATCH];
+    gjkd_pose poses[BATCH];
+    for (int i = 0; i < BATCH; i++) {
+        gjkd_pose p = {{3.0 * i, 0, 0}, {0, 0, 0, 1}};
+        poses[i] = p;
+        must(gjkd_register_sphere(c, 1.0, NULL, &poses[i], &ids[i]), "register");
+    }
+    for (int i = 0; i < BATCH; i++) {
+        pairs[2 * i] = ids[i];
+        pairs[2 * i + 1] = ids[(i + 1) % BATCH];
+    }
+    double distance[BATCH], point_a[3 * BATCH];
+    uint32_t error[BATCH];
+    gjkd_results out;
+    memset(&out, 0, sizeof out);
+    out.distance = distance;
+    out.point_a = point_a;
+    out.error = error;
+
+    char long_name[GJKD_MAX_NAME_LEN + 2];
+    memset(long_name, 'n', sizeof long_name - 1);
+    long_name[sizeof long_name - 1] = '\0';
+    gjkd_pose bad = {{NAN, 0, 0}, {0, 0, 0, 1}};
+    gjkd_id found;
+    long round_trips = 0;
+    for (long k = 0; k < calls; k++) {
+        if (k % ROUND_TRIP_EVERY == 0) {
+            switch ((k / ROUND_TRIP_EVERY) % 3) {
+            case 0:
+                must(gjkd_set_poses(c, ids, poses, BATCH), "set_poses");
+                break;
+            case 1:
+                must(gjkd_distances(c, pairs, BATCH, NULL, NULL, NULL, &out), "distances");
+                if (fabs(distance[0] - 1.0) > 1e-9) {
+                    fprintf(stderr, "distance %.17g, expected 1\n", distance[0]);
+                    return 4;
+                }
+                break;
+            default:
+                must_fail(gjkd_lookup(c, "absent", &found), GJKD_ERR_REJECTED, "lookup");
+            }
+            round_trips++;
+            continue;
+        }
+        switch (k % 3) {
+        case 0:
+            must_fail(gjkd_lookup(c, long_name, &found), GJKD_ERR_INVALID_ARGUMENT, "long name");
+            break;
+        case 1:
+            must_fail(gjkd_set_pose(c, ids[0], &bad), GJKD_ERR_INVALID_ARGUMENT, "nan pose");
+            break;
+        default:
+            must_fail(gjkd_distances(c, pairs, BATCH, NULL, NULL, NULL, NULL),
+                      GJKD_ERR_NULL_POINTER, "null out");
+        }
+    }
+    for (int i = 0; i < BATCH; i++) must(gjkd_remove(c, ids[i]), "remove");
+    must(gjkd_close(c), "close");
+    printf("calls %ld, round trips %ld\n", calls, round_trips);
+    return 0;
+}

@@ -1,0 +1,57 @@
+//! The C and C++ examples, built with the system compiler against the
+//! static library, run against a real server and check their own answers
+//! (analytic distances to 1e-9); this test checks what they printed.
+
+mod common;
+
+use gjkd_e2e::Server;
+
+/// The lines every example prints about its answers.
+fn assert_answers(stdout: &str) {
+    for line in [
+        "box-sphere             1.500000000000",
+        "box-capsule            2.750000000000",
+        "box-polytope           2.500000000000",
+        "sphere-capsule         4.250000000000",
+        "box-compound           3.700000000000",
+        "box-sphere above       2.500000000000",
+        "unknown pair           GJKD_CODE_UNKNOWN_OBJECT",
+        "lookup of a missing name: GJKD_ERR_REJECTED, GJKD_CODE_UNKNOWN_NAME",
+    ] {
+        assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
+    }
+    assert!(!stdout.contains("WRONG"), "{stdout}");
+    assert_eq!(stdout.lines().last(), Some("ok"), "{stdout}");
+}
+
+#[test]
+fn c_example_answers_match_the_analytic_distances() {
+    let exe = common::compile(&["examples/basic.c"], "basic", false);
+    let server = Server::start("ffi-c", &["--no-persist"]);
+    let stdout = common::run_ok(&exe, &[&server.service]);
+    assert_answers(&stdout);
+    assert!(stdout.contains("found by name: yes"), "{stdout}");
+}
+
+#[test]
+fn cpp_example_answers_match_the_analytic_distances() {
+    let exe = common::compile(&["examples/basic.cpp"], "basic_cpp", true);
+    let server = Server::start("ffi-cpp", &["--no-persist"]);
+    let stdout = common::run_ok(&exe, &[&server.service]);
+    assert_answers(&stdout);
+    assert!(stdout.contains("lookup gives the id    1.0"), "{stdout}");
+}
+
+#[test]
+fn examples_fail_when_no_server_runs() {
+    // An example that cannot connect says so and exits non-zero, rather
+    // than printing answers.
+    let exe = common::compile(&["examples/basic.c"], "basic_noserver", false);
+    let out = common::run(&exe, &[&gjkd_e2e::unique_service("ffi-none")]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("gjkd_connect failed: GJKD_ERR_SERVER_GONE"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,122 @@
+//! The committed header is the one cbindgen generates from this crate, and
+//! its constants agree with the Rust crates'.
+
+use std::path::Path;
+
+/// The header build.rs generated in this build.
+const GENERATED: &str = include_str!(concat!(env!("OUT_DIR"), "/gjkd.h"));
+
+fn committed_path() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("include/gjkd.h")
+}
+
+#[test]
+fn committed_header_is_the_generated_one() {
+    let path = committed_path();
+    if std::env::var_os("GJKD_UPDATE_HEADER").is_some() {
+        std::fs::write(&path, GENERATED).expect("write include/gjkd.h");
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == GENERATED,
+        "ffi/include/gjkd.h differs from the header cbindgen generates from the crate; \
+         refresh it with\n    GJKD_UPDATE_HEADER=1 cargo test -p gjkd-c --test header\n\
+         and commit it"
+    );
+}
+
+/// The value of `#define NAME value` in the header.
+fn define(name: &str) -> String {
+    let prefix = format!("#define {name} ");
+    GENERATED
+        .lines()
+        .find_map(|l| l.strip_prefix(&prefix))
+        .unwrap_or_else(|| panic!("no #define {name} in the header"))
+        .trim()
+        .to_owned()
+}
+
+#[test]
+fn version_macro_matches_the_wire_protocol() {
+    assert_eq!(
+        define("GJKD_PROTOCOL_VERSION"),
+        gjkd_proto::PROTOCOL_VERSION.to_string()
+    );
+    assert_eq!(
+        gjkd_c::gjkd_protocol_version(),
+        gjkd_proto::PROTOCOL_VERSION
+    );
+}
+
+#[test]
+fn limit_and_default_macros_match_the_rust_crates() {
+    assert_eq!(
+        define("GJKD_MAX_PIECES"),
+        gjkd_proto::MAX_PIECES.to_string()
+    );
+    assert_eq!(
+        define("GJKD_MAX_NAME_LEN"),
+        gjkd_proto::MAX_NAME_LEN.to_string()
+    );
+    assert_eq!(
+        define("GJKD_DEFAULT_MAX_ITERATIONS"),
+        gjkd_proto::DEFAULT_MAX_ITERATIONS.to_string()
+    );
+    let tol: f64 = define("GJKD_DEFAULT_TOLERANCE").parse().expect("a number");
+    assert_eq!(tol, gjkd_proto::DEFAULT_TOLERANCE);
+}
+
+#[test]
+fn error_codes_in_the_header_are_the_wire_codes() {
+    // Each wire code appears as `GJKD_CODE_<NAME> = <value>` with the name
+    // the library reports for it.
+    for code in gjkd_proto::ErrorCode::ALL {
+        let name = unsafe { std::ffi::CStr::from_ptr(gjkd_c::gjkd_error_code_name(code.raw())) }
+            .to_str()
+            .expect("ASCII");
+        let line = format!("{name} = {},", code.raw());
+        assert!(GENERATED.contains(&line), "{line} missing from the header");
+        let words =
+            unsafe { std::ffi::CStr::from_ptr(gjkd_c::gjkd_error_code_describe(code.raw())) };
+        assert_eq!(words.to_str().expect("ASCII"), code.describe());
+    }
+    let past = gjkd_proto::ErrorCode::ALL.len() as u32;
+    let name = unsafe { std::ffi::CStr::from_ptr(gjkd_c::gjkd_error_code_name(past)) };
+    assert_eq!(name.to_str().expect("ASCII"), "GJKD_CODE_UNKNOWN");
+}
+
+#[test]
+fn query_statuses_in_the_header_are_the_wire_statuses() {
+    for (name, status) in [
+        ("GJKD_QUERY_CONVERGED", gjkd_proto::Status::Converged),
+        ("GJKD_QUERY_FARTHER", gjkd_proto::Status::Farther),
+        ("GJKD_QUERY_CLOSER", gjkd_proto::Status::Closer),
+        ("GJKD_QUERY_ITERATION_CAP", gjkd_proto::Status::IterationCap),
+        (
+            "GJKD_QUERY_TOLERANCE_NOT_MET",
+            gjkd_proto::Status::ToleranceNotMet,
+        ),
+    ] {
+        let line = format!("{name} = {},", status.raw());
+        assert!(GENERATED.contains(&line), "{line} missing from the header");
+    }
+}
+
+#[test]
+fn every_function_is_documented() {
+    // A declaration `... gjkd_xxx(` must follow a comment line.
+    let lines: Vec<&str> = GENERATED.lines().collect();
+    let mut functions = 0;
+    for (i, line) in lines.iter().enumerate() {
+        let is_decl =
+            !line.starts_with([' ', '/', '#', '}']) && line.contains("gjkd_") && line.contains('(');
+        if is_decl {
+            functions += 1;
+            assert!(
+                i > 0 && lines[i - 1].trim_start().starts_with("//"),
+                "undocumented: {line}"
+            );
+        }
+    }
+    assert!(functions >= 23, "only {functions} functions found");
+}

@@ -89,7 +89,9 @@ pub struct Decomposition {
 impl Mesh {
     /// Reads a mesh file (binary or ASCII STL, OBJ, COLLADA `.dae`) and
     /// scales it by `scale` (per axis); all the file's meshes are merged,
-    /// COLLADA's unit and node transforms applied.
+    /// COLLADA's unit and node transforms applied. Coordinates are read in
+    /// single precision (binary STL's own; the `mesh-loader` crate reads
+    /// OBJ and COLLADA text that way too), then widened and scaled.
     ///
     /// # Errors
     /// [`MeshError::Io`], [`MeshError::Parse`], [`MeshError::Empty`],

@@ -37,6 +37,7 @@ pub mod commands;
 pub mod journal;
 pub mod objects;
 pub mod persist;
+pub mod robots;
 pub mod scene;
 pub mod server;
 pub mod state;

@@ -115,6 +115,8 @@ pub struct State {
     workspace: gjk::Workspace,
     /// Query clients connected, as last seen by the serving loop.
     clients: u64,
+    /// Robots: kinematics attached to link objects (see [`crate::robots`]).
+    pub(crate) robots: crate::robots::Robots,
 }
 
 /// The shape part of a registration, in the server's terms.
@@ -148,6 +150,7 @@ impl State {
             next_slot: 0,
             persist_errors: 0,
             clients: 0,
+            robots: crate::robots::Robots::default(),
             workspace: gjk::Workspace::new(),
         }
     }
@@ -620,18 +623,30 @@ impl State {
             Some(ItemKind::Distance) => self
                 .distance(client, item)
                 .unwrap_or_else(ItemResult::error),
+            Some(ItemKind::SetJoints) => match crate::robots::set_joints(self, item) {
+                Ok(()) => ItemResult::default(),
+                Err(e) => ItemResult::error(e),
+            },
             None => ItemResult::error(ErrorCode::Malformed),
         }
     }
 
     fn set_pose(&mut self, item: &Item) -> Result<(), ErrorCode> {
-        let object = self
-            .objects
-            .get_mut(&item.a)
-            .ok_or(ErrorCode::UnknownObject)?;
-        object.pose = check_pose(&item.pose_a)?;
+        let pose = check_pose(&item.pose_a)?;
+        self.store_pose(item.a, pose)
+    }
+
+    /// The upper 32 bits of every id of this run.
+    pub(crate) fn id_epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// Stores a checked pose for object `id` (and journals it).
+    pub(crate) fn store_pose(&mut self, id: u64, pose: Isometry3<f64>) -> Result<(), ErrorCode> {
+        let object = self.objects.get_mut(&id).ok_or(ErrorCode::UnknownObject)?;
+        object.pose = pose;
         if let Some(journal) = &mut self.journal
-            && let Err(e) = journal.write(object.slot, item.a, &object.pose)
+            && let Err(e) = journal.write(object.slot, id, &object.pose)
         {
             self.persist_errors += 1;
             tracing::error!("cannot write the pose journal: {e}");
@@ -736,7 +751,9 @@ impl State {
         let op_kind = AdminOp::from_raw(op);
         // Only a registration carries vertices: any other request with a
         // slice is malformed (and would otherwise be silently ignored).
-        if !vertices.is_empty() && op_kind != Some(AdminOp::Register) {
+        if !vertices.is_empty()
+            && !matches!(op_kind, Some(AdminOp::Register | AdminOp::AttachRobot))
+        {
             reply.error = ErrorCode::Malformed as u32;
             return reply;
         }
@@ -763,6 +780,9 @@ impl State {
                 Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
                 None => Err(ErrorCode::Malformed),
             },
+            Some(AdminOp::AttachRobot) => {
+                crate::robots::attach_request(self, requester, request, vertices)
+            }
             None => Err(ErrorCode::Malformed),
         };
         match outcome {

@@ -39,5 +39,6 @@ pub mod objects;
 pub mod persist;
 pub mod robots;
 pub mod scene;
+pub mod scene_robots;
 pub mod server;
 pub mod state;

@@ -266,7 +266,7 @@ joints = { turn = 0.5 }
     #[test]
     fn bad_robots_and_meshes_in_a_scene_are_reported() {
         let dir = folder("bad");
-        let err = |toml: &str| load(&dir, toml).err().expect("refused").to_string();
+        let err = |toml: &str| load(&dir, toml).expect_err("refused").to_string();
         let e = err(&SCENE.replace("joints = { turn = 0.5 }", "joints = { turn = 5.0 }"));
         assert!(e.contains("outside its limits"), "{e}");
         let e = err(&SCENE.replace("joints = { turn = 0.5 }", "joints = { twist = 0.5 }"));

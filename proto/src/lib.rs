@@ -908,6 +908,15 @@ impl AdminOp {
     }
 }
 
+/// Values of [`AdminRequest::shape`] for [`AdminOp::Lookup`].
+pub mod lookup_kind {
+    /// Look up an object (the default, 0).
+    pub const OBJECT: u32 = 0;
+    /// Look up a robot attached with [`AdminOp::AttachRobot`](super::AdminOp::AttachRobot)
+    /// or loaded from the scene file: the reply's id is the robot's.
+    pub const ROBOT: u32 = 1;
+}
+
 /// Values of [`AdminRequest::shape`].
 pub mod shape_kind {
     /// One convex piece: `pieces[0]` describes it (its offset is ignored).

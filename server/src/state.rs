@@ -776,9 +776,12 @@ impl State {
                     })
                 }),
             Some(AdminOp::Remove) => self.remove_committed(request.id, requester),
-            Some(AdminOp::Lookup) => match request.name() {
-                Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
-                None => Err(ErrorCode::Malformed),
+            Some(AdminOp::Lookup) => match (request.name(), request.shape) {
+                (Some(name), 0) => self.lookup(name).ok_or(ErrorCode::UnknownName),
+                (Some(name), gjkd_proto::lookup_kind::ROBOT) => {
+                    self.robots.lookup(name).ok_or(ErrorCode::UnknownName)
+                }
+                _ => Err(ErrorCode::Malformed),
             },
             Some(AdminOp::AttachRobot) => {
                 crate::robots::attach_request(self, requester, request, vertices)

@@ -45,5 +45,5 @@ pub mod srdf;
 pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
 pub use mesh::{Decomposition, Mesh, MeshError};
 pub use paths::{PACKAGE_PATH_ENV, PackagePath};
-pub use robot::{LinkModel, RobotError, RobotModel};
+pub use robot::{CylinderError, LinkModel, RobotError, RobotModel, cylinder};
 pub use srdf::{SrdfError, disabled_pairs};

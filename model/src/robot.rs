@@ -8,7 +8,7 @@
 //! collision elements has no shape.
 //!
 //! `<cylinder>` is refused with [`RobotError::Cylinder`] until gjk has an
-//! exact cylinder (see `element_convex`): gjkd never approximates one by a
+//! exact cylinder (see [`cylinder`]): gjkd never approximates one by a
 //! polytope.
 
 use std::path::{Path, PathBuf};
@@ -161,6 +161,38 @@ fn link_shape(
     Ok(Some(shape))
 }
 
+/// Why a cylinder could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CylinderError {
+    /// gjk has no exact cylinder yet, and gjkd does not approximate one.
+    #[error(
+        "cylinders are not supported yet (gjkd has no exact cylinder shape; it does not approximate one)"
+    )]
+    Unsupported,
+    /// A size is negative or not finite.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// A cylinder along z, centred on its frame's origin: the one place where
+/// URDF `<cylinder>` elements and scene-file cylinders become a shape.
+///
+/// # Errors
+/// [`CylinderError::Invalid`] for a negative or non-finite size;
+/// [`CylinderError::Unsupported`] always otherwise, for now.
+pub fn cylinder(radius: f64, half_height: f64) -> Result<Convex, CylinderError> {
+    if !(radius.is_finite() && radius >= 0.0 && half_height.is_finite() && half_height >= 0.0) {
+        return Err(CylinderError::Invalid(format!(
+            "cylinder radius {radius} and half height {half_height} must be finite and >= 0"
+        )));
+    }
+    // CYLINDER HOOK: when gjk has an exact cylinder (a disk swept along a
+    // segment, by its support function), build it here from `radius` and
+    // `half_height`, axis z as in URDF. Until then it is refused, never
+    // approximated by a polytope.
+    Err(CylinderError::Unsupported)
+}
+
 /// One collision element as a convex shape in its own frame.
 fn element_convex(
     link: &str,
@@ -193,13 +225,12 @@ fn element_convex(
             let h = length / 2.0;
             Convex::capsule(Point3::new(0.0, 0.0, -h), Point3::new(0.0, 0.0, h), *radius)
         }
-        // CYLINDER HOOK: the one place a URDF `<cylinder>` becomes a shape.
-        // When gjk has an exact cylinder (radius, half-height = length / 2,
-        // axis z as in URDF), build it here; until then it is refused, never
-        // approximated.
-        G::Cylinder { .. } => {
-            return Err(RobotError::Cylinder {
-                link: link.to_owned(),
+        G::Cylinder { radius, length } => {
+            return cylinder(*radius, length / 2.0).map_err(|e| match e {
+                CylinderError::Unsupported => RobotError::Cylinder {
+                    link: link.to_owned(),
+                },
+                CylinderError::Invalid(reason) => bad(reason),
             });
         }
         G::Mesh { filename, scale } => {

@@ -290,3 +290,60 @@ joints = { turn = 0.5 }
         std::fs::remove_dir_all(dir).unwrap();
     }
 }
+
+#[cfg(test)]
+mod doc_tests {
+    use crate::scene::Scene;
+    use crate::state::{Limits, State};
+    use gjkd_proto::WaitMode;
+
+    const ARM: &str = r#"<robot name="arm">
+      <link name="base"><collision><geometry><mesh filename="package://arm/base.obj"/></geometry></collision></link>
+      <link name="upper"><collision><geometry><box size="0.1 0.1 0.4"/></geometry></collision></link>
+      <link name="fore"><collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+        <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
+        <origin xyz="0 0 0.4"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+    </robot>"#;
+
+    const TETRA_OBJ: &str =
+        "v 0 0 0\nv 1000 0 0\nv 0 1000 0\nv 0 0 1000\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+    #[test]
+    fn the_robot_doc_example_loads() {
+        let doc = include_str!("../../docs/scene-files.md");
+        let section = &doc[doc.find("## Robots and meshes").expect("the section")..];
+        let toml: String = section
+            .lines()
+            .skip_while(|l| !l.starts_with("```toml"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("```"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let dir = std::env::temp_dir().join(format!("gjkd-scene-doc-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("meshes")).unwrap();
+        std::fs::create_dir_all(dir.join("packages/arm")).unwrap();
+        std::fs::write(dir.join("meshes/shelf.stl"), "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1000 0 0\nvertex 0 1000 0\nendloop\nendfacet\nendsolid s\n").unwrap();
+        std::fs::write(dir.join("packages/arm/base.obj"), TETRA_OBJ).unwrap();
+        std::fs::write(dir.join("arm.urdf"), ARM).unwrap();
+        std::fs::write(
+            dir.join("arm.srdf"),
+            r#"<robot name="arm"><disable_collisions link1="base" link2="fore" reason="Never"/></robot>"#,
+        )
+        .unwrap();
+        std::fs::write(dir.join("scene.toml"), toml).unwrap();
+        let scene = Scene::load(&dir.join("scene.toml")).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        assert_eq!(ids.len(), 4, "the shelf and three links");
+        let robot = state
+            .robots
+            .get(state.robots.lookup("arm").unwrap())
+            .unwrap();
+        assert_eq!(robot.positions, [0.3, -1.0]);
+        assert_eq!(robot.allowed, [(0, 1), (0, 2), (1, 2)]);
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}

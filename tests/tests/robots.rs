@@ -254,21 +254,19 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
 fn a_robot_and_a_mesh_from_the_scene_file_are_served() {
     let dir = folder("scene");
     write_box_stl(&dir.join("block.stl"), [0.5, 0.25, 0.125]);
-    let scene = format!(
-        r#"
+    let scene = r#"
 [[object]]
 name = "block"
 type = "mesh"
 file = "block.stl"
-pose = {{ translation = [3.0, 0.0, 0.0] }}
+pose = { translation = [3.0, 0.0, 0.0] }
 
 [[robot]]
 name = "arm"
 urdf = "arm.urdf"
-pose = {{ translation = [0.0, 0.0, 1.0] }}
-joints = {{ elbow = 0.5 }}
-"#
-    );
+pose = { translation = [0.0, 0.0, 1.0] }
+joints = { elbow = 0.5 }
+"#;
     std::fs::write(dir.join("scene.toml"), scene).unwrap();
     let scene_path = dir.join("scene.toml");
     let pkg = dir.join("pkg");

@@ -2,7 +2,7 @@
 //!
 //! It starts `gjkd serve` as a child process on a private service name,
 //! registers the Section 8 scene (a compound object moving and turning
-//! through five fixed obstacles, from `gjk::paper::section8`) through the
+//! through five fixed obstacles, from `gjkd_testkit::paper::section8`) through the
 //! client library, sweeps the path at T = 10, 100 and 1000 steps, and prints
 //! the distance to each obstacle along the path and the time of cold-started
 //! sweeps against sweeps warm-started from the server's per-pair cache, beside
@@ -21,9 +21,9 @@ use std::io::Write;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use gjk::paper::{self, Motion, OBSTACLES};
 use gjk::{Options, Shape};
 use gjkd_client::{Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions};
+use gjkd_testkit::paper::{self, Motion, OBSTACLES};
 use nalgebra::Isometry3;
 
 /// The paper's Table 1: time without warm start over time with it, for

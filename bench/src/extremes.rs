@@ -14,7 +14,7 @@
 //!
 //! Almost every case is axis-aligned boxes (possibly flat), spheres or
 //! segments placed by translations only, so its distance has a closed form in
-//! the very `f64` inputs ([`super::reference::aabb_distance`]); the scaled
+//! the very `f64` inputs ([`gjkd_testkit::reference::aabb_distance`]); the scaled
 //! polytopes are left to the brute force.
 
 use gjk::{Convex, Shape};
@@ -59,7 +59,7 @@ fn boxes(
     hb: [f64; 3],
     cb: [f64; 3],
 ) -> RawCase {
-    let d = super::reference::aabb_distance(
+    let d = gjkd_testkit::reference::aabb_distance(
         &Vector3::from(ca),
         &Vector3::from(ha),
         &Vector3::from(cb),
@@ -318,7 +318,7 @@ impl Rng {
 /// brute force: the radii come off the core distance exactly).
 fn rounded(out: &mut Vec<RawCase>) {
     let mut rng = Rng(0x0005_eed5);
-    for (i, poly) in gjk::paper::family().into_iter().enumerate() {
+    for (i, poly) in gjkd_testkit::paper::family().into_iter().enumerate() {
         for k in 0..2 {
             let r = rng.range(0.2, 1.0);
             let dir = rng.direction();

@@ -12,7 +12,7 @@
 //!   HdrHistogram percentiles.
 //! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
 //!   and cold starts and early-exit margins, judged by an exact reference
-//!   ([`reference`](mod@reference)) that owes nothing to GJK.
+//!   ([`gjkd_testkit::reference`](mod@gjkd_testkit::reference)) that owes nothing to GJK.
 //! - [`paper`]: the paper's Section 7, time per query against the number of
 //!   vertices `M`.
 //! - [`robot`]: a 7-joint robot moved by one joint request, against link
@@ -20,7 +20,7 @@
 //!
 //! Each writes a table to stdout, CSV and SVG plots to `--out`, and shows a
 //! progress bar while it runs. Timing is never asserted anywhere: the tests
-//! cover only the logic (percentiles, fits, the Pareto front, the reference).
+//! cover only the logic (percentiles, fits, the Pareto front).
 
 #![warn(missing_docs)]
 
@@ -31,7 +31,6 @@ pub mod extremes;
 pub mod latency;
 pub mod paper;
 pub mod plot;
-pub mod reference;
 pub mod robot;
 pub mod robot_demo;
 pub mod stats;

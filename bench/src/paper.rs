@@ -11,8 +11,8 @@ use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;
 
-use gjk::paper::{self, Case, PAIRS};
 use gjk::{Options, Shape};
+use gjkd_testkit::paper::{self, Case, PAIRS};
 
 use super::plot::{self, Axis, Chart, Mark, Series};
 use super::stats::{Csv, Fit, Progress, fit_line, mean};

@@ -488,8 +488,8 @@ const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
 const YIELD_FOR: Duration = Duration::from_millis(2);
 /// While busy-polling, give the core away this often: a server the kernel
-/// woke onto this core cannot answer while the client holds it (on a busy
-/// 2-core machine that made a client spin out its whole 100 µs).
+/// woke onto this core cannot answer while the client holds it, and on a
+/// machine with few cores the client would spin out its whole `SPIN_FOR`.
 const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {
@@ -544,12 +544,17 @@ impl Client {
     fn open_failed(&self, service: &str, cause: OpenFailure) -> ClientError {
         match cause {
             OpenFailure::Missing => {
-                let ours = [
+                let (query, admin, wake) = (
                     query_service_name(&self.service),
                     admin_service_name(&self.service),
                     wake_service_name(&self.service),
+                );
+                let ours = [
+                    (query.as_str(), false),
+                    (admin.as_str(), false),
+                    (wake.as_str(), true),
                 ];
-                match name_taken_by(&self.service, ours.each_ref().map(String::as_str)) {
+                match name_taken_by(&self.service, ours) {
                     Some(NameTakenBy::Version(server)) => ClientError::VersionMismatch {
                         service: self.service.clone(),
                         server,
@@ -806,8 +811,9 @@ impl Client {
     ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
     ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
     ///   piece offset), [`ErrorCode::TooManyObjects`] (the server's
-    ///   `--max-objects`), [`ErrorCode::Internal`] (the server could not
-    ///   write the object to its store, for example on a full disk).
+    ///   `--max-objects`), [`ErrorCode::StorageFull`] (the server's disk
+    ///   has no room to store the object; the same call succeeds once there
+    ///   is room), [`ErrorCode::Internal`] (the store failed otherwise).
     /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`]. **The
     ///   registration may then have happened**: the request may have
     ///   reached the server and been stored before the server died or the
@@ -982,7 +988,10 @@ impl Client {
     ///
     /// # Errors
     /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
-    /// client's object, [`ErrorCode::ReadOnly`] for a scene object.
+    /// client's object, [`ErrorCode::ReadOnly`] for a scene object,
+    /// [`ErrorCode::StorageFull`] when the server's disk has no room to
+    /// store the removal (the object stays; the same call succeeds once
+    /// there is room).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.id = id.raw();

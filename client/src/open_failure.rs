@@ -5,6 +5,7 @@ use iceoryx2::config::Config;
 use iceoryx2::prelude::*;
 use iceoryx2::service::builder::event::EventOpenError;
 use iceoryx2::service::builder::request_response::RequestResponseOpenError;
+use iceoryx2::service::static_config::messaging_pattern::MessagingPattern;
 
 /// The classes of open failure that lead to different [`ClientError`]s.
 ///
@@ -94,8 +95,11 @@ pub(crate) enum NameTakenBy {
 }
 
 /// Who holds `service`'s names (any protocol version) in a way that keeps
-/// this client from using them, if anyone does.
-pub(crate) fn name_taken_by(service: &str, ours: [&str; 3]) -> Option<NameTakenBy> {
+/// this client from using them, if anyone does. `ours` are our three names
+/// with whether each is an event service (the others are request-response);
+/// finding one of them with its own pattern is no obstacle: it is a server
+/// still starting or going away.
+pub(crate) fn name_taken_by(service: &str, ours: [(&str, bool); 3]) -> Option<NameTakenBy> {
     let prefix = format!("{service}/v");
     let mut found = None;
     let _ = ipc::Service::list(Config::global_config(), |details| {
@@ -107,11 +111,14 @@ pub(crate) fn name_taken_by(service: &str, ours: [&str; 3]) -> Option<NameTakenB
             .and_then(|v| v.parse::<u32>().ok());
         found = match version {
             Some(v) if v != gjkd_proto::PROTOCOL_VERSION => Some(NameTakenBy::Version(v)),
-            _ if ours.contains(&name) => Some(NameTakenBy::OtherPattern {
-                name: name.to_owned(),
-                pattern: format!("{:?}", config.messaging_pattern()),
-            }),
-            _ => None,
+            _ => ours
+                .iter()
+                .find(|(ours, _)| *ours == name)
+                .filter(|(_, event)| !has_pattern(config.messaging_pattern(), *event))
+                .map(|_| NameTakenBy::OtherPattern {
+                    name: name.to_owned(),
+                    pattern: pattern_name(config.messaging_pattern()).to_owned(),
+                }),
         };
         if found.is_some() {
             CallbackProgression::Stop
@@ -120,4 +127,21 @@ pub(crate) fn name_taken_by(service: &str, ours: [&str; 3]) -> Option<NameTakenB
         }
     });
     found
+}
+
+fn has_pattern(pattern: &MessagingPattern, event: bool) -> bool {
+    if event {
+        matches!(pattern, MessagingPattern::Event(_))
+    } else {
+        matches!(pattern, MessagingPattern::RequestResponse(_))
+    }
+}
+
+fn pattern_name(pattern: &MessagingPattern) -> &'static str {
+    match pattern {
+        MessagingPattern::RequestResponse(_) => "request-response",
+        MessagingPattern::PublishSubscribe(_) => "publish-subscribe",
+        MessagingPattern::Event(_) => "event",
+        _ => "differently patterned",
+    }
 }

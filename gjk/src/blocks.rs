@@ -19,18 +19,17 @@ use crate::shape::{robust_norm, scan_top};
 
 /// Vertices per block: a multiple of the AVX2 scan's eight lanes, near the
 /// square root of the set's size, so that bounding every block costs about
-/// as much as scanning the few blocks that cannot be skipped. Measured (cold
-/// queries on round and box-shaped clouds): from 1 024 to 16 384 vertices 64
-/// is best or within 5 % of it (32 is up to 23 % slower, 128 up to 9 %); at
-/// 100 000, 128 is 17 % faster than 64.
+/// as much as scanning the few blocks that cannot be skipped. Cold queries
+/// on round and box-shaped clouds found 64 best or nearly so up to some
+/// 16 000 vertices, and 128 faster on the largest sets.
 fn block_size(n: usize) -> usize {
     if n < 32_768 { 64 } else { 128 }
 }
 
 /// Sets with fewer vertices keep the plain scan: with a handful of blocks,
-/// bounding them costs about what skipping saves. Measured against the scan
-/// (cold queries on round and box-shaped clouds): 0.7–0.8× at 256 vertices,
-/// 1.0–1.1× at 512, 1.4× at 1 024.
+/// bounding them costs about what skipping saves: against the scan (cold
+/// queries on round and box-shaped clouds) the block search loses below
+/// this size, breaks even at it and wins above.
 pub(crate) const MIN_VERTICES: usize = 512;
 
 /// Relative growth of each bounding sphere, far above the few units of
@@ -75,8 +74,8 @@ impl Blocks {
     pub(crate) fn new(xs: &[f64], ys: &[f64], zs: &[f64], n: usize) -> Self {
         let block = block_size(n);
         // The points themselves are partitioned, not indices into them:
-        // the splits then read memory in order (3× faster to build at 10^6
-        // vertices than through indices, measured).
+        // the splits then read memory in order, which builds large sets
+        // several times faster than through indices.
         let mut pts: Vec<([f64; 3], u32)> =
             (0..n).map(|i| ([xs[i], ys[i], zs[i]], i as u32)).collect();
         split(&mut pts, block);

@@ -349,9 +349,9 @@ impl Simplex {
             // its leading minor times the last squared edge), and the
             // incremental pass below would have kept every point.
             let independent = match points.len() {
-                2 => self.load::<2, 0b11>(points),
-                3 => self.load::<3, 0b111>(points),
-                _ => self.load::<4, 0b1111>(points),
+                2 => self.load_cofactors::<2, 0b11>(points),
+                3 => self.load_cofactors::<3, 0b111>(points),
+                _ => self.load_cofactors::<4, 0b1111>(points),
             };
             if independent {
                 self.newest = None;
@@ -378,7 +378,7 @@ impl Simplex {
     /// cofactor, unrolled for the size (a warm start's usual path), and
     /// whether the set is independent.
     #[inline(always)]
-    fn load<const K: usize, const ALL: usize>(&mut self, points: &[Vertex]) -> bool {
+    fn load_cofactors<const K: usize, const ALL: usize>(&mut self, points: &[Vertex]) -> bool {
         self.vertices[..K].copy_from_slice(&points[..K]);
         for i in 0..K {
             for j in 0..=i {
@@ -388,13 +388,13 @@ impl Simplex {
             }
         }
         self.all = ALL as u8;
-        self.fill::<ALL>();
+        self.fill_cofactors::<ALL>();
         self.independent_in(ALL)
     }
 
     /// The cofactors of every subset of `ALL`, smallest first, unrolled.
     #[inline(always)]
-    fn fill<const ALL: usize>(&mut self) {
+    fn fill_cofactors<const ALL: usize>(&mut self) {
         macro_rules! step {
             ($($k:literal)*) => {$(
                 if const { BY_SIZE[$k] as usize & !ALL == 0 } {
@@ -409,14 +409,14 @@ impl Simplex {
     /// products and cofactors that involve it.
     #[inline(always)]
     pub fn push(&mut self, keep: u8, p: Vertex) {
-        let slot = self.keep(keep);
+        let slot = self.slot_after_keeping(keep);
         self.insert(slot, p);
         self.newest = Some(slot);
     }
 
     /// `Y = V̂` ahead of a push: the slot the new point goes to.
     #[inline(always)]
-    fn keep(&mut self, keep: u8) -> u8 {
+    fn slot_after_keeping(&mut self, keep: u8) -> u8 {
         debug_assert!(keep.count_ones() <= 3);
         self.all = keep;
         (!keep).trailing_zeros() as u8
@@ -427,7 +427,7 @@ impl Simplex {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     pub fn push_avx2(&mut self, keep: u8, p: Vertex) {
-        let slot = self.keep(keep);
+        let slot = self.slot_after_keeping(keep);
         self.insert_avx2(slot, p);
         self.newest = Some(slot);
     }
@@ -465,7 +465,7 @@ impl Simplex {
         macro_rules! dispatch {
             ($($n:literal => [$($all:literal),*]),*) => {
                 match (n_us, self.all as usize) {
-                    $($(($n, $all) => self.update::<$n, $all>(),)*)*
+                    $($(($n, $all) => self.update_cofactors::<$n, $all>(),)*)*
                     _ => {
                         let (list, len) = WITH_NEW[n_us][self.all as usize & 15];
                         for &mask in list.iter().take(len as usize) {
@@ -486,7 +486,7 @@ impl Simplex {
     /// The cofactors of every subset of `ALL` that holds slot `N`, smallest
     /// first, unrolled: each step's subset is a constant.
     #[inline(always)]
-    fn update<const N: usize, const ALL: usize>(&mut self) {
+    fn update_cofactors<const N: usize, const ALL: usize>(&mut self) {
         macro_rules! step {
             ($($k:literal)*) => {$(
                 if const { WITH_NEW[N][ALL].1 > $k } {
@@ -633,7 +633,7 @@ impl Simplex {
     /// that: the lower bound of Theorem 4.1 stays tight.
     #[cold]
     #[inline(never)]
-    fn thin_v(&self, mask: usize) -> Option<Vector3<f64>> {
+    fn thin_simplex_v(&self, mask: usize) -> Option<Vector3<f64>> {
         let (mem, _) = MEMBERS[mask & 15];
         let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
         let [yi, yj, yk] = [i, j, k].map(|x| self.vertices[x].y);
@@ -781,8 +781,8 @@ impl Simplex {
             return vols.iter().all(|&v| (v > 0.0) == (total > 0.0));
         }
         // Each volume's test again, for the rare exact path: carrying the
-        // four flags through the common path costs more (13 instructions an
-        // intersecting query, measured).
+        // four flags through the common path costs every intersecting query
+        // more than the rare recomputation does.
         self.holds_origin_exactly(&vols.map(|v| (v, v * v > bound)))
     }
 
@@ -874,7 +874,7 @@ impl Simplex {
         }
         if len == 3
             && self.is_thin(mask)
-            && let Some(p) = self.thin_v(mask)
+            && let Some(p) = self.thin_simplex_v(mask)
         {
             v = p;
         }
@@ -904,22 +904,22 @@ impl Simplex {
     fn solve_inline(&self) -> Option<Solution> {
         let all = self.all as usize;
         match self.newest {
-            Some(n) => by_shape!(n as usize, all, N, ALL => self.solve_of::<N, ALL>(), {
-                self.solve_any()
+            Some(n) => by_shape!(n as usize, all, N, ALL => self.solve_after_push::<N, ALL>(), {
+                self.solve_warm()
             }),
-            None => self.solve_any(),
+            None => self.solve_warm(),
         }
     }
 
     /// [`solve`](Self::solve) after a push of slot `N` into the set `ALL`.
     #[inline(always)]
-    fn solve_of<const N: usize, const ALL: usize>(&self) -> Option<Solution> {
+    fn solve_after_push<const N: usize, const ALL: usize>(&self) -> Option<Solution> {
         let old = ALL & !(1 << N);
         if old == 0 {
             return Some(self.solution(ALL));
         }
         // First the face that drops the old vertex most aligned with the
-        // newest point: it holds the answer about 80% of the time.
+        // newest point: it most often holds the answer.
         let (mem, len) = const { MEMBERS[ALL & !(1 << N)] };
         let mut drop = mem[0] as usize & 3;
         for &i in &mem[1..len as usize] {
@@ -930,13 +930,13 @@ impl Simplex {
         }
         let first = ALL & !(1 << drop);
         if by_mask!(first, M => self.passes_in(M, ALL)) {
-            return Some(self.solution_by(first));
+            return Some(self.solution_specialised(first));
         }
         let (list, len) = const { ORDER[N][ALL] };
         for &m in &list[..len as usize] {
             let m = m as usize;
             if m != first && by_mask!(m, M => self.passes_in(M, ALL)) {
-                return Some(self.solution_by(m));
+                return Some(self.solution_specialised(m));
             }
         }
         None
@@ -944,16 +944,16 @@ impl Simplex {
 
     /// [`solve`](Self::solve) for a fresh `V0` (a warm start), where the whole
     /// set is the likeliest answer.
-    fn solve_any(&self) -> Option<Solution> {
+    fn solve_warm(&self) -> Option<Solution> {
         if self.all == 0 {
             return None;
         }
-        by_mask!(self.all as usize, ALL => self.solve_fresh::<ALL>())
+        by_mask!(self.all as usize, ALL => self.solve_warm_set::<ALL>())
     }
 
-    /// [`solve_any`](Self::solve_any) for the set `ALL`, unrolled.
+    /// [`solve_warm`](Self::solve_warm) for the set `ALL`, unrolled.
     #[inline(always)]
-    fn solve_fresh<const ALL: usize>(&self) -> Option<Solution> {
+    fn solve_warm_set<const ALL: usize>(&self) -> Option<Solution> {
         macro_rules! step {
             ($($k:literal)*) => {$(
                 if const { DOWN[ALL].1 > $k } {
@@ -970,13 +970,13 @@ impl Simplex {
 
     /// [`solution`](Self::solution), one specialised body per subset.
     #[inline(always)]
-    fn solution_by(&self, mask: usize) -> Solution {
+    fn solution_specialised(&self, mask: usize) -> Solution {
         by_mask!(mask, M => self.solution(M))
     }
 
     /// The Backup Procedure (6.5): among the subsets with `Δ > 0` and every
     /// `Δ_i > 0`, the one whose affine hull is nearest the origin (measured
-    /// on the `v` it gives, see `backup_d2`).
+    /// on the `v` it gives, see `backup_distance2`).
     /// Always succeeds: a single point qualifies.
     pub fn backup(&self) -> Solution {
         let all = self.all as usize;
@@ -986,7 +986,7 @@ impl Simplex {
             if mask & !all != 0 {
                 continue;
             }
-            let d2 = by_mask!(mask, M => self.backup_d2(M));
+            let d2 = by_mask!(mask, M => self.backup_distance2(M));
             if d2 < best_d2 {
                 best_d2 = d2;
                 best = mask;
@@ -997,13 +997,13 @@ impl Simplex {
         if best == 0 {
             best = all & all.wrapping_neg();
         }
-        self.solution_by(best)
+        self.solution_specialised(best)
     }
 
     /// `|v(aff Y_s)|²` for a candidate of the Backup Procedure, infinity for a
     /// subset that is not one.
     #[inline(always)]
-    fn backup_d2(&self, mask: usize) -> f64 {
+    fn backup_distance2(&self, mask: usize) -> f64 {
         if !self.interior(mask) || (mask == 0b1111 && !self.holds_origin()) {
             return f64::INFINITY;
         }
@@ -1127,7 +1127,7 @@ impl Simplex {
                 lambda[base] += mu;
                 sol.v - e * mu
             }
-            // A thin triangle's v is already its plane's (`thin_v`); the
+            // A thin triangle's v is already its plane's (`thin_simplex_v`); the
             // normal equations below would square its condition.
             3 if self.is_thin(sol.mask as usize) => return None,
             3 => {
@@ -1166,8 +1166,8 @@ impl Simplex {
     /// whose weight (1e-16) moves `v` across the set by more than `v`'s own
     /// round-off while `|v|` changes by less. A needle lying along a prism's
     /// edge, the support search then tied between the edge's two faces by
-    /// the sign of that sideways error, stopped at 5.6e-5 of a truth of
-    /// 1.6e-11 (`mid_sets` seed 8554, pair 164). `None` when `y_j` is not a
+    /// the sign of that sideways error, stopped far short of its distance
+    /// (the `mid_sets` sweep found it). `None` when `y_j` is not a
     /// dropped vertex, when the grown subset would be the whole tetrahedron
     /// (see [`origin_weights`](Self::origin_weights)), or when
     /// [`refine`](Self::refine) declines.
@@ -1262,7 +1262,7 @@ fn exact_volume_without(y: &[Vector3<f64>; 4], l: usize) -> f64 {
 mod tests {
     use super::*;
 
-    fn vtx(x: f64, y: f64, z: f64) -> Vertex {
+    fn vertex_at(x: f64, y: f64, z: f64) -> Vertex {
         Vertex {
             y: Vector3::new(x, y, z),
             ia: 0,
@@ -1274,10 +1274,10 @@ mod tests {
     fn cofactors_match_gram_determinant() {
         // Δ(Y_s) is the Gram determinant of the edge vectors (Theorem 5.1 proof).
         let pts = [
-            vtx(1.0, 0.2, 0.3),
-            vtx(-0.5, 1.0, 0.1),
-            vtx(0.3, -0.7, 1.2),
-            vtx(0.9, 0.4, -1.1),
+            vertex_at(1.0, 0.2, 0.3),
+            vertex_at(-0.5, 1.0, 0.1),
+            vertex_at(0.3, -0.7, 1.2),
+            vertex_at(0.9, 0.4, -1.1),
         ];
         let s = Simplex::new(&pts);
         let e1 = pts[1].y - pts[0].y;
@@ -1289,23 +1289,23 @@ mod tests {
         assert!((s.total(0b0111) - a).abs() < 1e-12 * a);
     }
 
-    /// The triangle of `mid_sets` seed 8554 (see `regrow`): a needle's edge
+    /// The needle's triangle of `regrow`'s documentation: an edge
     /// of K 5.55e-5 from the origin and a vertex 1.3e5 away whose weight in
     /// the nearest point is about 1e-16.
     #[test]
     fn regrow_restores_a_far_vertex_lost_to_round_off() {
         let mut pts = [
-            vtx(
+            vertex_at(
                 9.166550882371626e-12,
                 5.365944365714793e-5,
                 -61997.68103873958,
             ),
-            vtx(
+            vertex_at(
                 -22760.413943159896,
                 8.154773311155362e-12,
                 131071.99999999999,
             ),
-            vtx(
+            vertex_at(
                 -5.385364345995226e-12,
                 6.0975361175549454e-5,
                 181151.45797131996,
@@ -1342,7 +1342,7 @@ mod tests {
 
     #[test]
     fn segment_nearest_point_is_projection() {
-        let s = Simplex::new(&[vtx(-1.0, 1.0, 0.0), vtx(3.0, 1.0, 0.0)]);
+        let s = Simplex::new(&[vertex_at(-1.0, 1.0, 0.0), vertex_at(3.0, 1.0, 0.0)]);
         let sol = s.solve().unwrap();
         assert_eq!(sol.mask, 0b11);
         assert!((sol.v - Vector3::new(0.0, 1.0, 0.0)).norm() < 1e-15);
@@ -1353,10 +1353,10 @@ mod tests {
     fn tetrahedron_with_origin_inside_and_its_inner_radius() {
         let mut s = Simplex::empty();
         s.reset(&[
-            vtx(1.0, 1.0, 1.0),
-            vtx(1.0, -1.0, -1.0),
-            vtx(-1.0, 1.0, -1.0),
-            vtx(-1.0, -1.0, 1.0),
+            vertex_at(1.0, 1.0, 1.0),
+            vertex_at(1.0, -1.0, -1.0),
+            vertex_at(-1.0, 1.0, -1.0),
+            vertex_at(-1.0, -1.0, 1.0),
         ]);
         let sol = s.solve().unwrap();
         assert_eq!(sol.mask, 0b1111);
@@ -1375,10 +1375,10 @@ mod tests {
         let at = |h: f64| {
             let mut s = Simplex::empty();
             s.reset(&[
-                vtx(0.3, 0.2, 1.0),
-                vtx(-1.0, -1.0, -h),
-                vtx(2.0, -1.0, -h),
-                vtx(-1.0, 2.0, -h),
+                vertex_at(0.3, 0.2, 1.0),
+                vertex_at(-1.0, -1.0, -h),
+                vertex_at(2.0, -1.0, -h),
+                vertex_at(-1.0, 2.0, -h),
             ]);
             s
         };
@@ -1393,10 +1393,10 @@ mod tests {
         // Clear volumes of both signs: the origin beyond an edge, far out.
         let mut s = Simplex::empty();
         s.reset(&[
-            vtx(5.0, 5.0, 1.0),
-            vtx(4.0, 4.0, 0.0),
-            vtx(7.0, 4.0, 0.0),
-            vtx(4.0, 7.0, 0.0),
+            vertex_at(5.0, 5.0, 1.0),
+            vertex_at(4.0, 4.0, 0.0),
+            vertex_at(7.0, 4.0, 0.0),
+            vertex_at(4.0, 7.0, 0.0),
         ]);
         assert!(!s.holds_origin());
     }
@@ -1419,7 +1419,7 @@ mod tests {
             .zip(want)
             .fold(Vector3::zeros(), |s, (c, w)| s + c * w);
         let last = -rest / want[3];
-        let pts = [corners[0], corners[1], corners[2], last].map(|c| vtx(c.x, c.y, c.z));
+        let pts = [corners[0], corners[1], corners[2], last].map(|c| vertex_at(c.x, c.y, c.z));
         // As a run builds it, by a push: `new` would keep a flat set to
         // its independent points.
         let four = |p: &[Vertex; 4]| {
@@ -1438,14 +1438,14 @@ mod tests {
         // Round-off of the points' size (about 4), not of a flat cofactor.
         assert!(v.amax() < 32.0 * f64::EPSILON, "{v:?}");
         // Lifted by ten times its thickness: the origin is just below it.
-        let off = pts.map(|p| vtx(p.y.x, p.y.y, p.y.z + 10.0 * h));
+        let off = pts.map(|p| vertex_at(p.y.x, p.y.y, p.y.z + 10.0 * h));
         assert_eq!(four(&off).origin_weights(), None);
         // Flat through the origin (all four volumes exactly 0): undecided.
         let flat = [
-            vtx(1.0, 0.0, 0.0),
-            vtx(0.0, 1.0, 0.0),
-            vtx(-1.0, -1.0, 0.0),
-            vtx(2.0, 2.0, 0.0),
+            vertex_at(1.0, 0.0, 0.0),
+            vertex_at(0.0, 1.0, 0.0),
+            vertex_at(-1.0, -1.0, 0.0),
+            vertex_at(2.0, 2.0, 0.0),
         ];
         assert_eq!(four(&flat).origin_weights(), None);
         // Fewer than four points: not asked.
@@ -1454,7 +1454,11 @@ mod tests {
 
     #[test]
     fn backup_picks_nearest_affine_hull() {
-        let s = Simplex::new(&[vtx(1.0, 1.0, 0.0), vtx(1.0, -1.0, 0.0), vtx(2.0, 0.0, 0.0)]);
+        let s = Simplex::new(&[
+            vertex_at(1.0, 1.0, 0.0),
+            vertex_at(1.0, -1.0, 0.0),
+            vertex_at(2.0, 0.0, 0.0),
+        ]);
         let sol = s.backup();
         assert!((sol.v - Vector3::new(1.0, 0.0, 0.0)).norm() < 1e-15);
     }

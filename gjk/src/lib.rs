@@ -33,10 +33,11 @@ mod blocks;
 mod cones;
 mod dd;
 mod johnson;
-pub mod paper;
 mod query;
 mod shape;
 
+#[doc(hidden)]
+pub use query::distance_in_baseline;
 pub use query::{Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_in};
 pub use shape::{Compound, Convex, Shape};
 

@@ -49,16 +49,16 @@ pub struct Convex {
     zs: Vec<f64>,
     /// How the support point is found: a scan in general, a closed form for
     /// the shapes whose support function is one.
-    kind: Kind,
+    kind: SupportKind,
     /// The scanned vertices again in f32, divided by `size` so that every
     /// coordinate lies in [-1, 1] (no overflow, whatever the shape's scale),
     /// for [`Precision::Single`](crate::Precision::Single). None for shapes
     /// that gain nothing from it: closed-form supports, fewer than
     /// [`SINGLE_MIN_VERTICES`] vertices, and [`SINGLE_MAX_VERTICES`] or more.
-    single: Option<Box<Single>>,
-    /// The block search's reordered copy, for [`Kind::Blocks`].
+    single: Option<Box<F32Copy>>,
+    /// The block search's reordered copy, for [`SupportKind::Blocks`].
     blocks: Option<Box<Blocks>>,
-    /// The cube map of candidate lists, for [`Kind::Cones`].
+    /// The cube map of candidate lists, for [`SupportKind::Cones`].
     cones: Option<Box<Cones>>,
 }
 
@@ -81,20 +81,19 @@ pub(crate) const SINGLE_MIN_VERTICES: usize = 16;
 
 /// Shapes with this many vertices or more keep the exact block search under
 /// [`Precision::Single`](crate::Precision::Single): around here it catches
-/// up with the f32 scan of every vertex, and beyond it is faster (measured
-/// A/B on round and box-shaped clouds, cold: 0.86–1.01× the f32 scan at
-/// 1 024 vertices, 1.24–1.26× at 2 048, 2.9–5× at 16 384 to 100 000).
+/// up with the f32 scan of every vertex on round and box-shaped clouds
+/// (cold), and beyond it is faster, by more the larger the set.
 pub(crate) const SINGLE_MAX_VERTICES: usize = 1024;
 
 /// The f32 copy of a shape's scan arrays.
 #[derive(Clone, Debug, PartialEq)]
-struct Single {
+struct F32Copy {
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
 }
 
-impl Single {
+impl F32Copy {
     /// The copy of centroid-relative arrays of a set of size `size`, each
     /// coordinate divided by it; `None` where that cannot be done exactly
     /// enough or the indices would not fit the scan's i32 lanes.
@@ -108,7 +107,7 @@ impl Single {
         }
         let inv = 1.0 / size;
         let to32 = |c: &[f64]| c.iter().map(|&x| (x * inv) as f32).collect();
-        Some(Box::new(Single {
+        Some(Box::new(F32Copy {
             xs: to32(xs),
             ys: to32(ys),
             zs: to32(zs),
@@ -125,7 +124,7 @@ pub(crate) const SINGLE_SLACK: f64 = 1.0 / (1u64 << 20) as f64;
 
 /// The support function's form, decided once from the vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
+enum SupportKind {
     /// One vertex: a sphere's core.
     Point,
     /// Eight vertices `(±h.x, ±h.y, ±h.z)` about the centroid, vertex `i`
@@ -140,12 +139,12 @@ enum Kind {
     /// AVX2 and FMA (checked once, here): the vector scan, called directly.
     #[cfg(target_arch = "x86_64")]
     Avx2,
-    /// As [`Kind::Avx2`] on a CPU without them: the portable scan.
+    /// As [`SupportKind::Avx2`] on a CPU without them: the portable scan.
     Scan,
     /// [`CONES_MIN_VERTICES`] to [`CONES_MAX_VERTICES`] (less one): the cube map's few candidates
     /// for the direction (see [`crate::cones`]), scanned with the arithmetic
     /// of the scan the shape would otherwise use (fused when `fused`, the
-    /// [`Kind::Avx2`] scan's), so the same vertex; that scan for the
+    /// [`SupportKind::Avx2`] scan's), so the same vertex; that scan for the
     /// directions the map declines.
     Cones { fused: bool },
     /// Larger sets: the block search, exact and the scan's own choice, which
@@ -158,9 +157,8 @@ impl Convex {
     ///
     /// Sets of 512 vertices or more also get an index for the support
     /// search: the vertices sorted into blocks of nearby points (a copy,
-    /// 28 bytes a vertex), built in O(n log n): about 15 ms for 100 000
-    /// vertices, against 2 ms without it, measured on this project's
-    /// 2-core machine.
+    /// 28 bytes a vertex), built in O(n log n), which makes building a large
+    /// shape several times slower than without it.
     ///
     /// # Errors
     /// [`Error::EmptyVertices`] for no vertices, [`Error::TooManyVertices`] past
@@ -169,61 +167,13 @@ impl Convex {
     /// [`Error::InvalidRadius`] for a negative or non-finite radius.
     pub fn new(vertices: impl Into<Vec<Point3<f64>>>, radius: f64) -> Result<Self, Error> {
         let vertices = vertices.into();
-        if vertices.is_empty() {
-            return Err(Error::EmptyVertices);
-        }
-        if u32::try_from(vertices.len()).is_err() {
-            return Err(Error::TooManyVertices(vertices.len()));
-        }
-        if let Some(index) = vertices
-            .iter()
-            .position(|v| !v.coords.iter().all(|c| c.is_finite()))
-        {
-            return Err(Error::NonFiniteVertex(index));
-        }
-        if !(radius.is_finite() && radius >= 0.0) {
-            return Err(Error::InvalidRadius(radius));
-        }
-        // Two-pass mean around the first vertex: summing raw coordinates of a set
-        // far from the origin would lose the digits that matter.
-        let base = vertices[0];
-        let n = vertices.len() as f64;
-        let mean_offset = vertices
-            .iter()
-            .fold(Vector3::zeros(), |acc, v| acc + (v - base))
-            / n;
-        let centroid = base + mean_offset;
-        if !centroid.coords.iter().all(|c| c.is_finite()) {
-            // Finite vertices whose spread overflows f64.
-            return Err(Error::NonFiniteVertex(0));
-        }
+        check_input(&vertices, radius)?;
+        let centroid = centroid_of(&vertices)?;
+        let ((mut xs, mut ys, mut zs), widest) = relative_coordinates(&vertices, &centroid)?;
         let len = vertices.len();
-        let (mut xs, mut ys, mut zs) = (
-            Vec::with_capacity(len),
-            Vec::with_capacity(len),
-            Vec::with_capacity(len),
-        );
-        let mut widest: f64 = 0.0;
-        for v in &vertices {
-            let d = v - centroid;
-            widest = widest.max(d.amax());
-            xs.push(d.x);
-            ys.push(d.y);
-            zs.push(d.z);
-        }
-        if !widest.is_finite() {
-            return Err(Error::NonFiniteVertex(0));
-        }
-        // Squared lengths scaled by a power of two (exact), so that sets near
-        // 1e-300 or 1e300 neither underflow to a size of 0 nor overflow.
-        let (k, inv_k) = pow2_scale(widest);
-        let mut size2: f64 = 0.0;
-        for i in 0..len {
-            size2 = size2.max(Vector3::new(xs[i] * k, ys[i] * k, zs[i] * k).norm_squared());
-        }
-        let size = size2.sqrt() * inv_k;
+        let size = largest_length(&xs, &ys, &zs, widest)?;
         let centroid_norm = robust_norm(&centroid.coords);
-        if !size.is_finite() || centroid_norm + size > MAX_REACH {
+        if centroid_norm + size > MAX_REACH {
             return Err(Error::NonFiniteVertex(0));
         }
         // Pad the scan arrays to whole vector steps with copies of vertex 0:
@@ -235,43 +185,7 @@ impl Convex {
                 coord.resize(padded, coord[0]);
             }
         }
-        let base = if len == 1 {
-            Kind::Point
-        } else if is_box(&xs, &ys, &zs) {
-            Kind::Box
-        } else if len < 8 {
-            Kind::Few
-        } else {
-            scan_kind()
-        };
-        // Sets from CONES_MIN_VERTICES to below CONES_MAX_VERTICES get the
-        // cube map, unless their size is outside the range its margins are
-        // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
-        // the block search.
-        let scanned = base == Kind::Scan || is_avx2(base);
-        let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
-            Cones::new(&xs, &ys, &zs, len, size).map(Box::new)
-        } else {
-            None
-        };
-        let kind = match (&cones, base) {
-            (Some(_), Kind::Scan) => Kind::Cones { fused: false },
-            (Some(_), _) => Kind::Cones { fused: true },
-            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => Kind::Blocks,
-            (None, k) => k,
-        };
-        let blocks = (kind == Kind::Blocks).then(|| Box::new(Blocks::new(&xs, &ys, &zs, len)));
-        // The f32 scan only where the exact search is the portable scan of
-        // every vertex: against the AVX2 scan, the cube map and the block
-        // search it is slower at every size measured (0.86× at 16 vertices,
-        // 0.4× at 512, docs/speed-accuracy.md), and `Single` then takes the
-        // exact search. Indices ride in i32 lanes in the f32 scan.
-        let single =
-            if kind == Kind::Scan && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len) {
-                Single::of(&xs, &ys, &zs, size)
-            } else {
-                None
-            };
+        let search = SupportSearch::choose(&xs, &ys, &zs, len, size);
         Ok(Self {
             vertices,
             radius,
@@ -281,10 +195,10 @@ impl Convex {
             xs,
             ys,
             zs,
-            kind,
-            single,
-            blocks,
-            cones,
+            kind: search.kind,
+            single: search.single,
+            blocks: search.blocks,
+            cones: search.cones,
         })
     }
 
@@ -382,25 +296,25 @@ impl Convex {
     pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
         match self.kind {
             // A sphere's core: nothing to scan.
-            Kind::Point => 0,
+            SupportKind::Point => 0,
             // A box's support is its direction's sign pattern. A zero
             // component is a tie between the two faces, given to the lower
             // index as the scan would.
-            Kind::Box => {
+            SupportKind::Box => {
                 usize::from(d.x > 0.0) | usize::from(d.y > 0.0) << 1 | usize::from(d.z > 0.0) << 2
             }
             // A handful of products: cheaper here than a call.
-            Kind::Few => scan_few(&self.xs, &self.ys, &self.zs, d).1,
+            SupportKind::Few => scan_few(&self.xs, &self.ys, &self.zs, d).1,
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: Kind::Avx2 is only chosen on a CPU with AVX2 and FMA.
-            Kind::Avx2 => unsafe { scan_avx2(self, d) },
-            Kind::Scan => self.scan_portable(d),
-            Kind::Cones { fused } => self.cones_index(d, fused),
-            Kind::Blocks => self.search_index(d),
+            // SAFETY: SupportKind::Avx2 is only chosen on a CPU with AVX2 and FMA.
+            SupportKind::Avx2 => unsafe { scan_avx2(self, d) },
+            SupportKind::Scan => self.scan_portable(d),
+            SupportKind::Cones { fused } => self.cones_index(d, fused),
+            SupportKind::Blocks => self.search_index(d),
         }
     }
 
-    /// [`support_index`](Self::support_index) for [`Kind::Cones`]: the
+    /// [`support_index`](Self::support_index) for [`SupportKind::Cones`]: the
     /// direction's candidates with the scan's arithmetic, or for a direction
     /// the map declines, the scan itself.
     #[inline(always)]
@@ -411,7 +325,7 @@ impl Convex {
         #[cfg(target_arch = "x86_64")]
         if fused {
             // SAFETY: `fused` is only set on a CPU with AVX2 and FMA (it
-            // replaces Kind::Avx2).
+            // replaces SupportKind::Avx2).
             return unsafe { cones_fused(self, cones, d) };
         }
         let _ = fused;
@@ -421,7 +335,7 @@ impl Convex {
         }
     }
 
-    /// [`scan_top`]'s index for [`Kind::Scan`], out of line: the query
+    /// [`scan_top`]'s index for [`SupportKind::Scan`], out of line: the query
     /// inlines only the arms that need no call.
     #[inline(never)]
     fn scan_portable(&self, d: &Vector3<f64>) -> usize {
@@ -529,6 +443,151 @@ impl Convex {
         // SAFETY: i < xs.len() (checked just above) == ys.len() == zs.len().
         let (y, z) = unsafe { (*self.ys.get_unchecked(i), *self.zs.get_unchecked(i)) };
         Vector3::new(x, y, z)
+    }
+}
+
+/// The checks of [`Convex::new`] on its input, before any arithmetic.
+fn check_input(vertices: &[Point3<f64>], radius: f64) -> Result<(), Error> {
+    if vertices.is_empty() {
+        return Err(Error::EmptyVertices);
+    }
+    if u32::try_from(vertices.len()).is_err() {
+        return Err(Error::TooManyVertices(vertices.len()));
+    }
+    if let Some(index) = vertices
+        .iter()
+        .position(|v| !v.coords.iter().all(|c| c.is_finite()))
+    {
+        return Err(Error::NonFiniteVertex(index));
+    }
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(Error::InvalidRadius(radius));
+    }
+    Ok(())
+}
+
+/// The mean of `vertices` (at least one), in two passes around the first
+/// vertex: summing raw coordinates of a set far from the origin would lose
+/// the digits that matter.
+fn centroid_of(vertices: &[Point3<f64>]) -> Result<Point3<f64>, Error> {
+    let base = vertices[0];
+    let count = vertices.len() as f64;
+    let mean_offset = vertices
+        .iter()
+        .fold(Vector3::zeros(), |acc, v| acc + (v - base))
+        / count;
+    let centroid = base + mean_offset;
+    if !centroid.coords.iter().all(|c| c.is_finite()) {
+        // Finite vertices whose spread overflows f64.
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(centroid)
+}
+
+/// The scan arrays: each coordinate of every vertex relative to the
+/// centroid, one array per axis.
+type ScanArrays = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// `vertices` relative to `centroid`, as scan arrays, and the largest
+/// coordinate among them (absolute).
+fn relative_coordinates(
+    vertices: &[Point3<f64>],
+    centroid: &Point3<f64>,
+) -> Result<(ScanArrays, f64), Error> {
+    let len = vertices.len();
+    let (mut xs, mut ys, mut zs) = (
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+        Vec::with_capacity(len),
+    );
+    let mut widest: f64 = 0.0;
+    for v in vertices {
+        let d = v - centroid;
+        widest = widest.max(d.amax());
+        xs.push(d.x);
+        ys.push(d.y);
+        zs.push(d.z);
+    }
+    if !widest.is_finite() {
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(((xs, ys, zs), widest))
+}
+
+/// The largest length among the scan arrays' points, `D(coZ - z̄)` of
+/// (6.4), whose largest coordinate is `widest`. Squared lengths are scaled
+/// by a power of two (exact), so that sets near 1e-300 or 1e300 neither
+/// underflow to a size of 0 nor overflow.
+fn largest_length(xs: &[f64], ys: &[f64], zs: &[f64], widest: f64) -> Result<f64, Error> {
+    let (scale, inv_scale) = pow2_scale(widest);
+    let mut size2: f64 = 0.0;
+    for ((x, y), z) in xs.iter().zip(ys).zip(zs) {
+        size2 = size2.max(Vector3::new(x * scale, y * scale, z * scale).norm_squared());
+    }
+    let size = size2.sqrt() * inv_scale;
+    if !size.is_finite() {
+        return Err(Error::NonFiniteVertex(0));
+    }
+    Ok(size)
+}
+
+/// How a shape's support point is found, with the copies of its vertices
+/// that the search needs.
+struct SupportSearch {
+    kind: SupportKind,
+    single: Option<Box<F32Copy>>,
+    blocks: Option<Box<Blocks>>,
+    cones: Option<Box<Cones>>,
+}
+
+impl SupportSearch {
+    /// The search for the `len` vertices of size `size` in the (padded)
+    /// scan arrays.
+    fn choose(xs: &[f64], ys: &[f64], zs: &[f64], len: usize, size: f64) -> Self {
+        let base = if len == 1 {
+            SupportKind::Point
+        } else if is_box(xs, ys, zs) {
+            SupportKind::Box
+        } else if len < 8 {
+            SupportKind::Few
+        } else {
+            scan_kind()
+        };
+        // Sets from CONES_MIN_VERTICES to below CONES_MAX_VERTICES get the
+        // cube map, unless their size is outside the range its margins are
+        // proved for; larger ones (or those) from blocks::MIN_VERTICES on,
+        // the block search.
+        let scanned = base == SupportKind::Scan || is_avx2(base);
+        let cones = if scanned && (CONES_MIN_VERTICES..CONES_MAX_VERTICES).contains(&len) {
+            Cones::new(xs, ys, zs, len, size).map(Box::new)
+        } else {
+            None
+        };
+        let kind = match (&cones, base) {
+            (Some(_), SupportKind::Scan) => SupportKind::Cones { fused: false },
+            (Some(_), _) => SupportKind::Cones { fused: true },
+            (None, _) if scanned && len >= crate::blocks::MIN_VERTICES => SupportKind::Blocks,
+            (None, other) => other,
+        };
+        let blocks = (kind == SupportKind::Blocks).then(|| Box::new(Blocks::new(xs, ys, zs, len)));
+        // The f32 scan only where the exact search is the portable scan of
+        // every vertex: against the AVX2 scan, the cube map and the block
+        // search it is slower at every size measured (docs/speed-accuracy.md),
+        // and `Single` then takes the
+        // exact search. Indices ride in i32 lanes in the f32 scan.
+        let single = if kind == SupportKind::Scan
+            && (SINGLE_MIN_VERTICES..SINGLE_MAX_VERTICES).contains(&len)
+        {
+            F32Copy::of(xs, ys, zs, size)
+        } else {
+            None
+        };
+        SupportSearch {
+            kind,
+            single,
+            blocks,
+            cones,
+        }
     }
 }
 
@@ -762,7 +821,7 @@ pub(crate) fn scan_top(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> 
         }
     }
     // Through u32: the index is exact and small, and the unsigned 64-bit
-    // conversion costs a dozen instructions without AVX-512.
+    // conversion takes a sequence of instructions without AVX-512.
     let mut idx = top_i as u32 as usize;
     for i in n - n % LANES..n {
         let dot = xs[i] * dx + ys[i] * dy + zs[i] * dz;
@@ -793,21 +852,21 @@ fn scan_few(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>) -> (f64, usize
     (top, idx)
 }
 
-/// Sets with fewer vertices keep the scan. Measured on the paper's family
-/// (`paper_compare`, one run each way): with the map from 32 vertices, pairs
-/// with its 40- to 60-vertex polytopes took up to 10 % longer (a query's
-/// directions cluster at face normals, where a cell lists a whole face) and
-/// the 100-vertex pairs 12 % less; from 64, only the latter.
+/// Sets with fewer vertices keep the scan. On the paper's family
+/// (`paper_compare`), the map from 32 vertices slowed the pairs of its 40- to
+/// 60-vertex polytopes (a query's directions cluster at face normals, where
+/// a cell lists a whole face) while it sped up the 100-vertex pairs; from
+/// 64, only the latter remains.
 pub(crate) const CONES_MIN_VERTICES: usize = 64;
 
 /// Sets of this many vertices or more keep the block search: the map's
-/// construction grows with the vertices (about 17 ms at 4 096).
+/// construction grows with the vertices.
 pub(crate) const CONES_MAX_VERTICES: usize = 4096;
 
 /// Whether `kind` is the AVX2 scan.
-fn is_avx2(kind: Kind) -> bool {
+fn is_avx2(kind: SupportKind) -> bool {
     #[cfg(target_arch = "x86_64")]
-    if kind == Kind::Avx2 {
+    if kind == SupportKind::Avx2 {
         return true;
     }
     let _ = kind;
@@ -828,20 +887,20 @@ fn cones_fused(c: &Convex, cones: &Cones, d: &Vector3<f64>) -> usize {
 }
 
 /// The kind of a set of 8 vertices or more that the block search leaves to
-/// the scan: [`Kind::Avx2`] if this CPU has AVX2 and FMA, the vector scan's
-/// requirements, else [`Kind::Scan`].
-fn scan_kind() -> Kind {
+/// the scan: [`SupportKind::Avx2`] if this CPU has AVX2 and FMA, the vector scan's
+/// requirements, else [`SupportKind::Scan`].
+fn scan_kind() -> SupportKind {
     #[cfg(target_arch = "x86_64")]
     if crate::has_avx2_fma() {
-        return Kind::Avx2;
+        return SupportKind::Avx2;
     }
-    Kind::Scan
+    SupportKind::Scan
 }
 
 /// [`scan_top`] in AVX2 and FMA intrinsics, chosen at run time: two sets of four
 /// lanes, so the two compare-and-select chains overlap, and the comparison
 /// mask used as it is (the compiler's own vectorisation of [`scan_top`] spends
-/// five instructions per step converting it to booleans and back). Dot
+/// instructions on every step converting it to booleans and back). Dot
 /// products are fused multiply-adds, so they may differ from [`scan_top`]'s in
 /// the last bit; either vertex of such a near-tie is a valid support point.
 #[cfg(target_arch = "x86_64")]
@@ -916,7 +975,7 @@ pub(crate) unsafe fn scan_avx2_top(
     let mut top = _mm256_cvtsd_f64(v);
     let top_i = _mm256_cvtsd_f64(ix);
     // Through u32: the index is exact and small, and the unsigned 64-bit
-    // conversion costs a dozen instructions without AVX-512.
+    // conversion takes a sequence of instructions without AVX-512.
     let mut idx = top_i as u32 as usize;
     for i in full..n {
         let dot = zs[i].mul_add(d.z, ys[i].mul_add(d.y, xs[i] * d.x));
@@ -995,7 +1054,8 @@ unsafe fn scan_avx2(c: &Convex, d: &Vector3<f64>) -> usize {
         }
     };
     // The other steps two at a time, an odd one out first: one loop test and
-    // two counter updates for 16 vertices (about 1 % of a family query).
+    // two counter updates for 16 vertices, a share of a small query that
+    // shows.
     let mut i = 8;
     if n.is_multiple_of(16) {
         take(i, _mm256_set1_epi64x(8));
@@ -1165,7 +1225,7 @@ pub(crate) mod tests {
     use super::*;
 
     /// The support index by brute force: the first vertex of largest `v·d`.
-    fn brute(c: &Convex, d: &Vector3<f64>) -> usize {
+    fn brute_force_support(c: &Convex, d: &Vector3<f64>) -> usize {
         let mut best = 0;
         for i in 1..c.len() {
             if c.local(i).dot(d) > c.local(best).dot(d) {
@@ -1184,12 +1244,12 @@ pub(crate) mod tests {
             Vector3::new(0.5, 2.0, 0.0),
         ] {
             let b = Convex::cuboid(half, 0.1).unwrap();
-            assert_eq!(b.kind, Kind::Box);
+            assert_eq!(b.kind, SupportKind::Box);
             for &x in &comps {
                 for &y in &comps {
                     for &z in &comps {
                         let d = Vector3::new(x, y, z);
-                        let (i, j) = (b.support_index(&d), brute(&b, &d));
+                        let (i, j) = (b.support_index(&d), brute_force_support(&b, &d));
                         assert_eq!(b.local(i).dot(&d), b.local(j).dot(&d), "{d:?}");
                         // A flat axis, or a component lost in the sum,
                         // ties the two faces: either is a support point.
@@ -1218,9 +1278,9 @@ pub(crate) mod tests {
         for (verts, kind) in [
             (swapped, scan_kind()),
             (skew, scan_kind()),
-            (shifted, Kind::Box),
-            (b.vertices()[..1].to_vec(), Kind::Point),
-            (b.vertices()[..2].to_vec(), Kind::Few),
+            (shifted, SupportKind::Box),
+            (b.vertices()[..1].to_vec(), SupportKind::Point),
+            (b.vertices()[..2].to_vec(), SupportKind::Few),
         ] {
             let c = Convex::new(verts, 0.0).unwrap();
             assert_eq!(c.kind, kind);
@@ -1229,7 +1289,11 @@ pub(crate) mod tests {
                 Vector3::new(-1.0, 0.0, 0.0),
                 Vector3::new(0.0, 0.0, 0.0),
             ] {
-                assert_eq!(c.support_index(&d), brute(&c, &d), "{kind:?} {d:?}");
+                assert_eq!(
+                    c.support_index(&d),
+                    brute_force_support(&c, &d),
+                    "{kind:?} {d:?}"
+                );
             }
         }
     }
@@ -1246,11 +1310,79 @@ pub(crate) mod tests {
         }
     }
 
+    /// `n` points of a cloud of size `scale` at `offset` on x. Flat sets put
+    /// every other vertex within 3e-7 of the plane x = scale, far from the
+    /// centroid: with directions near +x, near-ties that f32 cannot
+    /// resolve, which is what the slack is for.
+    fn cloud(rng: &mut Rng, n: usize, scale: f64, offset: f64, flat: bool) -> Vec<Point3<f64>> {
+        (0..n)
+            .map(|i| {
+                let x = if flat && i % 2 == 0 {
+                    1.0 + 3e-7 * rng.next()
+                } else if flat {
+                    rng.next().min(0.0)
+                } else {
+                    rng.next()
+                };
+                Point3::new(
+                    offset + x * scale,
+                    rng.next() * scale,
+                    rng.next() * scale * 1e-3,
+                )
+            })
+            .collect()
+    }
+
+    /// The `k`-th direction of a test on a cloud of size `scale`: near +x
+    /// for a flat cloud, and by turns with a tiny component, signed zeros,
+    /// huge and subnormal.
+    fn direction(rng: &mut Rng, k: usize, flat: bool, scale: f64) -> Vector3<f64> {
+        let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
+        if flat {
+            d = Vector3::new(1.0, d.y * 1e-9, d.z * 1e-9);
+        }
+        match k % 5 {
+            1 => d.y *= 1e-300,
+            2 => d = Vector3::new(0.0, -0.0, d.z),
+            // Subnormal: 1/max overflows, the f64 scan takes over.
+            4 => d *= 1e-310,
+            // Large, but not so large that the reference overflows.
+            3 => d *= 1e120 / scale.max(1.0),
+            _ => {}
+        }
+        d
+    }
+
+    /// The f32 scan's picks for `d` on `c` (which has its f32 copy): through
+    /// the support search, and straight from the portable and, where the
+    /// CPU has them, the AVX2 f32 scans.
+    fn single_picks(c: &Convex, d: &Vector3<f64>) -> Vec<usize> {
+        let s = c.single.as_deref().expect("an f32 copy");
+        let d32 = {
+            let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
+            let u = d * (1.0 / m);
+            [u.x as f32, u.y as f32, u.z as f32]
+        };
+        let mut picks = vec![c.support_index_single(d)];
+        let scalable = d32.iter().all(|x| x.is_finite());
+        if scalable {
+            picks.push(scan_single(&s.xs, &s.ys, &s.zs, d32));
+        }
+        #[cfg(target_arch = "x86_64")]
+        if scalable
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the features were checked just above.
+            picks.push(unsafe { scan_single_avx2(&s.xs, &s.ys, &s.zs, d32) });
+        }
+        picks
+    }
+
     /// The f32 scan's choice is within `SINGLE_SLACK · size · |d|` of the
     /// true support value, on both code paths, at every scale f64 allows,
     /// far from the origin, for directions with components of wildly
-    /// different sizes (and ±0); and shapes that keep the exact support
-    /// return the exact support.
+    /// different sizes (and ±0).
     #[test]
     fn single_precision_support_is_within_its_slack() {
         let mut rng = Rng(0x5eed_1234_abcd_0001);
@@ -1260,27 +1392,7 @@ pub(crate) mod tests {
             // Sizes are found through squared lengths, so 1e±150 is the range.
             for scale in [1e-140, 1e-9, 1.0, 1e9, 1e140] {
                 for (offset, flat) in [(0.0, false), (1e9, false), (0.0, true), (1e9, true)] {
-                    // Flat sets put every other vertex within 3e-7 of the
-                    // plane x = scale, far from the centroid, and directions
-                    // near +x: near-ties that f32 cannot resolve, which is
-                    // what the slack is for.
-                    let pts: Vec<Point3<f64>> = (0..n)
-                        .map(|i| {
-                            let x = if flat && i % 2 == 0 {
-                                1.0 + 3e-7 * rng.next()
-                            } else if flat {
-                                rng.next().min(0.0)
-                            } else {
-                                rng.next()
-                            };
-                            Point3::new(
-                                offset + x * scale,
-                                rng.next() * scale,
-                                rng.next() * scale * 1e-3,
-                            )
-                        })
-                        .collect();
-                    let mut c = Convex::new(pts, 0.0).unwrap();
+                    let mut c = Convex::new(cloud(&mut rng, n, scale, offset, flat), 0.0).unwrap();
                     if offset * 1e-6 > scale {
                         // The vertices collapsed onto a few values.
                         continue;
@@ -1289,45 +1401,14 @@ pub(crate) mod tests {
                     // the portable scan; built here on any CPU, so that the
                     // f32 path is tested everywhere.
                     if c.single.is_none() {
-                        c.single = Single::of(&c.xs, &c.ys, &c.zs, c.size);
+                        c.single = F32Copy::of(&c.xs, &c.ys, &c.zs, c.size);
                     }
                     assert!(c.has_single(), "n {n} scale {scale:e}");
                     for k in 0..64 {
-                        let mut d = Vector3::new(rng.next(), rng.next(), rng.next());
-                        if flat {
-                            d = Vector3::new(1.0, d.y * 1e-9, d.z * 1e-9);
-                        }
-                        match k % 5 {
-                            1 => d.y *= 1e-300,
-                            2 => d = Vector3::new(0.0, -0.0, d.z),
-                            // Subnormal: 1/max overflows, the f64 scan takes over.
-                            4 => d *= 1e-310,
-                            // Large, but not so large that the reference overflows.
-                            3 => d *= 1e120 / scale.max(1.0),
-                            _ => {}
-                        }
-                        let best = c.local(brute(&c, &d)).dot(&d);
+                        let d = direction(&mut rng, k, flat, scale);
+                        let best = c.local(brute_force_support(&c, &d)).dot(&d);
                         let slack = SINGLE_SLACK * c.size() * d.norm();
-                        let s = c.single.as_deref().unwrap();
-                        let d32 = {
-                            let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
-                            let u = d * (1.0 / m);
-                            [u.x as f32, u.y as f32, u.z as f32]
-                        };
-                        let mut picks = vec![c.support_index_single(&d)];
-                        let scalable = d32.iter().all(|x| x.is_finite());
-                        if scalable {
-                            picks.push(scan_single(&s.xs, &s.ys, &s.zs, d32));
-                        }
-                        #[cfg(target_arch = "x86_64")]
-                        if scalable
-                            && std::arch::is_x86_feature_detected!("avx2")
-                            && std::arch::is_x86_feature_detected!("fma")
-                        {
-                            // SAFETY: the features were checked just above.
-                            picks.push(unsafe { scan_single_avx2(&s.xs, &s.ys, &s.zs, d32) });
-                        }
-                        for i in picks {
+                        for i in single_picks(&c, &d) {
                             assert!(i < c.len());
                             let got = c.local(i).dot(&d);
                             worst = worst.max((best - got) / (c.size() * d.norm()));
@@ -1342,11 +1423,15 @@ pub(crate) mod tests {
             }
         }
         assert!(checked > 3000, "{checked}");
-        // The flat sets did produce misses (about 2e-8 here), so the bound
-        // was tested, not just the easy picks.
+        // The flat sets did produce misses, so the bound was tested, not
+        // just the easy picks.
         assert!(worst > 0.0);
-        // Directions whose largest component is near f64::MAX (1/m would be
-        // subnormal) go to the exact scan.
+    }
+
+    /// Directions whose largest component is near f64::MAX (1/m would be
+    /// subnormal), or that are subnormal themselves, go to the exact scan.
+    #[test]
+    fn single_precision_leaves_extreme_directions_to_the_exact_scan() {
         let mut ring = Convex::new(
             (0..40)
                 .map(|i| {
@@ -1357,7 +1442,7 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
-        ring.single = Single::of(&ring.xs, &ring.ys, &ring.zs, ring.size);
+        ring.single = F32Copy::of(&ring.xs, &ring.ys, &ring.zs, ring.size);
         assert!(ring.has_single());
         for d in [
             Vector3::new(1.7e308, 3e307, -2e307),
@@ -1365,7 +1450,13 @@ pub(crate) mod tests {
         ] {
             assert_eq!(ring.support_index_single(&d), ring.scan_index(&d), "{d:?}");
         }
-        // Small and closed-form shapes keep the exact support.
+    }
+
+    /// Small and closed-form shapes keep the exact support under
+    /// `Precision::Single`; so do sets large enough for the cube map or the
+    /// block search, which are faster.
+    #[test]
+    fn shapes_without_an_f32_copy_keep_the_exact_support() {
         let small = Convex::new(
             (0..15)
                 .map(|i| Point3::new(i as f64, (i * i) as f64, 1.0))
@@ -1374,8 +1465,6 @@ pub(crate) mod tests {
         )
         .unwrap();
         let cube = Convex::cuboid(Vector3::new(1.0, 2.0, 3.0), 0.0).unwrap();
-        // So do sets large enough for the cube map or the block search,
-        // which are faster.
         let large = Convex::new(
             (0..SINGLE_MAX_VERTICES)
                 .map(|i| {
@@ -1386,11 +1475,14 @@ pub(crate) mod tests {
             0.0,
         )
         .unwrap();
-        assert!(matches!(large.kind, Kind::Blocks | Kind::Cones { .. }));
+        assert!(matches!(
+            large.kind,
+            SupportKind::Blocks | SupportKind::Cones { .. }
+        ));
         for c in [small, cube, large] {
             assert!(!c.has_single());
             let d = Vector3::new(0.3, -0.8, 0.1);
-            assert_eq!(c.support_index_single(&d), brute(&c, &d));
+            assert_eq!(c.support_index_single(&d), brute_force_support(&c, &d));
         }
     }
 
@@ -1458,7 +1550,7 @@ pub(crate) mod tests {
                     })
                     .collect();
                 let c = Convex::new(pts, 0.0).unwrap();
-                if matches!(c.kind, Kind::Box | Kind::Point) {
+                if matches!(c.kind, SupportKind::Box | SupportKind::Point) {
                     continue;
                 }
                 for k in 0..40 {

@@ -1,6 +1,6 @@
 //! Contacts between degenerate sets that the randomised sweep does not draw.
 //!
-//! Found on 2026-11-24 by the hunt in `mid_sets.rs`: a flat polygon touching a
+//! Found on 2026-11-24 by the hunt in `testkit/tests/mid_sets.rs`: a flat polygon touching a
 //! needle (a tiny cluster of points with one far point) or a collinear set
 //! ended 1.2× to 9× the requirement (1e-9 of the size) away from a true
 //! distance of 0, `Converged` or `ToleranceNotMet` with the interval [0, d].

@@ -169,17 +169,22 @@ pub enum ErrorCode {
     TooManyObjects = 18,
     /// The server failed in a way that is its own fault; it keeps serving.
     Internal = 19,
+    /// The server's disk has no room to store a registration or removal:
+    /// the change was not made. Queries and pose updates are still served;
+    /// the same request succeeds once there is room again, without a
+    /// server restart.
+    StorageFull = 20,
     /// A joint position is outside its joint's limits (and the item did not
     /// ask for clamping, [`item_flags::CLAMP`]).
-    OutOfLimits = 20,
+    OutOfLimits = 21,
     /// A robot's URDF is malformed, or its links do not form one tree of
     /// fixed, revolute, continuous and prismatic joints.
-    InvalidRobot = 21,
+    InvalidRobot = 22,
 }
 
 impl ErrorCode {
     /// Every code, in wire order.
-    pub const ALL: [ErrorCode; 22] = [
+    pub const ALL: [ErrorCode; 23] = [
         ErrorCode::Ok,
         ErrorCode::UnknownObject,
         ErrorCode::NonFinitePose,
@@ -200,6 +205,7 @@ impl ErrorCode {
         ErrorCode::NameTaken,
         ErrorCode::TooManyObjects,
         ErrorCode::Internal,
+        ErrorCode::StorageFull,
         ErrorCode::OutOfLimits,
         ErrorCode::InvalidRobot,
     ];
@@ -238,6 +244,7 @@ impl ErrorCode {
             ErrorCode::NameTaken => "name already taken",
             ErrorCode::TooManyObjects => "server object limit reached",
             ErrorCode::Internal => "internal server error",
+            ErrorCode::StorageFull => "no room on the server's disk to store the change",
             ErrorCode::OutOfLimits => "joint position outside its limits",
             ErrorCode::InvalidRobot => "malformed URDF or unsupported kinematic tree",
         }
@@ -1093,10 +1100,10 @@ pub struct ServerStats {
     /// (every few seconds): a client that died drops out once its death
     /// is detected.
     pub clients: u64,
-    /// Writes of the state file, change log or pose journal that failed. A
-    /// registration or removal that could be written nowhere was refused
-    /// with [`ErrorCode::Internal`] and undone; one whose compaction failed
-    /// but whose log record was written was acknowledged.
+    /// Commits to the object store and writes of the pose journal that
+    /// failed. A registration or removal that could not be committed was
+    /// refused (with [`ErrorCode::StorageFull`] on a full disk,
+    /// [`ErrorCode::Internal`] otherwise) and undone.
     pub persist_errors: u64,
 }
 

@@ -10,9 +10,8 @@ use std::sync::atomic::AtomicBool;
 
 use clap::{Args, ValueEnum};
 use gjkd_proto::{DEFAULT_SERVICE, MAX_PIECES, WaitMode};
-use tracing::{error, info, warn};
+use tracing::info;
 
-use crate::persist::{Loaded, LogError, Replay, Store};
 use crate::scene::Scene;
 use crate::server::{ServeOptions, run};
 use crate::state::{Limits, State};
@@ -117,55 +116,12 @@ pub struct ObjectsArgs {
 /// # Errors
 /// A message saying what stopped it.
 pub fn objects(args: &ObjectsArgs) -> Result<(), String> {
-    use crate::objects::{alive_nodes, liveness, remove_departed, table};
     let path = args
         .state_file
         .clone()
-        .or_else(|| crate::persist::default_path(&args.service))
+        .or_else(|| crate::stored::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file")?;
-    let mut store = Store::open(&path)
-        .map_err(|e| format!("{e} (a server using this file must be stopped first)"))?;
-    let mut snapshot = match store.load_or_quarantine().map_err(|e| e.to_string())? {
-        Loaded::Missing { log } => {
-            report_log(store.log_path(), &log);
-            println!("no state file at {}: no objects", path.display());
-            return Ok(());
-        }
-        Loaded::Corrupt {
-            reason, moved_to, ..
-        } => {
-            return Err(format!(
-                "{} is corrupt ({reason}); it was set aside as {}",
-                path.display(),
-                moved_to.display()
-            ));
-        }
-        Loaded::Snapshot { snapshot, log } => {
-            report_log(store.log_path(), &log);
-            snapshot
-        }
-    };
-    let alive = alive_nodes()?;
-    print!("{}", table(&snapshot, &liveness(&snapshot, &alive)));
-    if !args.remove_departed {
-        return Ok(());
-    }
-    let removed = remove_departed(&mut snapshot, &alive);
-    if removed.is_empty() {
-        println!("no object has an owner that is gone: nothing removed");
-        return Ok(());
-    }
-    store.write(&snapshot).map_err(|e| e.to_string())?;
-    println!(
-        "removed {} object(s) whose owner is gone: {}",
-        removed.len(),
-        removed
-            .iter()
-            .map(|o| format!("{:#x}", o.id))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    Ok(())
+    crate::offline::run(&path, args.remove_departed)
 }
 
 /// Runs `gjkd serve` until SIGINT or SIGTERM.
@@ -227,85 +183,14 @@ pub fn serve_until(
     run(&options, state, shutdown, ready).map_err(|e| e.to_string())
 }
 
-/// The state of a persisting server: restored from its state file, or
-/// empty when there is none or it was corrupt (set aside, never half-loaded).
+/// The state of a persisting server (see `State::open`).
 fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
     let path = args
         .state_file
         .clone()
-        .or_else(|| crate::persist::default_path(&args.service))
+        .or_else(|| crate::stored::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file or --no-persist")?;
-    let mut store = Store::open(&path).map_err(|e| e.to_string())?;
-    let wait = args.wait.into();
-    let mut state = match store.load_or_quarantine().map_err(|e| e.to_string())? {
-        Loaded::Missing { log } => {
-            info!(file = %path.display(), "no state file yet: starting empty");
-            report_log(store.log_path(), &log);
-            State::new(limits, wait, epoch())
-        }
-        Loaded::Snapshot { snapshot, log } => {
-            report_log(store.log_path(), &log);
-            let state = State::restore(limits, wait, &snapshot).map_err(|e| {
-                format!(
-                    "cannot restore {} ({e}); raise the limits or move the file away",
-                    path.display()
-                )
-            })?;
-            info!(file = %path.display(), objects = state.len(), "objects restored");
-            state
-        }
-        Loaded::Corrupt {
-            reason,
-            moved_to,
-            log,
-        } => {
-            error!(
-                file = %path.display(),
-                moved_to = %moved_to.display(),
-                "state file is corrupt ({reason}): set aside, starting with no objects"
-            );
-            report_log(store.log_path(), &log);
-            State::new(limits, wait, epoch())
-        }
-    };
-    state.set_store(store).map_err(|e| e.to_string())?;
-    Ok(state)
-}
-
-/// Says what loading the change log did: quietly when it was whole, loudly
-/// when something of it was cut off or set aside.
-fn report_log(path: &std::path::Path, log: &Replay) {
-    if log.applied + log.skipped > 0 {
-        info!(
-            file = %path.display(),
-            applied = log.applied,
-            skipped = log.skipped,
-            "change log replayed"
-        );
-    }
-    if log.torn > 0 {
-        warn!(
-            file = %path.display(),
-            bytes = log.torn,
-            "change log ended in a torn record (an append cut short by a crash, never acknowledged): cut off"
-        );
-    }
-    if let Some(e) = &log.error {
-        let kept = match e {
-            LogError::Corrupt { .. } | LogError::Invalid { .. } => {
-                "the records before it are kept (written into the state file)"
-            }
-            LogError::Header(_) | LogError::Inconsistent(_) => {
-                "none of its records are kept, the state file alone is loaded"
-            }
-            LogError::Orphan | LogError::StateCorrupt => "none of its records are kept",
-        };
-        error!(
-            file = %path.display(),
-            moved_to = %log.moved_to.as_deref().unwrap_or(path).display(),
-            "change log is corrupt ({e}): set aside; {kept}"
-        );
-    }
+    State::open(limits, args.wait.into(), &path, epoch())
 }
 
 /// Upper half of every object id of this run: differs between runs so that a

@@ -1,15 +1,15 @@
 //! The pose journal: the latest stored pose of every object, in a
-//! memory-mapped file next to the state file (`<state file>.poses`).
+//! memory-mapped file next to the object store (`<store file>.poses`).
 //!
 //! Pose updates are the hot path (one per object per control cycle), far too
-//! frequent for an fsynced rewrite of the state file each. A store into a
+//! frequent for a committed transaction each. A store into a
 //! shared file mapping costs a few nanoseconds and lands in the kernel's page
 //! cache, which outlives the process: after `kill -9` (or a panic, or an
 //! abort) the restarted server finds every pose that was acknowledged. Only
 //! a crash of the whole machine can lose poses written since the last
 //! `msync` (done at housekeeping, every few seconds while poses change); the
-//! objects themselves are on disk regardless (the fsynced change log and state
-//! file, see `crate::persist`).
+//! objects themselves are on disk regardless (the database, committed before
+//! each acknowledgement, see `crate::database`).
 //!
 //! # Layout (version 1)
 //!
@@ -17,15 +17,15 @@
 //! one 72-byte slot per object: the object id, the seven pose components
 //! (`[x, y, z, i, j, k, w]`) and a check word, all `u64` little-endian. The
 //! check word is a hash of the other eight, so a slot torn by a kill in the
-//! middle of its update reads as invalid and the state file's pose is used
-//! instead. A slot whose id is not the object's (a slot reused after a
+//! middle of its update reads as invalid and the pose stored with the object
+//! is used instead. A slot whose id is not the object's (a slot reused after a
 //! removal) is ignored too.
 
 use std::fs::{File, OpenOptions};
 use std::os::unix::fs::OpenOptionsExt;
-use std::os::unix::io::AsRawFd;
 use std::path::{Path, PathBuf};
 
+use memmap2::MmapMut;
 use nalgebra::Isometry3;
 
 /// First bytes of a journal.
@@ -37,9 +37,9 @@ const HEADER: usize = 16;
 pub const SLOT: usize = 72;
 const INITIAL_SLOTS: usize = 1024;
 
-/// The journal path of a state file: `<state file>.poses`.
-pub fn path_for(state_file: &Path) -> PathBuf {
-    let mut p = state_file.as_os_str().to_owned();
+/// The journal path of a store file: `<store file>.poses`.
+pub fn path_for(store_file: &Path) -> PathBuf {
+    let mut p = store_file.as_os_str().to_owned();
     p.push(".poses");
     PathBuf::from(p)
 }
@@ -77,19 +77,15 @@ fn check(w: &[u64]) -> u64 {
 pub struct Journal {
     file: File,
     path: PathBuf,
-    map: *mut u8,
-    len: usize,
+    map: MmapMut,
     dirty: bool,
 }
 
-// SAFETY: the mapping is owned by this value alone (no aliasing handles
-// exist), like a Vec's buffer; moving it to another thread is fine.
-unsafe impl Send for Journal {}
-
 impl Journal {
     /// Opens (creating owner-only, 0600) the journal at `path`, keeping its
-    /// content. A file that is not a journal of this version is started
-    /// afresh: its poses are only a refinement of the state file's.
+    /// content. A file that is not a journal of this version is copied
+    /// aside (`<file>.corrupt-<unix seconds>`) and started afresh: its poses
+    /// are only a refinement of the stored ones.
     ///
     /// # Errors
     /// When the file cannot be opened, sized or mapped.
@@ -108,23 +104,30 @@ impl Journal {
             head[..8] == MAGIC && head[8..12] == VERSION.to_le_bytes()
         };
         if !valid_header {
+            if current > 0 {
+                // Kept as found before it is started afresh; the objects it
+                // held poses for are reported by the store.
+                let kept = crate::database::aside_name(path, "corrupt");
+                std::fs::copy(path, &kept)?;
+                tracing::error!(
+                    file = %path.display(),
+                    kept_as = %kept.display(),
+                    "the pose journal is not a journal of this version: kept aside, started afresh"
+                );
+            }
             file.set_len(0)?;
         }
         let slots = current.saturating_sub(HEADER) / SLOT;
+        let map = map(&file, slots.max(INITIAL_SLOTS))?;
         let mut j = Journal {
             file,
             path: path.to_path_buf(),
-            map: std::ptr::null_mut(),
-            len: 0,
+            map,
             dirty: false,
         };
-        j.remap(slots.max(INITIAL_SLOTS))?;
         if !valid_header {
-            let mut head = [0u8; HEADER];
-            head[..8].copy_from_slice(&MAGIC);
-            head[8..12].copy_from_slice(&VERSION.to_le_bytes());
-            // SAFETY: the mapping is at least HEADER bytes long.
-            unsafe { std::ptr::copy_nonoverlapping(head.as_ptr(), j.map, HEADER) };
+            j.map[..8].copy_from_slice(&MAGIC);
+            j.map[8..12].copy_from_slice(&VERSION.to_le_bytes());
         }
         Ok(j)
     }
@@ -135,42 +138,7 @@ impl Journal {
     }
 
     fn slots(&self) -> usize {
-        (self.len - HEADER) / SLOT
-    }
-
-    fn remap(&mut self, slots: usize) -> std::io::Result<()> {
-        let len = HEADER + slots * SLOT;
-        if (self.file.metadata()?.len() as usize) < len {
-            self.file.set_len(len as u64)?;
-        }
-        self.unmap();
-        // SAFETY: a fresh shared mapping of `len` bytes of a file that is at
-        // least that long; checked for failure below.
-        let map = unsafe {
-            libc::mmap(
-                std::ptr::null_mut(),
-                len,
-                libc::PROT_READ | libc::PROT_WRITE,
-                libc::MAP_SHARED,
-                self.file.as_raw_fd(),
-                0,
-            )
-        };
-        if map == libc::MAP_FAILED {
-            return Err(std::io::Error::last_os_error());
-        }
-        self.map = map.cast();
-        self.len = len;
-        Ok(())
-    }
-
-    fn unmap(&mut self) {
-        if !self.map.is_null() {
-            // SAFETY: `map` and `len` are those of our own live mapping.
-            unsafe { libc::munmap(self.map.cast(), self.len) };
-            self.map = std::ptr::null_mut();
-            self.len = 0;
-        }
+        (self.map.len() - HEADER) / SLOT
     }
 
     /// Records `pose` as the pose of object `id` in `slot`, growing the file
@@ -181,17 +149,14 @@ impl Journal {
     pub fn write(&mut self, slot: u32, id: u64, pose: &Isometry3<f64>) -> std::io::Result<()> {
         let slot = slot as usize;
         if slot >= self.slots() {
-            self.remap((self.slots() * 2).max(slot + 1))?;
+            // The old mapping stays valid until the new one is in place, so
+            // a failure to grow leaves the journal as it was.
+            self.map = map(&self.file, (self.slots() * 2).max(slot + 1))?;
         }
-        let w = words(id, pose);
-        let mut bytes = [0u8; SLOT];
-        for (chunk, x) in bytes.chunks_exact_mut(8).zip(w) {
+        let start = HEADER + slot * SLOT;
+        let out = &mut self.map[start..start + SLOT];
+        for (chunk, x) in out.chunks_exact_mut(8).zip(words(id, pose)) {
             chunk.copy_from_slice(&x.to_le_bytes());
-        }
-        // SAFETY: slot < slots(), so the SLOT bytes at this offset are inside
-        // our mapping, which nothing else in this process aliases.
-        unsafe {
-            std::ptr::copy_nonoverlapping(bytes.as_ptr(), self.map.add(HEADER + slot * SLOT), SLOT);
         }
         self.dirty = true;
         Ok(())
@@ -206,10 +171,7 @@ impl Journal {
         if !self.dirty {
             return Ok(());
         }
-        // SAFETY: our own live mapping.
-        if unsafe { libc::msync(self.map.cast(), self.len, libc::MS_SYNC) } != 0 {
-            return Err(std::io::Error::last_os_error());
-        }
+        self.map.flush()?;
         self.dirty = false;
         Ok(())
     }
@@ -221,26 +183,19 @@ impl Journal {
         if slot >= self.slots() {
             return None;
         }
-        let mut bytes = [0u8; SLOT];
-        // SAFETY: inside our mapping, as in `write`.
-        unsafe {
-            std::ptr::copy_nonoverlapping(
-                self.map.add(HEADER + slot * SLOT),
-                bytes.as_mut_ptr(),
-                SLOT,
-            );
-        }
+        let start = HEADER + slot * SLOT;
         let mut w = [0u64; 9];
-        for (x, chunk) in w.iter_mut().zip(bytes.chunks_exact(8)) {
-            let mut b = [0u8; 8];
-            b.copy_from_slice(chunk);
-            *x = u64::from_le_bytes(b);
+        for (x, chunk) in w
+            .iter_mut()
+            .zip(self.map[start..start + SLOT].chunks_exact(8))
+        {
+            *x = u64::from_le_bytes(chunk.try_into().unwrap_or_default());
         }
         if w[0] != id || w[8] != check(&w[..8]) {
             return None;
         }
         let f = |i: usize| f64::from_bits(w[i]);
-        let pose = crate::persist::StoredPose {
+        let pose = crate::stored::StoredPose {
             translation: [f(1), f(2), f(3)],
             rotation: [f(4), f(5), f(6), f(7)],
         };
@@ -248,10 +203,38 @@ impl Journal {
     }
 }
 
+/// A shared writable mapping of the first `slots` slots of `file`, grown to
+/// hold them if shorter.
+fn map(file: &File, slots: usize) -> std::io::Result<MmapMut> {
+    let len = HEADER + slots * SLOT;
+    if (file.metadata()?.len() as usize) < len {
+        allocate(file, len)?;
+    }
+    // SAFETY: the file is ours (0600, under the store's lock, which keeps a
+    // second server away) and never truncated while mapped, so the mapping
+    // cannot lose its pages under us; every access goes through the slice
+    // bounds of `MmapMut`.
+    unsafe { memmap2::MmapOptions::new().len(len).map_mut(file) }
+}
+
+/// Grows `file` to `len` bytes with its disk blocks allocated: a store into
+/// a mapped page that has no block yet would kill the process (`SIGBUS`) on
+/// a full disk, where this fails with `ENOSPC` instead.
+fn allocate(file: &File, len: usize) -> std::io::Result<()> {
+    use std::os::unix::io::AsRawFd;
+    let len = libc::off_t::try_from(len).map_err(std::io::Error::other)?;
+    // SAFETY: posix_fallocate(3) on a descriptor we own.
+    match unsafe { libc::posix_fallocate(file.as_raw_fd(), 0, len) } {
+        0 => Ok(()),
+        // A file system without fallocate: grow it sparse.
+        libc::EOPNOTSUPP | libc::EINVAL => file.set_len(len as u64),
+        errno => Err(std::io::Error::from_raw_os_error(errno)),
+    }
+}
+
 impl Drop for Journal {
     fn drop(&mut self) {
         let _ = self.sync();
-        self.unmap();
     }
 }
 
@@ -290,11 +273,18 @@ mod tests {
         assert_eq!(j.read(3, 13), None, "torn slot");
         assert_eq!(j.read(0, 11), Some(p));
         j.sync().expect("sync");
-        // A file that is not a journal starts afresh.
+        // A file that is not a journal starts afresh, kept aside first.
         drop(j);
         std::fs::write(&path, b"garbage").expect("spoil");
         let j = Journal::open(&path).expect("reopen");
         assert_eq!(j.read(0, 11), None);
+        let kept: Vec<_> = std::fs::read_dir(&dir)
+            .expect("list")
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().contains(".corrupt-"))
+            .collect();
+        assert_eq!(kept.len(), 1);
+        assert_eq!(std::fs::read(kept[0].path()).expect("kept"), b"garbage");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -1,11 +1,15 @@
 //! # gjkd-server
 //!
-//! The gjkd distance server as a library: the object store and its request
-//! handlers ([`state`]), the per-pair warm-start cache ([`cache`]), scene files
-//! ([`scene`]), the state file that keeps objects across crashes
-//! ([`persist`]), the iceoryx2 serving loop ([`server`]) and the daemon's
-//! commands with their flags ([`commands`]). The `gjkd` binary (package
-//! `gjkd`) is a thin command line over these and the tools of `gjkd-bench`.
+//! The gjkd distance server as a library: the server's state ([`state`]),
+//! its object store ([`store`]) and request handlers ([`requests`]), the
+//! per-pair warm-start cache ([`cache`]), scene files ([`scene`]), the
+//! database that keeps objects across crashes ([`database`], with the
+//! stored form of objects in [`stored`] and the migration of the old state
+//! file in [`legacy`]), the pose journal ([`journal`]), the offline
+//! `gjkd objects` command ([`offline`]), the iceoryx2 serving loop
+//! ([`server`]) and the daemon's commands with their flags ([`commands`]).
+//! The `gjkd` binary (package `gjkd`) is a thin command line over these and
+//! the tools of `gjkd-bench`.
 //!
 //! The handlers are pure functions of the [`State`](state::State) and the
 //! request's bytes, so they can be tested and fuzzed without any IPC:
@@ -34,11 +38,15 @@
 
 pub mod cache;
 pub mod commands;
+pub mod database;
 pub mod journal;
-pub mod objects;
-pub mod persist;
+pub mod legacy;
+pub mod offline;
+pub mod requests;
 pub mod robots;
 pub mod scene;
 pub mod scene_robots;
 pub mod server;
 pub mod state;
+pub mod store;
+pub mod stored;

@@ -17,7 +17,9 @@ use gjkd_model::{Kinematics, LimitMode, disabled_pairs};
 use gjkd_proto::{AdminRequest, ErrorCode, Item, Vertex, item_flags};
 use nalgebra::Isometry3;
 
-use crate::state::{Owner, State, check_pose};
+use crate::requests::check_pose;
+use crate::state::State;
+use crate::store::Owner;
 
 /// Set in every robot id, so that a robot id is never mistaken for an
 /// object id in logs.
@@ -150,7 +152,7 @@ pub fn attach(state: &mut State, new: NewRobot<'_>) -> Result<u64, ErrorCode> {
         owner: new.owner,
     };
     store_link_poses(state, &robot.links, &poses)?;
-    let epoch = state.id_epoch();
+    let epoch = state.store.id_epoch();
     let robots = &mut state.robots;
     let id = match robots.names.get(new.name) {
         Some(&id) => id,
@@ -264,7 +266,7 @@ fn store_link_poses(
     }
     for (id, pose) in links.iter().zip(poses) {
         if let Some(id) = id {
-            state.store_pose(*id, *pose)?;
+            state.store.set_pose(*id, *pose)?;
         }
     }
     Ok(())

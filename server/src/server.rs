@@ -17,10 +17,24 @@ use iceoryx2::port::server::Server as IoxServer;
 use iceoryx2::prelude::*;
 use tracing::{debug, error, info, warn};
 
-use crate::state::State;
+use crate::state::{Limits, State};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+type QueryService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Item],
+    (),
+    [ItemResult],
+    ReplyHeader,
+>;
+type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Vertex],
+    AdminRequest,
+    AdminReply,
+    (),
+>;
 
 /// Why the server could not start or stopped.
 #[derive(Debug, thiserror::Error)]
@@ -93,20 +107,22 @@ pub struct ServeOptions {
     pub remove_departed: bool,
 }
 
-/// Runs a server until `shutdown` becomes true, then removes its services and
-/// returns. `state` comes filled (scene objects) and its limits size the
-/// services.
-///
-/// # Errors
-/// [`ServerError`] when the services or ports cannot be set up; once running,
-/// errors of single requests are logged and the loop goes on.
-pub fn run(
-    options: &ServeOptions,
-    mut state: State,
-    shutdown: &AtomicBool,
-    ready: impl FnOnce(),
-) -> Result<(), ServerError> {
-    let limits = *state.limits();
+/// The iceoryx2 side of a running server. Fields drop in declaration
+/// order: ports first, then services, then the node, the reverse of their
+/// creation, which removes the services' shared memory.
+struct Endpoints {
+    query: QueryServer,
+    admin: AdminServer,
+    listener: Listener<ipc::Service>,
+    _wake_service: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+    admin_service: AdminService,
+    query_service: QueryService,
+    node: Node<ipc::Service>,
+}
+
+/// Creates the node, the services and the ports of a server for
+/// `options.service`, sized by `limits`.
+fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, ServerError> {
     let name = |s: String| {
         ServiceName::new(&s).map_err(|_| ServerError::InvalidName(options.service.clone()))
     };
@@ -171,14 +187,6 @@ pub fn run(
         .listener_builder()
         .create()
         .map_err(ipc("wake listener"))?;
-    let waitset = WaitSetBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .map_err(ipc("waitset"))?;
-    let _guard = waitset
-        .attach_notification(&listener)
-        .map_err(ipc("waitset attach"))?;
-
     let admin: AdminServer = admin_service
         .server_builder()
         .create()
@@ -210,6 +218,39 @@ pub fn run(
             e => ServerError::Ipc(format!("query server: {e:?}")),
         })?;
 
+    Ok(Endpoints {
+        query,
+        admin,
+        listener,
+        _wake_service: wake_service,
+        admin_service,
+        query_service,
+        node,
+    })
+}
+
+/// Runs a server until `shutdown` becomes true, then removes its services and
+/// returns. `state` comes filled (scene objects) and its limits size the
+/// services.
+///
+/// # Errors
+/// [`ServerError`] when the services or ports cannot be set up; once running,
+/// errors of single requests are logged and the loop goes on.
+pub fn run(
+    options: &ServeOptions,
+    mut state: State,
+    shutdown: &AtomicBool,
+    ready: impl FnOnce(),
+) -> Result<(), ServerError> {
+    let limits = *state.limits();
+    let endpoints = open_endpoints(options, &limits)?;
+    let waitset = WaitSetBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(ipc("waitset"))?;
+    let _guard = waitset
+        .attach_notification(&endpoints.listener)
+        .map_err(ipc("waitset attach"))?;
     info!(
         service = %options.service,
         wait = ?options.wait,
@@ -222,19 +263,49 @@ pub fn run(
         "gjkd serving"
     );
     ready();
+    serve_until(options, &mut state, &endpoints, &waitset, shutdown);
+    info!(service = %options.service, "shutting down");
+    if let Err(e) = state.flush() {
+        error!("cannot sync the pose journal: {e}");
+    }
+    // The current poses into the database, so that the next start needs
+    // no journal; if it fails, nothing is lost: the journal has them.
+    if let Err(e) = state.persist() {
+        error!("cannot write the current poses into the database: {e}");
+    }
+    Ok(())
+}
 
+/// When housekeeping last ran and when removing departed clients' objects
+/// may be tried again.
+struct Housekeeping {
+    last: Instant,
+    reap_after: Instant,
+}
+
+/// The serving loop: answers requests, sleeps or spins as `options.wait`
+/// says, and keeps house when idle, until `shutdown` becomes true.
+fn serve_until(
+    options: &ServeOptions,
+    state: &mut State,
+    endpoints: &Endpoints,
+    waitset: &WaitSet<ipc::Service>,
+    shutdown: &AtomicBool,
+) {
     let mut last_request = Instant::now();
     let mut last_yield = Instant::now();
-    let mut last_housekeeping = Instant::now();
-    let mut reap_after = Instant::now();
+    let mut house = Housekeeping {
+        last: Instant::now(),
+        reap_after: Instant::now(),
+    };
     let mut turns: u32 = 0;
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
-        let mut served = serve_queries(&query, &mut state);
+        let mut served = serve_queries(&endpoints.query, state);
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
         if options.wait != WaitMode::Spin || turns.is_multiple_of(ADMIN_POLL_EVERY) {
-            served += serve_admin(&admin, &admin_service, &mut state);
+            served += serve_admin(&endpoints.admin, &endpoints.admin_service, state);
         }
         let now = Instant::now();
         if served > 0 {
@@ -243,33 +314,12 @@ pub fn run(
             // idle turn after each reply.
             last_yield = now;
         }
-        let since = now.duration_since(last_housekeeping);
+        let since = now.duration_since(house.last);
         if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
             && since > HOUSEKEEPING_PERIOD)
             || since > HOUSEKEEPING_FORCED
         {
-            last_housekeeping = now;
-            let cleaned = node.try_cleanup_dead_nodes();
-            if cleaned.cleanups > 0 {
-                info!(
-                    count = cleaned.cleanups,
-                    "cleaned up resources of dead clients"
-                );
-            }
-            // Always compared with the live list, not the count: a client
-            // that died while another connected leaves the count unchanged.
-            forget_departed_clients(&query_service, &mut state);
-            if options.remove_departed && now >= reap_after {
-                // A store that cannot be written is not retried at every
-                // housekeeping: each attempt may write a whole snapshot.
-                if !remove_departed_objects(&mut state) {
-                    reap_after = now + REAP_BACKOFF;
-                }
-            }
-            state.set_clients(query_service.dynamic_config().number_of_clients());
-            if let Err(e) = state.flush() {
-                error!("cannot sync the pose journal: {e}");
-            }
+            keep_house(options, state, endpoints, &mut house, now);
         }
         if served > 0 {
             continue;
@@ -280,7 +330,12 @@ pub fn run(
             WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
         };
         if sleep {
-            block(&waitset, &listener, &query, &admin);
+            block(
+                waitset,
+                &endpoints.listener,
+                &endpoints.query,
+                &endpoints.admin,
+            );
         } else if now.duration_since(last_yield) >= POLITE_EVERY {
             // A client scheduled onto this core could not send while the
             // server spins: give the core away now and then.
@@ -290,31 +345,40 @@ pub fn run(
             std::hint::spin_loop();
         }
     }
-    info!(service = %options.service, "shutting down");
+}
+
+/// Cleans up after dead processes, forgets departed clients (and, when
+/// asked for, removes their objects), and puts the pose journal on disk.
+fn keep_house(
+    options: &ServeOptions,
+    state: &mut State,
+    endpoints: &Endpoints,
+    house: &mut Housekeeping,
+    now: Instant,
+) {
+    house.last = now;
+    let cleaned = endpoints.node.try_cleanup_dead_nodes();
+    if cleaned.cleanups > 0 {
+        info!(
+            count = cleaned.cleanups,
+            "cleaned up resources of dead clients"
+        );
+    }
+    // Always compared with the live list, not the count: a client that died
+    // while another connected leaves the count unchanged.
+    forget_departed_clients(&endpoints.query_service, state);
+    // A store that cannot be written is not retried at every housekeeping.
+    if options.remove_departed && now >= house.reap_after && !remove_departed_objects(state) {
+        house.reap_after = now + REAP_BACKOFF;
+    }
+    state.set_clients(endpoints.query_service.dynamic_config().number_of_clients());
     if let Err(e) = state.flush() {
         error!("cannot sync the pose journal: {e}");
     }
-    // One snapshot write, so that the next start reads a single file; if it
-    // fails, nothing is lost: the log still holds every change.
-    if let Err(e) = state.compact() {
-        error!("cannot fold the change log into the state file: {e}");
-    }
-    // Ports, services and the node are dropped here, in reverse order of
-    // creation, which removes the services' shared memory.
-    Ok(())
 }
 
 /// Drops the warm starts of query clients that are no longer connected.
-fn forget_departed_clients(
-    query_service: &iceoryx2::service::port_factory::request_response::PortFactory<
-        ipc::Service,
-        [Item],
-        (),
-        [ItemResult],
-        ReplyHeader,
-    >,
-    state: &mut State,
-) {
+fn forget_departed_clients(query_service: &QueryService, state: &mut State) {
     let mut alive = std::collections::HashSet::new();
     query_service.dynamic_config().list_clients(|c| {
         alive.insert(c.client_id.value());
@@ -333,7 +397,7 @@ fn forget_departed_clients(
 /// cannot be listed at all nothing is removed. False when a removal could
 /// not be committed.
 fn remove_departed_objects(state: &mut State) -> bool {
-    let alive = match crate::objects::alive_nodes() {
+    let alive = match crate::offline::alive_nodes() {
         Ok(alive) => alive,
         Err(e) => {
             warn!("cannot list the running clients, no object removed: {e}");
@@ -457,14 +521,6 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
         }
     }
 }
-
-type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
-    ipc::Service,
-    [Vertex],
-    AdminRequest,
-    AdminReply,
-    (),
->;
 
 /// The owner identity of admin client port `port`: the id of the iceoryx2
 /// node that created it. A `gjkd-client` `Client` keeps its node for its

@@ -92,7 +92,7 @@ fn a_service_of_another_pattern_is_incompatible() {
     match connect(&service).0 {
         Err(ClientError::Incompatible { service: s, cause }) => {
             assert_eq!(s, query);
-            assert!(cause.contains("PublishSubscribe"), "cause: {cause}");
+            assert!(cause.contains("publish-subscribe"), "cause: {cause}");
         }
         other => panic!("expected Incompatible, got {:?}", other.map(|_| ())),
     }
@@ -113,4 +113,25 @@ fn no_service_at_all_is_a_server_gone() {
         start.elapsed() >= Duration::from_millis(200),
         "a missing server is waited for until the connect timeout"
     );
+}
+
+#[test]
+fn a_server_half_set_up_is_waited_for_not_called_incompatible() {
+    // A starting server has made its query service but not yet its admin
+    // service: the client must wait for it, not blame the name's owner.
+    let service = unique_service("half-up");
+    let node = node();
+    let _query = node
+        .service_builder(&ServiceName::new(&query_service_name(&service)).unwrap())
+        .request_response::<[gjkd_proto::Item], [gjkd_proto::ItemResult]>()
+        .response_user_header::<gjkd_proto::ReplyHeader>()
+        .create()
+        .expect("gjkd's own query service");
+    let result = Client::builder(&service)
+        .timeout(Duration::from_millis(200))
+        .connect();
+    match result {
+        Err(ClientError::ServerGone(s)) => assert_eq!(s, service),
+        other => panic!("expected ServerGone, got {:?}", other.map(|_| ())),
+    }
 }

@@ -1,0 +1,89 @@
+"""gjkd: certified distances between convex shapes, from Python.
+
+Three ways to the same answers, all on numpy arrays:
+
+- :class:`Client` talks to a gjkd server on this host over shared memory
+  (start one with :class:`Server` or ``python -m gjkd serve``);
+- :class:`Local` (also ``gjkd.local.Local``) holds the shapes in this
+  process and answers the same calls, bit for bit, with no server;
+- :class:`Server` runs a server in a child process.
+
+Register shapes once (``register_sphere``, ``register_capsule``,
+``register_box``, ``register_polytope``, ``register_compound``; each returns
+an int id), set poses (``set_pose``, ``set_poses``: ``[x, y, z, qx, qy, qz,
+qw]`` rows or 4x4 matrices), then ask ``distance(a, b)`` for one pair or
+``distances(pairs)`` for many in one call. Every answer carries certified
+bounds ``lower <= distance <= upper``, nearest points and a normal.
+
+Example::
+
+    import numpy as np
+    import gjkd
+
+    with gjkd.Server(service="example") as server, gjkd.Client("example") as client:
+        ball = client.register_sphere(0.5)
+        crate = client.register_box([1.0, 1.0, 1.0])
+        client.set_pose(ball, [3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+        print(client.distance(crate, ball).distance)  # 1.5
+        result = client.distances(np.array([[crate, ball]]))
+        print(result.distance, result.point_a, result.error)
+"""
+
+from __future__ import annotations
+
+from . import local
+from ._codes import ErrorCode, Status
+from ._errors import (
+    AccessDenied,
+    Error,
+    Incompatible,
+    InvalidInput,
+    IpcError,
+    NotFound,
+    ProtocolError,
+    Refused,
+    ServerGone,
+    Timeout,
+)
+from ._native import (
+    DEFAULT_MAX_ITERATIONS,
+    DEFAULT_TOLERANCE,
+    MAX_NAME_LEN,
+    MAX_PIECES,
+    PROTOCOL_VERSION,
+    Answer,
+    Client,
+    Distances,
+    Local,
+    Shape,
+)
+from .server import Server
+
+__all__ = [
+    "AccessDenied",
+    "DEFAULT_MAX_ITERATIONS",
+    "DEFAULT_TOLERANCE",
+    "MAX_NAME_LEN",
+    "MAX_PIECES",
+    "PROTOCOL_VERSION",
+    "Answer",
+    "Client",
+    "Distances",
+    "Error",
+    "ErrorCode",
+    "Incompatible",
+    "InvalidInput",
+    "IpcError",
+    "Local",
+    "NotFound",
+    "ProtocolError",
+    "Refused",
+    "Server",
+    "ServerGone",
+    "Shape",
+    "Status",
+    "Timeout",
+    "local",
+]
+
+__version__ = "0.1.0"

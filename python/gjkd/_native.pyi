@@ -1,0 +1,287 @@
+"""Type stubs of the native module ``gjkd._native`` (see ``gjkd``)."""
+
+from types import TracebackType
+from typing import Optional, Sequence, Tuple, Type
+
+import numpy as np
+import numpy.typing as npt
+from typing_extensions import Self, final
+
+__all__ = [
+    "Answer",
+    "Client",
+    "DEFAULT_MAX_ITERATIONS",
+    "DEFAULT_TOLERANCE",
+    "Distances",
+    "Local",
+    "MAX_NAME_LEN",
+    "MAX_PIECES",
+    "PROTOCOL_VERSION",
+    "Shape",
+    "error_codes",
+    "serve",
+]
+
+DEFAULT_TOLERANCE: float
+DEFAULT_MAX_ITERATIONS: int
+MAX_PIECES: int
+MAX_NAME_LEN: int
+PROTOCOL_VERSION: int
+
+_ArrayLike = npt.ArrayLike
+_Pose = npt.ArrayLike
+"""A pose: ``(7,)`` ``[x, y, z, qx, qy, qz, qw]`` or a ``(4, 4)`` rigid
+transform, float64."""
+
+_F64 = npt.NDArray[np.float64]
+_U32 = npt.NDArray[np.uint32]
+
+@final
+class Shape:
+    """A convex shape: the hull of its vertices grown by a radius."""
+
+    @staticmethod
+    def sphere(radius: float) -> Shape:
+        """A ball of ``radius`` about the body origin."""
+    @staticmethod
+    def capsule(a: _ArrayLike, b: _ArrayLike, radius: float) -> Shape:
+        """The segment ``a``-``b`` grown by ``radius``."""
+    @staticmethod
+    def box(half_extents: _ArrayLike, radius: float = 0.0) -> Shape:
+        """A box of these half extents, edges rounded by ``radius``."""
+    @staticmethod
+    def polytope(vertices: _ArrayLike, radius: float = 0.0) -> Shape:
+        """The convex hull of ``(N, 3)`` float64 ``vertices`` grown by ``radius``."""
+    @property
+    def kind(self) -> str:
+        """``"sphere"``, ``"capsule"``, ``"box"`` or ``"polytope"``."""
+    @property
+    def radius(self) -> float:
+        """The rounding radius."""
+    @property
+    def vertices(self) -> _F64:
+        """``(N, 3)`` vertices in the order the server stores them."""
+
+@final
+class Answer:
+    """The answer to one pair query."""
+
+    @property
+    def distance(self) -> float:
+        """Distance between the (rounded) shapes."""
+    @property
+    def lower(self) -> float:
+        """Certified lower bound on the distance."""
+    @property
+    def upper(self) -> float:
+        """Certified upper bound on the distance."""
+    @property
+    def penetration(self) -> float:
+        """Lower bound on the penetration depth; 0 when separated."""
+    @property
+    def point_a(self) -> Tuple[float, float, float]:
+        """Nearest point on A, world frame."""
+    @property
+    def point_b(self) -> Tuple[float, float, float]:
+        """Nearest point on B, world frame."""
+    @property
+    def normal(self) -> Tuple[float, float, float]:
+        """Unit vector from A's nearest point towards B's (zero at contact)."""
+    @property
+    def status(self) -> int:
+        """A ``gjkd.Status`` value."""
+    @property
+    def iterations(self) -> int:
+        """Subalgorithm iterations."""
+    @property
+    def pieces(self) -> Tuple[int, int]:
+        """Pieces of A and B realising the distance (0 for convex objects)."""
+    @property
+    def warm_started(self) -> bool:
+        """The query started from the pair's last simplex."""
+    @property
+    def backup_used(self) -> bool:
+        """The Backup Procedure ran."""
+
+@final
+class Distances:
+    """The answers of N pair queries, one numpy array per field."""
+
+    def __new__(cls, n: int) -> Self:
+        """Zeroed arrays for ``n`` pairs, to pass as ``out=``."""
+    def __len__(self) -> int: ...
+    @property
+    def distance(self) -> _F64:
+        """``(N,)`` distances."""
+    @property
+    def lower(self) -> _F64:
+        """``(N,)`` certified lower bounds."""
+    @property
+    def upper(self) -> _F64:
+        """``(N,)`` certified upper bounds."""
+    @property
+    def penetration(self) -> _F64:
+        """``(N,)`` lower bounds on penetration depth."""
+    @property
+    def point_a(self) -> _F64:
+        """``(N, 3)`` nearest points on A."""
+    @property
+    def point_b(self) -> _F64:
+        """``(N, 3)`` nearest points on B."""
+    @property
+    def normal(self) -> _F64:
+        """``(N, 3)`` unit normals from A towards B."""
+    @property
+    def status(self) -> _U32:
+        """``(N,)`` ``gjkd.Status`` values (0 for failed rows)."""
+    @property
+    def iterations(self) -> _U32:
+        """``(N,)`` subalgorithm iterations."""
+    @property
+    def pieces(self) -> _U32:
+        """``(N, 2)`` pieces realising the distance."""
+    @property
+    def error(self) -> _U32:
+        """``(N,)`` ``gjkd.ErrorCode`` values, 0 when answered."""
+    @property
+    def warm_started(self) -> npt.NDArray[np.bool_]:
+        """``(N,)`` whether each query started warm."""
+    @property
+    def ok(self) -> npt.NDArray[np.bool_]:
+        """``(N,)`` the rows that were answered."""
+    def as_dict(self) -> dict[str, npt.NDArray[np.generic]]:
+        """The arrays keyed by field name."""
+
+class _Objects:
+    """The methods ``Client`` and ``Local`` share."""
+
+    def register(
+        self, shape: Shape, *, name: Optional[str] = None, pose: Optional[_Pose] = None
+    ) -> int:
+        """Registers ``shape``; returns its id."""
+    def register_sphere(
+        self, radius: float, *, name: Optional[str] = None, pose: Optional[_Pose] = None
+    ) -> int:
+        """Registers a ball; returns its id."""
+    def register_capsule(
+        self,
+        a: _ArrayLike,
+        b: _ArrayLike,
+        radius: float,
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers a capsule; returns its id."""
+    def register_box(
+        self,
+        half_extents: _ArrayLike,
+        radius: float = 0.0,
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers a box; returns its id."""
+    def register_polytope(
+        self,
+        vertices: _ArrayLike,
+        radius: float = 0.0,
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers the convex hull of ``(N, 3)`` vertices; returns its id."""
+    def register_compound(
+        self,
+        pieces: Sequence[Tuple[_Pose, Shape]],
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers a union of ``(offset, Shape)`` pieces; returns its id."""
+    def remove(self, id: int) -> None:
+        """Removes object ``id``."""
+    def lookup(self, name: str) -> int:
+        """The id of the object named ``name``."""
+    def set_pose(self, id: int, pose: _Pose) -> None:
+        """Stores the pose of object ``id``."""
+    def set_poses(self, ids: _ArrayLike, poses: _ArrayLike) -> None:
+        """Stores ``(N, 7)`` or ``(N, 4, 4)`` poses of ``(N,)`` ids."""
+    def distance(
+        self,
+        a: int,
+        b: int,
+        pose_a: Optional[_Pose] = None,
+        pose_b: Optional[_Pose] = None,
+        *,
+        tolerance: float = ...,
+        max_iterations: int = 128,
+        margin: Optional[float] = None,
+        warm_start: bool = True,
+    ) -> Answer:
+        """The distance between objects ``a`` and ``b``."""
+    def distances(
+        self,
+        pairs: _ArrayLike,
+        poses_a: Optional[_ArrayLike] = None,
+        poses_b: Optional[_ArrayLike] = None,
+        *,
+        tolerance: float = ...,
+        max_iterations: int = 128,
+        margin: Optional[float] = None,
+        warm_start: bool = True,
+        out: Optional[Distances] = None,
+    ) -> Distances:
+        """The distances of ``(N, 2)`` pairs in one call."""
+    def close(self) -> None:
+        """Closes (a no-op for ``Local``)."""
+
+@final
+class Client(_Objects):
+    """A connection to a gjkd server on this host."""
+
+    def __new__(
+        cls, service: str = "gjkd", timeout: float = 1.0, connect_timeout: Optional[float] = None
+    ) -> Self: ...
+    @property
+    def service(self) -> str:
+        """The service name."""
+    @property
+    def timeout(self) -> float:
+        """The timeout of every call, in seconds."""
+    @property
+    def connected(self) -> bool:
+        """Whether the client holds a connection."""
+    def server_info(self) -> Optional[dict[str, int]]:
+        """The server's limits, wait mode and pid."""
+    def stats(self) -> dict[str, int]:
+        """The server's counters."""
+    def __enter__(self) -> Client: ...
+    def __exit__(
+        self,
+        exc_type: Optional[Type[BaseException]],
+        exc: Optional[BaseException],
+        tb: Optional[TracebackType],
+    ) -> bool: ...
+
+@final
+class Local(_Objects):
+    """Shapes held in this process, answered with no server."""
+
+    def __new__(cls, max_vertices: int = 100000, cache_capacity: int = 65536) -> Self: ...
+    def __len__(self) -> int: ...
+    def forget_warm_starts(self) -> None:
+        """Forgets every pair's last simplex."""
+    def __enter__(self) -> Local: ...
+    def __exit__(
+        self,
+        exc_type: Optional[Type[BaseException]],
+        exc: Optional[BaseException],
+        tb: Optional[TracebackType],
+    ) -> bool: ...
+
+def serve(args: list[str]) -> int:
+    """Runs ``gjkd serve`` with ``args``; returns the exit status."""
+
+def error_codes() -> list[tuple[str, int, str]]:
+    """Every error code as ``(name, value, description)``."""

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The Python package's tests: makes (or reuses) a virtual environment, installs
+# maturin, numpy, pytest and mypy, builds the package into it, then runs
+# pytest. Extra arguments go to pytest.
+#
+# By default the package is built by `maturin develop` in the dev profile,
+# in the workspace's target directory: it reuses what `cargo test` built, so
+# the whole test command stays short. GJKD_PY_INSTALL=pip builds it as a
+# user does, `pip install ./python` (release, from scratch the first time).
+#
+#   python/run-tests.sh                 # venv in python/.venv
+#   GJKD_VENV=/tmp/venv python/run-tests.sh -k errors
+#   GJKD_PY_INSTALL=pip python/run-tests.sh
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+venv="${GJKD_VENV:-$here/.venv}"
+python="${PYTHON:-python3}"
+
+if [ ! -x "$venv/bin/python" ]; then
+  echo "== creating $venv"
+  "$python" -m venv "$venv"
+fi
+echo "== installing maturin, numpy, pytest and mypy"
+"$venv/bin/python" -m pip install --quiet --upgrade pip
+"$venv/bin/python" -m pip install --quiet "maturin>=1.7,<2" "numpy>=1.21" "pytest>=7" "mypy>=1.10"
+if [ "${GJKD_PY_INSTALL:-develop}" = pip ]; then
+  "$venv/bin/python" -m pip install --quiet "$here"
+else
+  echo "== maturin develop (dev profile, shared target directory)"
+  (cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet --skip-install)
+fi
+echo "== pytest"
+cd "$here"
+# pytest itself, not `python -m pytest`, which would put this directory on
+# sys.path and import the source tree instead of the installed package.
+exec "$venv/bin/pytest" -q "$@"

@@ -1,0 +1,473 @@
+//! What `gjkd.Client` and `gjkd.Local` have in common: the calls of their
+//! Python API written once over a [`Backend`], and the macro that gives
+//! both classes the same methods.
+
+use pyo3::prelude::*;
+
+use gjkd_client::{ClientError, ErrorCode, Item, ItemResult, ObjectId};
+use gjkd_proto::Pose;
+
+use nalgebra::Isometry3;
+
+use crate::arrays::{Ids, Poses, id_array, pose, pose_array};
+use crate::batch::{Answer, Distances, RequestArrays, options, set_pose_a, set_pose_b};
+use crate::errors::{self, invalid};
+use crate::runner::{Answerer, Buffers, run_items, run_pairs};
+use crate::server_lib::check_pose;
+use crate::shape::{Pieces, Registration, Shape};
+
+/// Who holds the objects: a server (through the Rust client) or the
+/// Python process.
+pub trait Backend {
+    /// The answerer of query items and the buffers kept for it.
+    fn parts(&mut self, py: Python<'_>) -> PyResult<(&mut dyn Answerer, &mut Buffers)>;
+    /// Registers `what`, returning its id.
+    fn register(
+        &mut self,
+        py: Python<'_>,
+        what: &Registration<'_>,
+        name: Option<&str>,
+        pose: Option<Pose>,
+    ) -> PyResult<u64>;
+    /// Removes object `id`.
+    fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()>;
+    /// The id of the object named `name`.
+    fn lookup(&mut self, py: Python<'_>, name: &str) -> PyResult<u64>;
+}
+
+/// A pose argument, checked as the server will check it, so that a bad one
+/// raises before anything is registered or changed.
+pub fn checked_pose(
+    py: Python<'_>,
+    obj: Option<&Bound<'_, PyAny>>,
+    field: &str,
+) -> PyResult<Option<Pose>> {
+    let Some(p) = pose(obj, field)? else {
+        return Ok(None);
+    };
+    check_pose(&p).map_err(|code| errors::refused(py, code, Some(field), None))?;
+    Ok(Some(p))
+}
+
+/// Registers one convex shape.
+pub fn register_shape(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    shape: &Shape,
+    name: Option<&str>,
+    pose: Option<&Bound<'_, PyAny>>,
+) -> PyResult<u64> {
+    let pose = checked_pose(py, pose, "pose")?;
+    backend.register(py, &Registration::Convex(shape), name, pose)
+}
+
+/// Registers a compound of `[(pose, Shape), ...]`.
+pub fn register_compound(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    pieces: &Bound<'_, PyAny>,
+    name: Option<&str>,
+    pose: Option<&Bound<'_, PyAny>>,
+) -> PyResult<u64> {
+    let pieces = Pieces::read(pieces)?;
+    for (i, offset) in pieces.offsets.iter().enumerate() {
+        check_pose(offset).map_err(|code| errors::refused(py, code, Some("pieces"), Some(i)))?;
+    }
+    let pose = checked_pose(py, pose, "pose")?;
+    backend.register(py, &Registration::Compound(&pieces), name, pose)
+}
+
+/// Stores `poses[i]` for `ids[i]` (arrays as Python gives them).
+pub fn set_poses(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    ids: &Bound<'_, PyAny>,
+    poses: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let id_arr = id_array(ids, "ids")?;
+    if id_arr.shape().len() != 1 {
+        return Err(invalid(
+            py,
+            "ids",
+            None,
+            format!("ids must have shape (N,), got {:?}", id_arr.shape()),
+        ));
+    }
+    let pose_arr = pose_array(poses, "poses")?;
+    store_poses(backend, py, id_arr.slice()?, pose_arr.poses()?, "poses")
+}
+
+/// Stores one pose.
+pub fn set_pose(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    id: u64,
+    pose_obj: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let p = pose(Some(pose_obj), "pose")?
+        .ok_or_else(|| invalid(py, "pose", None, "pose must not be None".into()))?;
+    let row = [
+        p.translation[0],
+        p.translation[1],
+        p.translation[2],
+        p.rotation[0],
+        p.rotation[1],
+        p.rotation[2],
+        p.rotation[3],
+    ];
+    let ids = [id];
+    store_poses(backend, py, Ids::Unsigned(&ids), Poses::rows(&row), "pose")
+}
+
+/// Every pose is checked first (a bad one raises `InvalidInput` with its
+/// row and changes nothing); an unknown id raises `NotFound` with its row
+/// after the other rows were stored.
+fn store_poses(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    ids: Ids<'_>,
+    poses: Poses<'_>,
+    field: &str,
+) -> PyResult<()> {
+    let n = ids.len();
+    if poses.len() != n {
+        return Err(invalid(
+            py,
+            field,
+            None,
+            format!("{field} has {} rows for {n} ids", poses.len()),
+        ));
+    }
+    // A single pose (`set_pose`) has no row to name.
+    let row = |i: usize| (field != "pose").then_some(i);
+    for i in 0..n {
+        check_pose(&poses.get(i)).map_err(|c| errors::refused(py, c, Some(field), row(i)))?;
+    }
+    if n == 0 {
+        return Ok(());
+    }
+    let make = move |i: usize| -> Item {
+        let mut item = Item::set_pose(ObjectId::from_raw(ids.get(i)), &Isometry3::identity());
+        item.pose_a = poses.get(i);
+        item
+    };
+    let mut failed: Option<(usize, ErrorCode)> = None;
+    let mut check = |i: usize, r: &ItemResult| -> Result<(), ClientError> {
+        if r.error != 0 && failed.is_none() {
+            failed = Some((i, r.error_code()));
+        }
+        Ok(())
+    };
+    let (answerer, buffers) = backend.parts(py)?;
+    run_items(py, answerer, buffers, n, &make, &mut check)
+        .map_err(|e| errors::client(py, e, None))?;
+    match failed {
+        Some((i, code)) => {
+            let field = if code == ErrorCode::UnknownObject {
+                "ids"
+            } else {
+                field
+            };
+            Err(errors::refused(py, code, Some(field), row(i)))
+        }
+        None => Ok(()),
+    }
+}
+
+/// Keyword options of a query, as Python passes them.
+pub struct QueryArgs {
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Iteration cap.
+    pub max_iterations: u32,
+    /// Early-exit margin.
+    pub margin: Option<f64>,
+    /// Start from the pair's last simplex.
+    pub warm_start: bool,
+}
+
+/// One pair query.
+pub fn distance(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    a: u64,
+    b: u64,
+    pose_a: Option<&Bound<'_, PyAny>>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+    args: &QueryArgs,
+) -> PyResult<Answer> {
+    let opts = options(
+        py,
+        args.tolerance,
+        args.max_iterations,
+        args.margin,
+        args.warm_start,
+    )?;
+    let mut item = Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(b), &opts);
+    if let Some(p) = pose(pose_a, "pose_a")? {
+        set_pose_a(&mut item, p);
+    }
+    if let Some(p) = pose(pose_b, "pose_b")? {
+        set_pose_b(&mut item, p);
+    }
+    let mut out = ItemResult::default();
+    let mut check = |_: usize, r: &ItemResult| -> Result<(), ClientError> {
+        out = *r;
+        Ok(())
+    };
+    let (answerer, buffers) = backend.parts(py)?;
+    run_items(py, answerer, buffers, 1, &move |_| item, &mut check)
+        .map_err(|e| errors::client(py, e, None))?;
+    match out.error_code() {
+        ErrorCode::Ok => Ok(Answer::new(out)),
+        code => {
+            let field = match code {
+                ErrorCode::UnknownObject => Some("id"),
+                ErrorCode::NonFinitePose | ErrorCode::BadQuaternion => Some("pose"),
+                _ => None,
+            };
+            Err(errors::refused(py, code, field, None))
+        }
+    }
+}
+
+/// `N` pair queries in as few round trips as the answerer's limit allows.
+pub fn distances(
+    backend: &mut dyn Backend,
+    py: Python<'_>,
+    pairs: &Bound<'_, PyAny>,
+    poses_a: Option<&Bound<'_, PyAny>>,
+    poses_b: Option<&Bound<'_, PyAny>>,
+    args: &QueryArgs,
+    out: Option<Bound<'_, Distances>>,
+) -> PyResult<Py<Distances>> {
+    let opts = options(
+        py,
+        args.tolerance,
+        args.max_iterations,
+        args.margin,
+        args.warm_start,
+    )?;
+    let arrays = RequestArrays::read(pairs, poses_a, poses_b)?;
+    let result = Distances::reuse_or_new(py, out, arrays.len())?;
+    let request = arrays.request(opts)?;
+    let (answerer, buffers) = backend.parts(py)?;
+    run_pairs(py, answerer, buffers, request, &result.borrow(py))?
+        .map_err(|e| errors::client(py, e, None))?;
+    Ok(result)
+}
+
+/// The Python methods `gjkd.Client` and `gjkd.Local` share, plus the
+/// class's own (`$extra`), in the one `#[pymethods]` block a class may
+/// have.
+macro_rules! backend_methods {
+    ($class:ident, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $class {
+            $($extra)*
+
+            /// Registers `shape` (a `gjkd.Shape`), optionally with a unique
+            /// `name` (see `lookup`) and an initial `pose` (`(7,)`
+            /// `[x, y, z, qx, qy, qz, qw]` or `(4, 4)`; default identity).
+            /// Returns the new object's id (an int).
+            #[pyo3(signature = (shape, *, name = None, pose = None))]
+            fn register(
+                &mut self,
+                py: Python<'_>,
+                shape: &Bound<'_, crate::shape::Shape>,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                crate::api::register_shape(self, py, shape.get(), name, pose)
+            }
+
+            /// Registers a ball of `radius` about the body origin; `name`
+            /// and `pose` as for `register`. Returns its id.
+            #[pyo3(signature = (radius, *, name = None, pose = None))]
+            fn register_sphere(
+                &mut self,
+                py: Python<'_>,
+                radius: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::sphere(radius);
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
+            /// Registers the segment `a`–`b` (three floats each) grown by
+            /// `radius`; `name` and `pose` as for `register`. Returns its id.
+            #[pyo3(signature = (a, b, radius, *, name = None, pose = None))]
+            fn register_capsule(
+                &mut self,
+                py: Python<'_>,
+                a: &Bound<'_, PyAny>,
+                b: &Bound<'_, PyAny>,
+                radius: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::capsule(a, b, radius)?;
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
+            /// Registers a box of these half extents (three floats, each
+            /// `>= 0`) centred on the body origin, its edges rounded by
+            /// `radius`; `name` and `pose` as for `register`. Returns its id.
+            #[pyo3(signature = (half_extents, radius = 0.0, *, name = None, pose = None))]
+            fn register_box(
+                &mut self,
+                py: Python<'_>,
+                half_extents: &Bound<'_, PyAny>,
+                radius: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::cuboid(py, half_extents, radius)?;
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
+            /// Registers the convex hull of `vertices` (`(N, 3)` float64,
+            /// N >= 1) grown by `radius`; `name` and `pose` as for
+            /// `register`. Returns its id.
+            #[pyo3(signature = (vertices, radius = 0.0, *, name = None, pose = None))]
+            fn register_polytope(
+                &mut self,
+                py: Python<'_>,
+                vertices: &Bound<'_, PyAny>,
+                radius: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::polytope(vertices, radius)?;
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
+            /// Registers a union of convex pieces, `[(offset, Shape), ...]`
+            /// (at most 64), each placed in the compound's body frame by its
+            /// offset (`(7,)` or `(4, 4)`). Answers name the pieces that
+            /// realise the distance by position in this list. `name` and
+            /// `pose` as for `register`. Returns its id.
+            #[pyo3(signature = (pieces, *, name = None, pose = None))]
+            fn register_compound(
+                &mut self,
+                py: Python<'_>,
+                pieces: &Bound<'_, PyAny>,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                crate::api::register_compound(self, py, pieces, name, pose)
+            }
+
+            /// Removes object `id`. Its id is never reused.
+            fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()> {
+                crate::api::Backend::remove(self, py, id)
+            }
+
+            /// The id of the object named `name`.
+            fn lookup(&mut self, py: Python<'_>, name: &str) -> PyResult<u64> {
+                crate::api::Backend::lookup(self, py, name)
+            }
+
+            /// Stores `pose` (`(7,)` or `(4, 4)`) as the pose of object `id`,
+            /// used by every later query that gives no pose of its own.
+            fn set_pose(
+                &mut self,
+                py: Python<'_>,
+                id: u64,
+                pose: &Bound<'_, PyAny>,
+            ) -> PyResult<()> {
+                crate::api::set_pose(self, py, id, pose)
+            }
+
+            /// Stores many poses in one round trip: `ids` `(N,)` integers
+            /// and `poses` `(N, 7)` `[x, y, z, qx, qy, qz, qw]` or
+            /// `(N, 4, 4)` float64. Every pose is checked first: a bad one
+            /// raises `InvalidInput` (with `index` its row) and stores
+            /// nothing. An unknown id raises `NotFound` (with its row) after
+            /// the other rows were stored.
+            fn set_poses(
+                &mut self,
+                py: Python<'_>,
+                ids: &Bound<'_, PyAny>,
+                poses: &Bound<'_, PyAny>,
+            ) -> PyResult<()> {
+                crate::api::set_poses(self, py, ids, poses)
+            }
+
+            /// The distance between objects `a` and `b`, at their stored
+            /// poses or at `pose_a` / `pose_b` (`(7,)` or `(4, 4)`) for this
+            /// query only. `tolerance` is the relative tolerance of the
+            /// stopping rule (default `gjkd.DEFAULT_TOLERANCE`, 100 × machine
+            /// epsilon), `max_iterations` the iteration cap, `margin`
+            /// an early exit (stop once the distance is proved above or at
+            /// most it), `warm_start` starts from the pair's last simplex.
+            /// Returns an `Answer`; a refused query raises (`NotFound` for
+            /// an unknown id, `InvalidInput` for a bad pose).
+            #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
+                tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
+                margin = None, warm_start = true),
+                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True)")]
+            #[allow(clippy::too_many_arguments)]
+            fn distance(
+                &mut self,
+                py: Python<'_>,
+                a: u64,
+                b: u64,
+                pose_a: Option<&Bound<'_, PyAny>>,
+                pose_b: Option<&Bound<'_, PyAny>>,
+                tolerance: f64,
+                max_iterations: u32,
+                margin: Option<f64>,
+                warm_start: bool,
+            ) -> PyResult<crate::batch::Answer> {
+                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                crate::api::distance(self, py, a, b, pose_a, pose_b, &args)
+            }
+
+            /// The distances of `N` pairs at once: `pairs` `(N, 2)` integer
+            /// ids; `poses_a`, `poses_b` `(N, 7)` or `(N, 4, 4)` float64
+            /// poses for these queries only (default: the stored poses);
+            /// options as for `distance`, the same for every pair. Batches
+            /// larger than the server takes are split transparently.
+            /// Returns a `Distances` (arrays, one row per pair); a pair
+            /// that fails has its `ErrorCode` in `error` and the other
+            /// pairs are still answered. `out`, a `Distances` of `N` rows
+            /// from an earlier call, is filled instead of new arrays.
+            #[pyo3(signature = (pairs, poses_a = None, poses_b = None, *,
+                tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
+                margin = None, warm_start = true, out = None),
+                text_signature = "($self, pairs, poses_a=None, poses_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, out=None)")]
+            #[allow(clippy::too_many_arguments)]
+            fn distances(
+                &mut self,
+                py: Python<'_>,
+                pairs: &Bound<'_, PyAny>,
+                poses_a: Option<&Bound<'_, PyAny>>,
+                poses_b: Option<&Bound<'_, PyAny>>,
+                tolerance: f64,
+                max_iterations: u32,
+                margin: Option<f64>,
+                warm_start: bool,
+                out: Option<Bound<'_, crate::batch::Distances>>,
+            ) -> PyResult<Py<crate::batch::Distances>> {
+                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
+            }
+
+            /// Returns itself: `with ... as x:`.
+            fn __enter__(slf: Py<Self>) -> Py<Self> {
+                slf
+            }
+
+            /// Closes (see `close`); exceptions pass through.
+            #[pyo3(signature = (*_args))]
+            fn __exit__(&mut self, _args: &Bound<'_, pyo3::types::PyTuple>) -> bool {
+                self.close();
+                false
+            }
+        }
+    };
+}
+
+pub(crate) use backend_methods;

@@ -1,0 +1,140 @@
+//! `gjkd.Local`: the same calls as `gjkd.Client`, answered in this process.
+
+use pyo3::prelude::*;
+
+use gjkd_client::{ClientError, Item, ItemResult};
+use gjkd_proto::{AdminOp, AdminRequest, Pose};
+
+use crate::api::{Backend, backend_methods};
+use crate::errors;
+use crate::runner::{Answerer, Buffers};
+use crate::server_lib::{Limits, Store};
+use crate::shape::{Registration, wire_registration};
+
+/// Objects held in this Python process and the distances between them,
+/// with no server: the same methods as `gjkd.Client`, the same arrays, the
+/// same errors.
+///
+/// `Local(max_vertices=100000, cache_capacity=65536)`. The queries run the
+/// server's own request handlers over the same `gjk` algorithm, so for the
+/// same objects, poses, options and order of queries, `Local` answers bit
+/// for bit what a server answers one `Client`. That includes warm starts:
+/// like a server, `Local` keeps the last simplex of every ordered pair
+/// queried with `warm_start=True` (up to `cache_capacity` pairs, the
+/// least recently used dropped first), and the next warm query of the pair
+/// starts from it. (A server keeps one such cache per client: a second
+/// `Client` querying the same pairs starts cold where `Local` starts warm.)
+/// `forget_warm_starts()` empties it.
+///
+/// The GIL is released while a batch is answered. A `Local` belongs to the
+/// thread that created it.
+#[pyclass(unsendable, module = "gjkd", name = "Local")]
+pub struct Local {
+    store: LocalStore,
+    buffers: Buffers,
+}
+
+/// The store as the answerer of batches.
+struct LocalStore {
+    store: Store,
+}
+
+impl Answerer for LocalStore {
+    fn max_batch(&self) -> usize {
+        self.store.limits().max_batch
+    }
+
+    fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
+        self.store.handle(items, results);
+        Ok(())
+    }
+}
+
+impl Local {
+    fn admin(
+        &mut self,
+        py: Python<'_>,
+        request: &AdminRequest,
+        vertices: &[gjkd_proto::Vertex],
+        field: Option<&str>,
+    ) -> PyResult<u64> {
+        self.store
+            .store
+            .admin(request, vertices)
+            .map_err(|code| errors::refused(py, code, field, None))
+    }
+
+    fn close(&mut self) {}
+}
+
+impl Backend for Local {
+    fn parts(&mut self, _py: Python<'_>) -> PyResult<(&mut dyn Answerer, &mut Buffers)> {
+        Ok((&mut self.store, &mut self.buffers))
+    }
+
+    fn register(
+        &mut self,
+        py: Python<'_>,
+        what: &Registration<'_>,
+        name: Option<&str>,
+        pose: Option<Pose>,
+    ) -> PyResult<u64> {
+        let (request, vertices) =
+            wire_registration(py, what, name, pose.unwrap_or(Pose::IDENTITY))?;
+        self.admin(py, &request, &vertices, None)
+    }
+
+    fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()> {
+        let mut request = AdminRequest::new(AdminOp::Remove);
+        request.id = id;
+        self.admin(py, &request, &[], Some("id")).map(|_| ())
+    }
+
+    fn lookup(&mut self, py: Python<'_>, name: &str) -> PyResult<u64> {
+        let mut request = AdminRequest::new(AdminOp::Lookup);
+        if !request.set_name(name) {
+            return Err(errors::invalid(py, "name", None, "name too long".into()));
+        }
+        self.admin(py, &request, &[], Some("name"))
+    }
+}
+
+backend_methods!(Local, {
+    #[new]
+    #[pyo3(signature = (max_vertices = 100_000, cache_capacity = 65_536))]
+    fn new(max_vertices: usize, cache_capacity: usize) -> Self {
+        let limits = Limits {
+            max_vertices,
+            cache_capacity,
+            ..Limits::default()
+        };
+        Local {
+            store: LocalStore {
+                store: Store::new(limits),
+            },
+            buffers: Buffers::default(),
+        }
+    }
+
+    /// Number of objects held.
+    fn __len__(&self) -> usize {
+        self.store.store.len()
+    }
+
+    /// Forgets every pair's last simplex: the next query of each starts
+    /// cold.
+    fn forget_warm_starts(&mut self) {
+        self.store.store.forget_warm_starts();
+    }
+
+    /// Does nothing (a `Local` holds no connection); there for symmetry
+    /// with `Client.close`.
+    #[pyo3(name = "close")]
+    fn py_close(&mut self) {
+        self.close();
+    }
+
+    fn __repr__(&self) -> String {
+        format!("gjkd.Local(<{} objects>)", self.store.store.len())
+    }
+});

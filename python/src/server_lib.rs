@@ -1,0 +1,109 @@
+//! Everything this module takes from the server library, in one place: the
+//! pose check and the request handlers (`gjkd.Local` answers with the very
+//! code a server runs, so the answers are the same bit for bit), and the
+//! serving command (`python -m gjkd serve`).
+
+use gjkd_proto::{AdminRequest, ErrorCode, Item, ItemResult, Pose, Vertex, WaitMode};
+use nalgebra::Isometry3;
+
+/// The server's check of a wire pose (finite, unit quaternion within its
+/// tolerance) and the isometry it then uses.
+///
+/// # Errors
+/// `NonFinitePose` or `BadQuaternion`.
+pub fn check_pose(p: &Pose) -> Result<Isometry3<f64>, ErrorCode> {
+    gjkd_server::requests::check_pose(p)
+}
+
+/// The server's limits, with defaults.
+pub use gjkd_server::state::Limits;
+
+/// The server's object store and request handlers, without any IPC.
+pub struct Store {
+    state: gjkd_server::state::State,
+}
+
+/// The client identity `gjkd.Local` uses with the handlers: the owner of
+/// every object and the key of every warm start.
+const LOCAL_CLIENT: u128 = 1;
+
+impl Store {
+    /// An empty store.
+    pub fn new(limits: Limits) -> Self {
+        Store {
+            state: gjkd_server::state::State::new(limits, WaitMode::Spin, 1),
+        }
+    }
+
+    /// The limits.
+    pub fn limits(&self) -> &Limits {
+        self.state.limits()
+    }
+
+    /// Answers a registration, removal or look-up: the id, or the error.
+    pub fn admin(&mut self, request: &AdminRequest, vertices: &[Vertex]) -> Result<u64, ErrorCode> {
+        let reply = self.state.handle_admin(LOCAL_CLIENT, request, vertices);
+        match reply.error_code() {
+            ErrorCode::Ok => Ok(reply.id),
+            code => Err(code),
+        }
+    }
+
+    /// Answers query items as a server answers one request.
+    pub fn handle(&mut self, items: &[Item], results: &mut [ItemResult]) {
+        self.state.handle(LOCAL_CLIENT, items, results);
+    }
+
+    /// Objects held.
+    pub fn len(&self) -> usize {
+        self.state.len()
+    }
+
+    /// Forgets every warm start.
+    pub fn forget_warm_starts(&mut self) {
+        self.state.forget_client(LOCAL_CLIENT);
+    }
+}
+
+/// `python -m gjkd serve`: the flags of `gjkd serve`, parsed by the
+/// server library's own definition.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "python -m gjkd serve",
+    about = "Serve distance queries until SIGINT or SIGTERM."
+)]
+struct ServeCommand {
+    #[command(flatten)]
+    args: gjkd_server::commands::ServeArgs,
+}
+
+/// Runs `gjkd serve` with `args` (without the program name) until SIGINT
+/// or SIGTERM, logging to stderr as the `gjkd` binary does; the exit
+/// status.
+pub fn serve(args: &[String]) -> i32 {
+    use clap::Parser;
+    let program = std::iter::once("python -m gjkd serve".to_owned());
+    let command = match ServeCommand::try_parse_from(program.chain(args.iter().cloned())) {
+        Ok(c) => c,
+        Err(e) => {
+            // Help and version go to stdout with status 0, mistakes to
+            // stderr with status 2, as clap does on its own.
+            let _ = e.print();
+            return e.exit_code();
+        }
+    };
+    let _ = tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .try_init();
+    match gjkd_server::commands::serve(command.args) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("gjkd serve: {e}");
+            1
+        }
+    }
+}

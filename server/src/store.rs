@@ -1,0 +1,944 @@
+//! The object store: objects, their ids, names, owners and journal slots,
+//! and their persistence (the database and the pose journal). Everything a
+//! registration, a removal or a pose update changes goes through here, so
+//! that what is acknowledged is what is on disk.
+
+use std::collections::HashMap;
+
+use gjk::Shape;
+use gjkd_proto::ErrorCode;
+use nalgebra::Isometry3;
+
+use crate::cache::FxBuild;
+use crate::database::{Database, StoreError};
+use crate::journal::Journal;
+use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredPose, StoredShape};
+
+/// Who may remove an object.
+///
+/// A client is identified by the id of its iceoryx2 node: one per
+/// `gjkd-client` `Client`, kept for the `Client`'s whole life, across its
+/// reconnections and across server restarts (the id is stored in the state
+/// store). A client *process* that restarts has a new node, so objects
+/// registered by its previous life can no longer be removed by any client;
+/// the operator can (`gjkd objects --remove-departed`, see
+/// `docs/reliability.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Owner {
+    /// Loaded from the scene file at start: read-only.
+    Scene,
+    /// Registered by the client whose iceoryx2 node has this id.
+    Client(u128),
+}
+
+/// A registered object.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// The geometry.
+    pub shape: Shape,
+    /// The stored pose, used by queries that do not give their own.
+    pub pose: Isometry3<f64>,
+    /// Who registered it.
+    pub owner: Owner,
+    /// Name for look-ups, if any.
+    pub name: Option<String>,
+    /// Its slot in the pose journal (see [`crate::journal`]).
+    pub slot: u32,
+}
+
+/// The shape part of a registration, in the server's terms.
+#[derive(Clone, Debug)]
+pub struct NewObject {
+    /// The geometry.
+    pub shape: Shape,
+    /// Initial pose.
+    pub pose: Isometry3<f64>,
+    /// Optional unique name.
+    pub name: Option<String>,
+}
+
+/// Logs the objects whose pose the journal at `path` could not verify, after
+/// keeping a copy of the journal as it was `found` (it is rewritten next).
+fn report_unverified_poses(path: &std::path::Path, found: &[u8], ids: &[u64]) {
+    let kept = crate::database::aside_name(path, "corrupt");
+    let write = |kept: &std::path::Path| {
+        use std::io::Write;
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o600)
+            .open(kept)?
+            .write_all(found)
+    };
+    let kept = match write(&kept) {
+        Ok(()) => kept.display().to_string(),
+        Err(e) => format!("(no copy: {e})"),
+    };
+    let first: Vec<String> = ids.iter().take(32).map(|id| format!("{id:#x}")).collect();
+    tracing::error!(
+        file = %path.display(),
+        kept_as = %kept,
+        objects = ids.len(),
+        ids = ?first,
+        "the pose journal holds no verifiable pose for these objects (damaged, cut short, or an update torn by a crash): they are served at the pose stored with them in the database, as of their registration or the last clean shutdown"
+    );
+}
+
+/// Most objects of departed clients removed one committed transaction at a
+/// time; beyond, [`ObjectStore::remove_departed`] removes them all in one.
+pub const BULK_REMOVAL: usize = 16;
+
+/// The objects and their persistence.
+#[derive(Debug)]
+pub struct ObjectStore {
+    /// Upper 32 bits of every id of this store, so ids of another store
+    /// are unknown rather than aliases.
+    epoch: u64,
+    next_index: u32,
+    objects: HashMap<u64, Object, FxBuild>,
+    names: HashMap<String, u64>,
+    /// Where registrations and removals are committed before they are
+    /// acknowledged; `None` when persistence is off.
+    database: Option<Database>,
+    /// Latest poses, kept where a crash of this process cannot lose them
+    /// (present when `database` is).
+    journal: Option<Journal>,
+    /// Journal slots of removed objects, for reuse.
+    free_slots: Vec<u32>,
+    /// Lowest slot never used.
+    next_slot: u32,
+    /// Commits to the database and journal writes that failed.
+    persist_errors: u64,
+}
+
+impl ObjectStore {
+    /// An empty store. `epoch` goes into the upper 32 bits of every id (0 is
+    /// replaced by 1, so that no id is 0).
+    pub fn new(epoch: u32) -> Self {
+        ObjectStore {
+            epoch: u64::from(epoch.max(1)) << 32,
+            next_index: 1,
+            objects: HashMap::default(),
+            names: HashMap::new(),
+            database: None,
+            journal: None,
+            free_slots: Vec::new(),
+            next_slot: 0,
+            persist_errors: 0,
+        }
+    }
+
+    /// A store holding the objects of `snapshot` with their exact ids, its
+    /// id counter continuing where the snapshot's stopped (so no id is ever
+    /// handed out twice).
+    ///
+    /// # Errors
+    /// A description of the problem if the snapshot does not pass
+    /// [`Snapshot::validate`] or holds more than `max_objects`; nothing is
+    /// half-loaded.
+    pub fn restore(snapshot: &Snapshot, max_objects: usize) -> Result<Self, String> {
+        snapshot.validate()?;
+        if snapshot.objects.len() > max_objects {
+            return Err(format!(
+                "{} objects stored, the limit is {max_objects}",
+                snapshot.objects.len(),
+            ));
+        }
+        let mut store = ObjectStore::new(snapshot.epoch);
+        store.next_index = snapshot.next_index;
+        for o in &snapshot.objects {
+            let object = Object {
+                shape: o.shape.to_shape()?,
+                pose: o.pose.to_isometry().ok_or("bad pose")?,
+                owner: match o.owner {
+                    StoredOwner::Scene => Owner::Scene,
+                    StoredOwner::Client(c) => Owner::Client(c),
+                },
+                name: o.name.clone(),
+                slot: o.slot,
+            };
+            if let Some(name) = &object.name {
+                store.names.insert(name.clone(), o.id);
+            }
+            store.objects.insert(o.id, object);
+        }
+        let mut used: Vec<u32> = snapshot.objects.iter().map(|o| o.slot).collect();
+        used.sort_unstable();
+        store.next_slot = used.last().map_or(0, |&m| m + 1);
+        store.free_slots = (0..store.next_slot)
+            .rev()
+            .filter(|s| used.binary_search(s).is_err())
+            .collect();
+        Ok(store)
+    }
+
+    /// Everything needed to rebuild this store: id counter and objects, in
+    /// id order.
+    pub fn snapshot(&self) -> Snapshot {
+        let mut objects: Vec<StoredObject> = self
+            .objects
+            .keys()
+            .filter_map(|&id| self.stored(id))
+            .collect();
+        objects.sort_unstable_by_key(|o| o.id);
+        Snapshot {
+            epoch: (self.epoch >> 32) as u32,
+            next_index: self.next_index,
+            objects,
+        }
+    }
+
+    /// The stored form of object `id`.
+    fn stored(&self, id: u64) -> Option<StoredObject> {
+        let o = self.objects.get(&id)?;
+        Some(StoredObject {
+            id,
+            owner: match o.owner {
+                Owner::Scene => StoredOwner::Scene,
+                Owner::Client(c) => StoredOwner::Client(c),
+            },
+            name: o.name.clone(),
+            pose: StoredPose::from_isometry(&o.pose),
+            shape: StoredShape::from_shape(&o.shape),
+            slot: o.slot,
+        })
+    }
+
+    /// Turns persistence on: from now on every registration and removal is
+    /// committed to `database` before it is acknowledged, and every pose
+    /// update goes to the pose journal next to it. Poses the journal holds
+    /// for the objects already here (restored from the database) replace
+    /// theirs: they are the latest ones before a crash.
+    ///
+    /// An object whose journal slot does not hold a whole record of it
+    /// (the journal damaged or cut short, or its last update torn by a
+    /// crash) keeps the pose stored with it in the database, the pose of
+    /// its registration or of the last clean shutdown, which may be older
+    /// than its last update: such objects are logged at ERROR by id, with a
+    /// copy of the journal as it was found, and returned.
+    ///
+    /// # Errors
+    /// When the journal cannot be opened; persistence stays off then.
+    pub fn set_database(&mut self, database: Database) -> Result<Vec<u64>, StoreError> {
+        let path = crate::journal::path_for(database.path());
+        // As found, before opening grows it: kept if it proves damaged.
+        let found = std::fs::read(&path).unwrap_or_default();
+        let journal = Journal::open(&path).map_err(|source| StoreError::Io {
+            what: "cannot open the pose journal",
+            path: path.clone(),
+            source,
+        })?;
+        let mut unverified = Vec::new();
+        for (&id, o) in self.objects.iter_mut() {
+            match journal.read(o.slot, id) {
+                Some(pose) => o.pose = pose,
+                None => unverified.push(id),
+            }
+        }
+        unverified.sort_unstable();
+        if !unverified.is_empty() {
+            report_unverified_poses(&path, &found, &unverified);
+        }
+        self.journal = Some(journal);
+        self.database = Some(database);
+        let slots: Vec<(u32, u64)> = self.objects.iter().map(|(&id, o)| (o.slot, id)).collect();
+        for (slot, id) in slots {
+            self.journal_pose(slot, id);
+        }
+        Ok(unverified)
+    }
+
+    /// Writes `pose` of object `id` (in `slot`) to the journal, if any. A
+    /// failure (the file cannot grow: disk full) costs only durability of
+    /// this pose, not the update itself, so it is counted and logged.
+    fn journal_pose(&mut self, slot: u32, id: u64) {
+        let (Some(journal), Some(o)) = (self.journal.as_mut(), self.objects.get(&id)) else {
+            return;
+        };
+        if let Err(e) = journal.write(slot, id, &o.pose) {
+            self.persist_errors += 1;
+            tracing::error!("cannot write the pose journal: {e}");
+        }
+    }
+
+    /// The database, when persistence is on.
+    pub fn database(&self) -> Option<&Database> {
+        self.database.as_ref()
+    }
+
+    /// Makes the database hold exactly this store, current poses included
+    /// (when persistence is on), writing only what differs: at start after
+    /// the scene is installed, and at shutdown.
+    ///
+    /// On a full disk this is not an error: the server must start (and
+    /// stop) there too. The poses stay in the journal, and the scene
+    /// objects not yet stored get new ids at the next start; it is counted
+    /// and logged.
+    ///
+    /// # Errors
+    /// Any other commit error; the database is then as it was.
+    pub fn persist(&mut self) -> Result<(), StoreError> {
+        if self.database.is_none() {
+            return Ok(());
+        }
+        let snapshot = self.snapshot();
+        let Some(database) = &mut self.database else {
+            return Ok(());
+        };
+        match database.sync(&snapshot) {
+            Ok(()) => Ok(()),
+            Err(StoreError::Full(path)) => {
+                self.persist_errors += 1;
+                tracing::warn!(
+                    file = %path.display(),
+                    "no room on the disk to bring the store up to date: the current poses stay in the journal only"
+                );
+                Ok(())
+            }
+            Err(e) => {
+                self.persist_errors += 1;
+                Err(e)
+            }
+        }
+    }
+
+    /// Asks the kernel to put the pose journal on disk if poses changed.
+    /// Only a machine crash needs this (the journal's pages outlive the
+    /// process); called when idle and at shutdown.
+    ///
+    /// # Errors
+    /// The `msync` error.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.journal {
+            Some(j) => j.sync(),
+            None => Ok(()),
+        }
+    }
+
+    /// Failed commits and journal writes so far.
+    pub fn persist_errors(&self) -> u64 {
+        self.persist_errors
+    }
+
+    /// The upper 32 bits of every id of this run (also those of robots,
+    /// see [`crate::robots`]).
+    pub fn id_epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// The object with this id.
+    pub fn object(&self, id: u64) -> Option<&Object> {
+        self.objects.get(&id)
+    }
+
+    /// Every object, in no particular order.
+    pub fn objects(&self) -> impl Iterator<Item = (u64, &Object)> {
+        self.objects.iter().map(|(&id, o)| (id, o))
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether no object is stored.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+
+    /// The id of the object named `name`.
+    pub fn lookup(&self, name: &str) -> Option<u64> {
+        self.names.get(name).copied()
+    }
+
+    /// Moves object `id` to `pose`, recorded in the journal.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownObject`].
+    pub fn set_pose(&mut self, id: u64, pose: Isometry3<f64>) -> Result<(), ErrorCode> {
+        let object = self.objects.get_mut(&id).ok_or(ErrorCode::UnknownObject)?;
+        object.pose = pose;
+        let slot = object.slot;
+        self.journal_pose(slot, id);
+        Ok(())
+    }
+
+    /// Installs a scene object: an object restored from the database with
+    /// the same name, the same geometry and scene ownership keeps its id
+    /// (and takes the scene's pose); otherwise a new object is inserted.
+    /// Call [`ObjectStore::drop_scene_objects_except`] after the whole
+    /// scene. The caller forgets the warm starts of a replaced object.
+    ///
+    /// # Errors
+    /// As [`ObjectStore::insert`].
+    pub fn adopt_scene_object(&mut self, new: NewObject) -> Result<u64, ErrorCode> {
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && let Some(old) = self.objects.get_mut(&id)
+            && old.owner == Owner::Scene
+            && old.shape == new.shape
+        {
+            old.pose = new.pose;
+            let slot = old.slot;
+            self.journal_pose(slot, id);
+            return Ok(id);
+        }
+        if let Some(name) = &new.name
+            && let Some(&id) = self.names.get(name)
+            && self
+                .objects
+                .get(&id)
+                .is_some_and(|o| o.owner == Owner::Scene)
+        {
+            // The scene file changed this object: the new one replaces it.
+            self.unlink_object(id);
+        }
+        self.insert(new, Owner::Scene, usize::MAX)
+    }
+
+    /// Removes the scene objects restored from the database that the
+    /// current scene no longer has; returns their ids.
+    pub fn drop_scene_objects_except(&mut self, keep: &[u64]) -> Vec<u64> {
+        let doomed: Vec<u64> = self
+            .objects
+            .iter()
+            .filter(|(id, o)| o.owner == Owner::Scene && !keep.contains(id))
+            .map(|(&id, _)| id)
+            .collect();
+        for &id in &doomed {
+            self.unlink_object(id);
+        }
+        doomed
+    }
+
+    /// Takes object `id` out of the store (not out of the database); its
+    /// slot is free again.
+    fn unlink_object(&mut self, id: u64) -> Option<Object> {
+        let object = self.objects.remove(&id)?;
+        if let Some(name) = &object.name {
+            self.names.remove(name);
+        }
+        self.free_slots.push(object.slot);
+        Some(object)
+    }
+
+    /// Adds an object, returning its id, without committing it (see
+    /// [`ObjectStore::register`] for that).
+    ///
+    /// # Errors
+    /// [`ErrorCode::NameTaken`], [`ErrorCode::TooManyObjects`] when
+    /// `max_objects` are stored or the id counter is spent.
+    pub fn insert(
+        &mut self,
+        new: NewObject,
+        owner: Owner,
+        max_objects: usize,
+    ) -> Result<u64, ErrorCode> {
+        if self.objects.len() >= max_objects || self.next_index == u32::MAX {
+            return Err(ErrorCode::TooManyObjects);
+        }
+        if let Some(name) = &new.name
+            && self.names.contains_key(name)
+        {
+            return Err(ErrorCode::NameTaken);
+        }
+        let id = self.epoch | u64::from(self.next_index);
+        self.next_index += 1;
+        if let Some(name) = &new.name {
+            self.names.insert(name.clone(), id);
+        }
+        let slot = self.free_slots.pop().unwrap_or_else(|| {
+            let s = self.next_slot;
+            self.next_slot += 1;
+            s
+        });
+        self.objects.insert(
+            id,
+            Object {
+                shape: new.shape,
+                pose: new.pose,
+                owner,
+                name: new.name,
+                slot,
+            },
+        );
+        // The slot may hold a removed object's last pose: overwrite it now.
+        self.journal_pose(slot, id);
+        Ok(id)
+    }
+
+    /// Adds a client's object and commits it to the database (when
+    /// persistence is on) before returning its id; if the commit fails, the
+    /// object is not kept.
+    ///
+    /// # Errors
+    /// As [`ObjectStore::insert`], and [`ErrorCode::StorageFull`] (no room
+    /// on the disk) or [`ErrorCode::Internal`] when the commit fails.
+    pub fn register(
+        &mut self,
+        new: NewObject,
+        owner: Owner,
+        max_objects: usize,
+    ) -> Result<u64, ErrorCode> {
+        let id = self.insert(new, owner, max_objects)?;
+        // Just inserted, so always there.
+        let stored = self.stored(id).ok_or(ErrorCode::Internal)?;
+        let next = self.next_index;
+        self.commit(|db| db.register(&stored, next))
+            .map(|()| id)
+            .inspect_err(|_| {
+                self.unlink_object(id);
+            })
+    }
+
+    /// Removes the objects of every client for which `alive` is false (its
+    /// process ended: no client could remove them, since a restarted
+    /// process gets a new identity). Scene objects stay; ids are never
+    /// reused. A few are committed one by one, like a client's removals;
+    /// more than [`BULK_REMOVAL`] at once in one transaction, since a
+    /// crashed process's thousand objects would otherwise hold the request
+    /// loop for a thousand synced commits. Returns the ids removed, in id
+    /// order, and the error that stopped the pass if a commit failed (the
+    /// objects it concerned are kept). The caller forgets their warm starts.
+    pub fn remove_departed(
+        &mut self,
+        alive: impl Fn(u128) -> bool,
+    ) -> (Vec<u64>, Option<ErrorCode>) {
+        let mut doomed: Vec<(u64, u128)> = self
+            .objects
+            .iter()
+            .filter_map(|(&id, o)| match o.owner {
+                Owner::Client(c) if !alive(c) => Some((id, c)),
+                _ => None,
+            })
+            .collect();
+        doomed.sort_unstable();
+        if doomed.len() > BULK_REMOVAL && self.database.is_some() {
+            return self.remove_in_bulk(&doomed);
+        }
+        let mut removed = Vec::with_capacity(doomed.len());
+        for (id, owner) in doomed {
+            match self.remove(id, owner) {
+                Ok(id) => removed.push(id),
+                Err(e) => return (removed, Some(e)),
+            }
+        }
+        (removed, None)
+    }
+
+    /// [`remove_departed`](Self::remove_departed)'s many: all dropped, then
+    /// one transaction; if it cannot be committed, all put back (the
+    /// database is as it was).
+    fn remove_in_bulk(&mut self, doomed: &[(u64, u128)]) -> (Vec<u64>, Option<ErrorCode>) {
+        let dropped: Vec<(u64, Object)> = doomed
+            .iter()
+            .filter_map(|&(id, _)| Some((id, self.unlink_object(id)?)))
+            .collect();
+        let ids: Vec<u64> = dropped.iter().map(|&(id, _)| id).collect();
+        if let Err(code) = self.commit(|db| db.remove(&ids)) {
+            // In reverse: each object's slot is then on top of the stack.
+            for (id, object) in dropped.into_iter().rev() {
+                self.relink_object(id, object);
+            }
+            return (Vec::new(), Some(code));
+        }
+        (ids, None)
+    }
+
+    /// Undoes [`unlink_object`](Self::unlink_object), the last unlinked
+    /// first.
+    fn relink_object(&mut self, id: u64, object: Object) {
+        if self.free_slots.last() == Some(&object.slot) {
+            self.free_slots.pop();
+        }
+        if let Some(name) = &object.name {
+            self.names.insert(name.clone(), id);
+        }
+        self.objects.insert(id, object);
+    }
+
+    /// Makes a registration or removal durable before it is acknowledged:
+    /// `write` commits it to the database (when persistence is on). The
+    /// error is what the client is told if that fails; the caller then
+    /// undoes the change.
+    fn commit(
+        &mut self,
+        write: impl FnOnce(&mut Database) -> Result<(), StoreError>,
+    ) -> Result<(), ErrorCode> {
+        let Some(database) = &mut self.database else {
+            return Ok(());
+        };
+        write(database).map_err(|e| {
+            self.persist_errors += 1;
+            tracing::error!("{e}; the change is undone");
+            match e {
+                StoreError::Full(_) => ErrorCode::StorageFull,
+                _ => ErrorCode::Internal,
+            }
+        })
+    }
+
+    /// Removes object `id` on behalf of `requester` and commits the removal
+    /// (when persistence is on) before returning; the caller forgets its
+    /// warm starts.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownObject`], [`ErrorCode::ReadOnly`] for scene
+    /// objects, [`ErrorCode::NotOwner`] for another client's object,
+    /// [`ErrorCode::StorageFull`] or [`ErrorCode::Internal`] when the commit
+    /// fails (nothing is removed).
+    pub fn remove(&mut self, id: u64, requester: u128) -> Result<u64, ErrorCode> {
+        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
+        match object.owner {
+            Owner::Scene => return Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
+            Owner::Client(_) => {}
+        }
+        let Some(object) = self.unlink_object(id) else {
+            return Err(ErrorCode::UnknownObject);
+        };
+        if let Err(e) = self.commit(|db| db.remove(&[id])) {
+            self.relink_object(id, object);
+            return Err(e);
+        }
+        Ok(id)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::test_support::*;
+    use crate::state::{Limits, State};
+    use gjkd_proto::{
+        AdminOp, AdminRequest, ErrorCode, Item, ObjectId, QueryOptions, Vertex, WaitMode,
+        shape_kind,
+    };
+    use nalgebra::{Isometry3, Vector3};
+
+    #[test]
+    fn a_full_server_refuses_and_recovers_room_on_removal() {
+        let limits = Limits {
+            max_objects: 2,
+            ..Limits::default()
+        };
+        let mut s = State::new(limits, WaitMode::Spin, 5);
+        let a = register_box(&mut s, 1);
+        register_box(&mut s, 1);
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        let v = [Vertex::default()];
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::TooManyObjects
+        );
+        s.remove(a, 1).expect("owner");
+        assert_eq!(s.handle_admin(1, &req, &v).error_code(), ErrorCode::Ok);
+    }
+
+    #[test]
+    fn only_the_owner_removes_and_scene_objects_stay() {
+        let mut s = state();
+        let id = register_box(&mut s, 1);
+        assert_eq!(s.remove(id, 2), Err(ErrorCode::NotOwner));
+        let scene = insert_scene_ball(&mut s, "fixed");
+        assert_eq!(s.remove(scene, 1), Err(ErrorCode::ReadOnly));
+        assert_eq!(s.remove(id, 1), Ok(()));
+        assert!(s.object(id).is_none());
+    }
+
+    #[test]
+    fn the_objects_of_departed_clients_are_removed_and_no_others() {
+        let mut s = state();
+        let kept = register_box(&mut s, 1);
+        let gone = [register_box(&mut s, 2), register_named(&mut s, 2, "arm")];
+        let scene = insert_scene_ball(&mut s, "fixed");
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!(failed, None);
+        assert_eq!(removed, gone.to_vec());
+        assert!(gone.iter().all(|&id| s.object(id).is_none()));
+        assert!(s.object(kept).is_some() && s.object(scene).is_some());
+        assert_eq!(s.lookup("arm"), None);
+        assert_eq!(s.lookup("fixed"), Some(scene));
+        // Nothing more to remove, and the name is free again under a new id.
+        assert_eq!(s.remove_departed(|c| c == 1), (vec![], None));
+        let again = register_named(&mut s, 1, "arm");
+        assert!(!gone.contains(&again));
+        // Everybody gone: only the scene object is left.
+        let (removed, _) = s.remove_departed(|_| false);
+        assert_eq!(removed.len(), 2);
+        assert_eq!(s.len(), 1);
+    }
+
+    #[test]
+    fn ids_carry_the_epoch_and_are_not_reused() {
+        let mut s = state();
+        let a = register_box(&mut s, 1);
+        assert_eq!(a >> 32, 3);
+        s.remove(a, 1).expect("owner");
+        let b = register_box(&mut s, 1);
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn a_restored_store_keeps_ids_owners_answers_and_counter() {
+        let mut s = state();
+        let a = register_box(&mut s, 41);
+        let b = register_box(&mut s, 42);
+        let gone = register_box(&mut s, 41);
+        s.remove(gone, 41).expect("owner");
+        let pb = Isometry3::new(Vector3::new(3.0, 0.5, 0.2), Vector3::new(0.1, 0.2, 0.3));
+        let (ia, ib) = (ObjectId::from_raw(a), ObjectId::from_raw(b));
+        one(&mut s, 1, Item::set_pose(ib, &pb));
+        let before = one(&mut s, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+
+        let snap = s.snapshot();
+        let back = through_database("restored", &snap);
+        assert_eq!(back, snap);
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("valid");
+        assert_eq!(r.len(), 2);
+        let after = one(&mut r, 1, Item::distance(ia, ib, &QueryOptions::cold()));
+        assert_eq!(
+            after, before,
+            "same ids, same poses, same answer bit for bit"
+        );
+        assert_eq!(r.remove(a, 42), Err(ErrorCode::NotOwner));
+        let c = register_box(&mut r, 41);
+        assert!(c > gone, "the counter continues past removed ids");
+        assert_eq!(r.remove(a, 41), Ok(()));
+        let too_few = Limits {
+            max_objects: 1,
+            ..Limits::default()
+        };
+        assert!(State::restore(too_few, WaitMode::Spin, &back).is_err());
+    }
+
+    /// Many objects registered and most removed: the survivors may sit in
+    /// high journal slots, and the file must still load.
+    #[test]
+    fn a_store_that_shrank_restores() {
+        let mut s = state();
+        let ids: Vec<u64> = (0..3000).map(|_| register_box(&mut s, 1)).collect();
+        for &id in &ids[..2990] {
+            s.remove(id, 1).expect("owner");
+        }
+        let snap = s.snapshot();
+        assert!(snap.objects.iter().any(|o| o.slot > 2000));
+        let back = through_database("shrank", &snap);
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &back).expect("restores");
+        assert_eq!(r.len(), 10);
+        // Freed slots are reused before new ones.
+        let fresh = register_box(&mut r, 1);
+        assert!(r.object(fresh).expect("there").slot < 2990);
+    }
+
+    /// More than [`BULK_REMOVAL`] objects of a departed client go in one
+    /// transaction: a restart sees none of them. If it cannot be committed,
+    /// every one of them is put back, named ones still found by name.
+    #[test]
+    fn a_departed_clients_many_objects_go_in_one_write_or_not_at_all() {
+        let (dir, path, mut s) = stored("bulk-removal");
+        let kept = register_box(&mut s, 1);
+        let mut gone: Vec<u64> = (0..BULK_REMOVAL + 4)
+            .map(|_| register_box(&mut s, 2))
+            .collect();
+        gone.push(register_named(&mut s, 2, "arm"));
+        // Warm starts: one naming a doomed object, one not.
+        let pair = |a: u64, b: u64| {
+            Item::distance(
+                ObjectId::from_raw(a),
+                ObjectId::from_raw(b),
+                &QueryOptions::default(),
+            )
+            .with_pose_b(&Isometry3::translation(3.0, 0.0, 0.0))
+        };
+        one(&mut s, 10, pair(kept, gone[0]));
+        one(&mut s, 10, pair(kept, kept));
+        assert_eq!(s.stats().cache_entries, 2);
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!((removed, failed), (gone, None));
+        assert_eq!(
+            s.stats().cache_entries,
+            1,
+            "the doomed pair's entry is gone"
+        );
+        assert!(
+            one(&mut s, 10, pair(kept, kept))
+                .answer()
+                .expect("ok")
+                .warm_started
+        );
+        drop(s);
+        assert_eq!(ids_of(&reload(&path)), vec![kept]);
+
+        // Again, on a disk that is full: nothing is removed.
+        let _ = std::fs::remove_dir_all(&dir);
+        let (dir, path, mut s) = stored("bulk-removal-full");
+        let first = register_box(&mut s, 1);
+        let doomed: Vec<u64> = (0..BULK_REMOVAL + 1)
+            .map(|_| register_box(&mut s, 3))
+            .collect();
+        let named = register_named(&mut s, 3, "leg");
+        one(&mut s, 10, pair(doomed[0], named));
+        let before = s.len();
+        let want = s.snapshot();
+        s.database().expect("db").simulate_full_disk(true);
+        let (removed, failed) = s.remove_departed(|c| c == 1);
+        assert_eq!((removed, failed), (vec![], Some(ErrorCode::StorageFull)));
+        assert_eq!(s.len(), before);
+        assert!(doomed.iter().all(|&id| s.object(id).is_some()));
+        assert_eq!(s.lookup("leg"), Some(named));
+        assert!(
+            one(&mut s, 10, pair(doomed[0], named))
+                .answer()
+                .expect("ok")
+                .warm_started
+        );
+        // Their slots are still theirs: a new object gets a fresh one, once
+        // there is room again.
+        s.database().expect("db").simulate_full_disk(false);
+        let fresh = register_box(&mut s, 1);
+        let slots: std::collections::HashSet<u32> =
+            s.store().objects().map(|(_, o)| o.slot).collect();
+        assert_eq!(slots.len(), s.len(), "{fresh}: no slot shared");
+        drop(s);
+        let back = reload(&path);
+        assert_eq!(back.objects.len(), want.objects.len() + 1);
+        assert!(ids_of(&back).contains(&first) && ids_of(&back).contains(&fresh));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A commit that fails on a full disk (a real `ENOSPC` from the storage
+    /// layer) undoes the change in memory and says `StorageFull`, while
+    /// queries and pose updates go on; once the disk has room again,
+    /// changes are accepted without a restart. Any other write failure
+    /// says `Internal`.
+    #[test]
+    fn a_full_disk_refuses_changes_until_there_is_room_again() {
+        let (dir, path, mut s) = stored("full-disk");
+        let kept = register_box(&mut s, 1);
+        let other = register_box(&mut s, 1);
+        s.database().expect("db").simulate_full_disk(true);
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        assert!(req.set_name("ghost"));
+        let reply = s.handle_admin(1, &req, &[Vertex::default()]);
+        assert_eq!(reply.error_code(), ErrorCode::StorageFull);
+        assert_eq!(s.len(), 2, "the unwritten object is not kept");
+        assert_eq!(s.lookup("ghost"), None);
+        assert_eq!(s.remove(kept, 1), Err(ErrorCode::StorageFull));
+        assert!(s.object(kept).is_some(), "the unwritten removal is undone");
+        assert_eq!(s.stats().persist_errors, 2);
+        // Queries and pose updates go on meanwhile.
+        let (ik, io) = (ObjectId::from_raw(kept), ObjectId::from_raw(other));
+        let moved = Isometry3::translation(5.0, 0.0, 0.0);
+        assert_eq!(
+            one(&mut s, 9, Item::set_pose(ik, &moved)).error_code(),
+            ErrorCode::Ok
+        );
+        let d = one(&mut s, 9, Item::distance(ik, io, &QueryOptions::cold()));
+        assert_eq!(d.answer().expect("served").distance, 3.0);
+        // Another failure of the storage is the server's own.
+        s.database().expect("db").fail_writes(libc::EIO);
+        assert_eq!(
+            s.handle_admin(1, &req, &[Vertex::default()]).error_code(),
+            ErrorCode::Internal
+        );
+        s.database().expect("db").fail_writes(0);
+        assert_eq!(s.remove(kept, 1), Ok(()));
+        let last = register_box(&mut s, 1);
+        drop(s);
+        assert_eq!(
+            ids_of(&reload(&path)),
+            [other, last],
+            "neither the ghost nor the removed object"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A pose journal damaged while the server was stopped: the objects
+    /// whose slot no longer verifies are returned (and logged) and keep the
+    /// pose stored in the database (here: their registration pose), the
+    /// others their journaled pose; the journal is copied aside as found.
+    #[test]
+    fn poses_the_journal_cannot_verify_are_reported_and_fall_back() {
+        let (dir, path, mut s) = stored("journal-damage");
+        let ids: Vec<u64> = (0..3).map(|_| register_box(&mut s, 1)).collect();
+        let moved = Isometry3::translation(7.0, 0.0, 0.0);
+        for &id in &ids {
+            let r = one(&mut s, 9, Item::set_pose(ObjectId::from_raw(id), &moved));
+            assert_eq!(r.error_code(), ErrorCode::Ok);
+        }
+        let slot = s.object(ids[1]).expect("there").slot as usize;
+        drop(s);
+        let journal = crate::journal::path_for(&path);
+        let reopen = || {
+            let (db, opened) = Database::open(&path, 9).expect("reopen");
+            let mut r =
+                State::restore(Limits::default(), WaitMode::Spin, &opened.snapshot).expect("ok");
+            let unverified = r.set_database(db).expect("journal");
+            (r, unverified)
+        };
+        let kept = |bytes: &[u8]| {
+            std::fs::read_dir(&dir)
+                .expect("list")
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().contains("poses.corrupt-"))
+                .any(|e| std::fs::read(e.path()).expect("read") == bytes)
+        };
+        // A byte of object 1's slot (after the 16-byte header).
+        let mut bytes = std::fs::read(&journal).expect("journal");
+        bytes[16 + slot * crate::journal::SLOT + 20] ^= 0x40;
+        std::fs::write(&journal, &bytes).expect("spoil");
+        let (r, unverified) = reopen();
+        assert_eq!(unverified, [ids[1]]);
+        assert_eq!(r.object(ids[0]).expect("there").pose, moved);
+        assert_eq!(r.object(ids[1]).expect("there").pose, Isometry3::identity());
+        assert_eq!(r.object(ids[2]).expect("there").pose, moved);
+        assert!(kept(&bytes), "the damaged journal is kept as found");
+        drop(r);
+        // Cut short to its header: no pose verifies.
+        let mut bytes = std::fs::read(&journal).expect("journal");
+        bytes.truncate(16);
+        std::fs::write(&journal, &bytes).expect("cut");
+        let (r, unverified) = reopen();
+        assert_eq!(unverified, ids);
+        assert!(
+            ids.iter()
+                .all(|&id| r.object(id).expect("there").pose == Isometry3::identity())
+        );
+        assert!(kept(&bytes));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A removal and a registration taking over the removed object's name
+    /// and journal slot: a restart gets exactly that, and the counter goes
+    /// on past both ids.
+    #[test]
+    fn a_removal_then_a_registration_reloads() {
+        let (dir, path, mut s) = stored("remove-register");
+        let other = register_box(&mut s, 2);
+        let a = register_named(&mut s, 1, "n");
+        let slot = s.object(a).expect("there").slot;
+        s.remove(a, 1).expect("owner");
+        let b = register_named(&mut s, 1, "n");
+        assert_eq!(s.object(b).expect("there").slot, slot, "slot reused");
+        let want = s.snapshot();
+        drop(s);
+        let snapshot = reload(&path);
+        assert_eq!(snapshot, want);
+        let mut r = State::restore(Limits::default(), WaitMode::Spin, &snapshot).expect("valid");
+        assert_eq!(r.lookup("n"), Some(b));
+        assert!(r.object(a).is_none());
+        assert!(r.object(other).is_some());
+        assert_eq!(r.object(b).expect("there").slot, slot);
+        let c = register_box(&mut r, 1);
+        assert!(c > b && c > a, "ids are not reused");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -54,6 +54,13 @@ class ErrorCode(enum.IntEnum):
     """The server holds as many objects as it accepts."""
     INTERNAL = 19
     """The server failed in a way that is its own fault; it keeps serving."""
+    STORAGE_FULL = 20
+    """The server's disk has no room to store a registration or removal; the
+    change was not made, queries are still served."""
+    OUT_OF_LIMITS = 21
+    """A joint position is outside its joint's limits."""
+    INVALID_ROBOT = 22
+    """A robot's URDF is malformed or its kinematic tree is not supported."""
 
 
 class Status(enum.IntEnum):

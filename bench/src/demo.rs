@@ -8,6 +8,10 @@
 //! sweeps against sweeps warm-started from the server's per-pair cache, beside
 //! the paper's Table 1.
 //!
+//! Then a robot ([`crate::robot_demo`]): a 7-joint arm from a built-in
+//! URDF sweeps a joint path among obstacles, one joint request per step,
+//! and its links' clearances are printed.
+//!
 //! Each sweep is sent as few batches as the server's batch limit allows, every
 //! item carrying the moving object's pose of its step: the items of a batch
 //! are applied in order, so each step's query of an obstacle starts from the
@@ -406,6 +410,8 @@ fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(),
          `in-process` is the same ratio for the gjk library called directly, for reference.",
         (max_batch / OBSTACLES).max(1) * OBSTACLES
     );
+    let _ = writeln!(out);
+    crate::robot_demo::run(&mut client, &mut out, 20)?;
     Ok(())
 }
 

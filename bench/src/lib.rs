@@ -15,6 +15,8 @@
 //!   ([`gjkd_testkit::reference`](mod@gjkd_testkit::reference)) that owes nothing to GJK.
 //! - [`paper`]: the paper's Section 7, time per query against the number of
 //!   vertices `M`.
+//! - [`robot`]: a 7-joint robot moved by one joint request, against link
+//!   poses computed by the client.
 //!
 //! Each writes a table to stdout, CSV and SVG plots to `--out`, and shows a
 //! progress bar while it runs. Timing is never asserted anywhere: the tests
@@ -29,6 +31,8 @@ pub mod extremes;
 pub mod latency;
 pub mod paper;
 pub mod plot;
+pub mod robot;
+pub mod robot_demo;
 pub mod stats;
 pub mod tradeoff;
 pub mod uds;
@@ -52,6 +56,9 @@ enum BenchCommand {
     Tradeoff(tradeoff::TradeoffArgs),
     /// The paper's Section 7: time per query and per vertex against M.
     Paper(paper::PaperArgs),
+    /// A 7-joint robot moved by one joint request with 70 link-obstacle
+    /// queries, against the same queries at link poses the client computed.
+    Robot(robot::RobotArgs),
     /// The socket server `latency` starts as a child process.
     #[command(hide = true)]
     UdsServer(uds::UdsServerArgs),
@@ -117,6 +124,10 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
         BenchCommand::Paper(a) => {
             paper::run(&a)?;
             "paper"
+        }
+        BenchCommand::Robot(a) => {
+            robot::run(&a)?;
+            "robot"
         }
         BenchCommand::UdsServer(_) => unreachable!("handled above"),
     };

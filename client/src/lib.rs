@@ -110,6 +110,11 @@
 #![warn(missing_docs)]
 
 mod open_failure;
+mod robots;
+
+pub use robots::{
+    Kinematics, LimitMode, Mesh, MeshMode, PackagePath, RegisteredMesh, RobotHandle, RobotModel,
+};
 
 use std::time::{Duration, Instant};
 
@@ -202,6 +207,10 @@ pub enum ClientError {
     /// iceoryx2 failed locally (shared memory, permissions, limits).
     #[error("iceoryx2: {0}")]
     Ipc(String),
+    /// A mesh, URDF or SRDF could not be loaded, or joint positions named
+    /// a joint the robot does not move; the message says which and why.
+    #[error("{0}")]
+    Model(String),
 }
 
 /// iceoryx2 warns on stderr, in every process, that it found no config

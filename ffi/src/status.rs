@@ -102,9 +102,9 @@ impl From<ClientError> for Failure {
             ClientError::ServerGone(_) => GJKD_ERR_SERVER_GONE,
             ClientError::Timeout(_) => GJKD_ERR_TIMEOUT,
             ClientError::Rejected(code) => return Failure::rejected(*code, ""),
-            ClientError::ResultBufferTooSmall { .. } | ClientError::InvalidArgument(_) => {
-                GJKD_ERR_INVALID_ARGUMENT
-            }
+            ClientError::ResultBufferTooSmall { .. }
+            | ClientError::InvalidArgument(_)
+            | ClientError::Model(_) => GJKD_ERR_INVALID_ARGUMENT,
             ClientError::Protocol(_) => GJKD_ERR_PROTOCOL,
             ClientError::VersionMismatch { .. } => GJKD_ERR_VERSION_MISMATCH,
             ClientError::Incompatible { .. } => GJKD_ERR_INCOMPATIBLE,

@@ -64,6 +64,9 @@ pub const DEFAULT_MAX_ITERATIONS: u32 = 128;
 /// [`AdminRequest`] header.
 pub const MAX_PIECES: usize = 64;
 
+/// Most joint positions one [`ItemKind::SetJoints`] item carries.
+pub const JOINTS_PER_ITEM: usize = 9;
+
 /// Longest object name in bytes (UTF-8).
 pub const MAX_NAME_LEN: usize = 64;
 
@@ -171,11 +174,17 @@ pub enum ErrorCode {
     /// the same request succeeds once there is room again, without a
     /// server restart.
     StorageFull = 20,
+    /// A joint position is outside its joint's limits (and the item did not
+    /// ask for clamping, [`item_flags::CLAMP`]).
+    OutOfLimits = 21,
+    /// A robot's URDF is malformed, or its links do not form one tree of
+    /// fixed, revolute, continuous and prismatic joints.
+    InvalidRobot = 22,
 }
 
 impl ErrorCode {
     /// Every code, in wire order.
-    pub const ALL: [ErrorCode; 21] = [
+    pub const ALL: [ErrorCode; 23] = [
         ErrorCode::Ok,
         ErrorCode::UnknownObject,
         ErrorCode::NonFinitePose,
@@ -197,6 +206,8 @@ impl ErrorCode {
         ErrorCode::TooManyObjects,
         ErrorCode::Internal,
         ErrorCode::StorageFull,
+        ErrorCode::OutOfLimits,
+        ErrorCode::InvalidRobot,
     ];
 
     /// The code with wire value `raw`, or `None` for a value this version does
@@ -234,6 +245,8 @@ impl ErrorCode {
             ErrorCode::TooManyObjects => "server object limit reached",
             ErrorCode::Internal => "internal server error",
             ErrorCode::StorageFull => "no room on the server's disk to store the change",
+            ErrorCode::OutOfLimits => "joint position outside its limits",
+            ErrorCode::InvalidRobot => "malformed URDF or unsupported kinematic tree",
         }
     }
 }
@@ -292,6 +305,10 @@ pub enum ItemKind {
     SetPose = 1,
     /// Distance between two objects.
     Distance = 2,
+    /// Set a robot's joint positions (and optionally its base pose): the
+    /// server computes every link's pose by forward kinematics and stores
+    /// them. See [`Item::set_joints`] for the layout.
+    SetJoints = 3,
 }
 
 impl ItemKind {
@@ -300,6 +317,7 @@ impl ItemKind {
         match raw {
             1 => Some(ItemKind::SetPose),
             2 => Some(ItemKind::Distance),
+            3 => Some(ItemKind::SetJoints),
             _ => None,
         }
     }
@@ -322,8 +340,12 @@ pub mod item_flags {
     /// v1 (the layout is unchanged): a server older than this bit refuses it
     /// as malformed rather than silently answering in f64.
     pub const SINGLE_PRECISION: u32 = 1 << 4;
+    /// For [`super::ItemKind::SetJoints`]: clamp positions outside their
+    /// limits instead of refusing the item. Added within v1, like
+    /// `SINGLE_PRECISION`.
+    pub const CLAMP: u32 = 1 << 5;
     /// Every bit this version knows; others are rejected as malformed.
-    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION;
+    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION | CLAMP;
 }
 
 /// Bits of [`ItemResult::flags`].
@@ -548,6 +570,74 @@ impl Item {
         self
     }
 
+    /// Set joint positions `first .. first + positions.len()` of `robot`
+    /// (in the robot's joint order: its URDF's moving joints, see
+    /// `gjkd_model::kinematics`), and its base pose if `base` is given; the
+    /// server then stores every link's pose, computed by forward kinematics.
+    /// With `clamp`, positions outside their limits are clamped, otherwise
+    /// the item fails with [`ErrorCode::OutOfLimits`] and changes nothing.
+    ///
+    /// Layout: `a` is the robot, `b` the index of the first joint,
+    /// `max_iterations` the number of positions (1 to [`JOINTS_PER_ITEM`]),
+    /// carried in `pose_b.translation`, `pose_b.rotation`, `tolerance` and
+    /// `margin`, in that order; flag [`item_flags::POSE_A`] sends a base pose
+    /// in `pose_a`. A robot with more joints takes several items in one
+    /// request (each computes the poses; only the last one's matter).
+    ///
+    /// # Panics
+    /// If `positions` is empty or longer than [`JOINTS_PER_ITEM`].
+    pub fn set_joints(
+        robot: ObjectId,
+        first: u32,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        clamp: bool,
+    ) -> Self {
+        assert!(
+            (1..=JOINTS_PER_ITEM).contains(&positions.len()),
+            "one item carries 1 to {JOINTS_PER_ITEM} joint positions"
+        );
+        let mut values = [0.0; JOINTS_PER_ITEM];
+        values[..positions.len()].copy_from_slice(positions);
+        let [t0, t1, t2, r0, r1, r2, r3, tolerance, margin] = values;
+        let mut item = Item {
+            kind: ItemKind::SetJoints as u32,
+            flags: if clamp { item_flags::CLAMP } else { 0 },
+            a: robot.raw(),
+            b: u64::from(first),
+            pose_a: Pose::IDENTITY,
+            pose_b: Pose {
+                translation: [t0, t1, t2],
+                rotation: [r0, r1, r2, r3],
+            },
+            tolerance,
+            margin,
+            max_iterations: positions.len() as u32,
+            reserved: 0,
+        };
+        if let Some(base) = base {
+            item.flags |= item_flags::POSE_A;
+            item.pose_a = Pose::from_isometry(base);
+        }
+        item
+    }
+
+    /// The joint positions of a [`ItemKind::SetJoints`] item (all
+    /// [`JOINTS_PER_ITEM`] slots) and how many are in use, `None` if the
+    /// count is out of range.
+    pub fn joint_positions(&self) -> Option<([f64; JOINTS_PER_ITEM], usize)> {
+        let count = self.max_iterations as usize;
+        if !(1..=JOINTS_PER_ITEM).contains(&count) {
+            return None;
+        }
+        let [t0, t1, t2] = self.pose_b.translation;
+        let [r0, r1, r2, r3] = self.pose_b.rotation;
+        Some((
+            [t0, t1, t2, r0, r1, r2, r3, self.tolerance, self.margin],
+            count,
+        ))
+    }
+
     /// The kind, if it is one this version knows.
     pub fn item_kind(&self) -> Option<ItemKind> {
         ItemKind::from_raw(self.kind)
@@ -740,6 +830,49 @@ impl From<Vertex> for Point3<f64> {
     }
 }
 
+/// Text packed into vertices, 24 bytes each (the admin service's slice
+/// carries only vertices), the last one padded with zeros. The inverse is
+/// [`unpack_text`].
+pub fn pack_text(text: &str) -> Vec<Vertex> {
+    text.as_bytes()
+        .chunks(24)
+        .map(|chunk| {
+            let mut bytes = [0u8; 24];
+            bytes[..chunk.len()].copy_from_slice(chunk);
+            let word = |i: usize| {
+                let mut w = [0u8; 8];
+                w.copy_from_slice(&bytes[8 * i..8 * i + 8]);
+                f64::from_bits(u64::from_le_bytes(w))
+            };
+            Vertex {
+                x: word(0),
+                y: word(1),
+                z: word(2),
+            }
+        })
+        .collect()
+}
+
+/// The first `len` bytes packed in `vertices` by [`pack_text`], if there
+/// are that many, the padding is zero and they are UTF-8.
+pub fn unpack_text(vertices: &[Vertex], len: u64) -> Option<String> {
+    let len = usize::try_from(len).ok()?;
+    if vertices.len() != len.div_ceil(24) {
+        return None;
+    }
+    let mut bytes = Vec::with_capacity(vertices.len() * 24);
+    for v in vertices {
+        for c in [v.x, v.y, v.z] {
+            bytes.extend(c.to_bits().to_le_bytes());
+        }
+    }
+    if bytes[len..].iter().any(|&b| b != 0) {
+        return None;
+    }
+    bytes.truncate(len);
+    String::from_utf8(bytes).ok()
+}
+
 /// Operations of the admin service; the wire values of [`AdminRequest::op`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u32)]
@@ -755,6 +888,16 @@ pub enum AdminOp {
     Lookup = 4,
     /// Server statistics ([`AdminReply::stats`]).
     Stats = 5,
+    /// Attach a robot's kinematics, named [`AdminRequest::name`], to the
+    /// objects already registered as its links (named `<robot>/<link>`; a
+    /// link with no such object has no shape and only carries its
+    /// children). The slice payload is text packed by [`pack_text`]: the
+    /// URDF, optionally followed by a NUL byte and an SRDF whose
+    /// `disable_collisions` pairs (with the adjacent links) the server keeps
+    /// as the robot's allowed pairs. [`AdminRequest::id`] is the text's
+    /// length in bytes. The reply's id is the robot's id, for
+    /// [`ItemKind::SetJoints`]; attaching a name again replaces the robot.
+    AttachRobot = 6,
 }
 
 impl AdminOp {
@@ -766,9 +909,19 @@ impl AdminOp {
             3 => Some(AdminOp::Remove),
             4 => Some(AdminOp::Lookup),
             5 => Some(AdminOp::Stats),
+            6 => Some(AdminOp::AttachRobot),
             _ => None,
         }
     }
+}
+
+/// Values of [`AdminRequest::shape`] for [`AdminOp::Lookup`].
+pub mod lookup_kind {
+    /// Look up an object (the default, 0).
+    pub const OBJECT: u32 = 0;
+    /// Look up a robot attached with [`AdminOp::AttachRobot`](super::AdminOp::AttachRobot)
+    /// or loaded from the scene file: the reply's id is the robot's.
+    pub const ROBOT: u32 = 1;
 }
 
 /// Values of [`AdminRequest::shape`].
@@ -1054,6 +1207,43 @@ mod tests {
         r.name_len = 2;
         r.name[0] = 0xff;
         assert_eq!(r.name(), None);
+    }
+
+    #[test]
+    fn joint_items_carry_their_positions() {
+        let q = [0.5, -1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
+        let robot = ObjectId::from_raw(9);
+        let base = Isometry3::translation(1.0, 2.0, 3.0);
+        let it = Item::set_joints(robot, 2, &q, Some(&base), true);
+        assert_eq!(it.item_kind(), Some(ItemKind::SetJoints));
+        assert_eq!(it.joint_positions(), Some((q, 9)));
+        assert_eq!((it.a, it.b), (9, 2));
+        assert_eq!(it.flags, item_flags::POSE_A | item_flags::CLAMP);
+        assert_eq!(it.pose_a, Pose::from_isometry(&base));
+        let short = Item::set_joints(robot, 0, &[1.5], None, false);
+        assert_eq!(
+            short.joint_positions().map(|(v, n)| (v[0], n)),
+            Some((1.5, 1))
+        );
+        assert_eq!(short.flags, 0);
+        let mut bad = short;
+        bad.max_iterations = 10;
+        assert_eq!(bad.joint_positions(), None);
+    }
+
+    #[test]
+    fn text_round_trips_through_vertices() {
+        for text in ["", "a", &"<robot name=\"é\"/>".repeat(5), &"x".repeat(48)] {
+            let packed = pack_text(text);
+            assert_eq!(packed.len(), text.len().div_ceil(24));
+            assert_eq!(
+                unpack_text(&packed, text.len() as u64).as_deref(),
+                Some(text)
+            );
+        }
+        let packed = pack_text("hello");
+        assert_eq!(unpack_text(&packed, 4), None, "non-zero padding");
+        assert_eq!(unpack_text(&packed, 30), None, "too few vertices");
     }
 
     #[test]

@@ -58,6 +58,10 @@ class ErrorCode(enum.IntEnum):
     """The server's disk has no room to store a registration or removal: the
     change was not made. Queries and pose updates are still served; the same
     call succeeds once there is room again, without a server restart."""
+    OUT_OF_LIMITS = 21
+    """A joint position is outside its joint's limits."""
+    INVALID_ROBOT = 22
+    """A robot's URDF is malformed or its kinematic tree is not supported."""
 
 
 class Status(enum.IntEnum):

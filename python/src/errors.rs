@@ -157,7 +157,7 @@ pub fn client(py: Python<'_>, e: ClientError, field: Option<&str>) -> PyErr {
         ClientError::ServerGone(_) => (Kind::ServerGone, None),
         ClientError::Timeout(_) => (Kind::Timeout, None),
         ClientError::Rejected(code) => return refused(py, *code, field, None),
-        ClientError::InvalidArgument(_) => (Kind::InvalidInput, None),
+        ClientError::InvalidArgument(_) | ClientError::Model(_) => (Kind::InvalidInput, None),
         ClientError::Protocol(_) => (Kind::Protocol, None),
         ClientError::Ipc(_) => (Kind::Ipc, None),
         ClientError::VersionMismatch { .. } | ClientError::Incompatible { .. } => {

@@ -47,6 +47,10 @@ pub struct ServeArgs {
     /// Scene file (TOML) of read-only named objects to load at start.
     #[arg(long)]
     pub scene: Option<PathBuf>,
+    /// A folder searched for the scene robots' `package://` mesh URLs
+    /// (repeatable; searched before `GJKD_PACKAGE_PATH`).
+    #[arg(long, value_name = "DIR")]
+    pub package_path: Vec<PathBuf>,
     /// Wait strategy.
     #[arg(long, value_enum, default_value_t = Wait::Adaptive)]
     pub wait: Wait,
@@ -161,7 +165,10 @@ pub fn serve_until(
     };
     if let Some(path) = &args.scene {
         let ids = Scene::load(path)
-            .and_then(|s| s.install(&mut state))
+            .and_then(|mut s| {
+                s.package_path.clone_from(&args.package_path);
+                s.install(&mut state)
+            })
             .map_err(|e| e.to_string())?;
         info!(scene = %path.display(), objects = ids.len(), "scene loaded");
     }

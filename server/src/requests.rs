@@ -57,6 +57,10 @@ impl State {
             Some(ItemKind::Distance) => self
                 .distance(client, item)
                 .unwrap_or_else(ItemResult::error),
+            Some(ItemKind::SetJoints) => match crate::robots::set_joints(self, item) {
+                Ok(()) => ItemResult::default(),
+                Err(e) => ItemResult::error(e),
+            },
             None => ItemResult::error(ErrorCode::Malformed),
         }
     }
@@ -164,7 +168,9 @@ impl State {
         let op_kind = AdminOp::from_raw(op);
         // Only a registration carries vertices: any other request with a
         // slice is malformed (and would otherwise be silently ignored).
-        if !vertices.is_empty() && op_kind != Some(AdminOp::Register) {
+        if !vertices.is_empty()
+            && !matches!(op_kind, Some(AdminOp::Register | AdminOp::AttachRobot))
+        {
             reply.error = ErrorCode::Malformed as u32;
             return reply;
         }
@@ -183,10 +189,18 @@ impl State {
                     self.store.register(new, Owner::Client(requester), max)
                 }),
             Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
-            Some(AdminOp::Lookup) => match request.name() {
-                Some(name) => self.lookup(name).ok_or(ErrorCode::UnknownName),
-                None => Err(ErrorCode::Malformed),
+            Some(AdminOp::Lookup) => match (request.name(), request.shape) {
+                (Some(name), gjkd_proto::lookup_kind::OBJECT) => {
+                    self.lookup(name).ok_or(ErrorCode::UnknownName)
+                }
+                (Some(name), gjkd_proto::lookup_kind::ROBOT) => {
+                    self.robots.lookup(name).ok_or(ErrorCode::UnknownName)
+                }
+                _ => Err(ErrorCode::Malformed),
             },
+            Some(AdminOp::AttachRobot) => {
+                crate::robots::attach_request(self, requester, request, vertices)
+            }
             None => Err(ErrorCode::Malformed),
         };
         match outcome {

@@ -40,6 +40,10 @@
 //! offset = { translation = [1.0, 0.0, 0.0] }
 //! ```
 //!
+//! Meshes (`type = "mesh"`) and robots (`[[robot]]`) are described in
+//! [`crate::scene_robots`]; `type = "cylinder"` (`radius`, `half_height`)
+//! is refused until gjk has an exact cylinder.
+//!
 //! A pose has an optional `translation` and at most one of `quaternion`
 //! (`[i, j, k, w]`, normalised on load) and `axis_angle` (the rotation axis
 //! scaled by the angle in radians).
@@ -94,6 +98,17 @@ pub struct Scene {
     /// The objects, in file order.
     #[serde(default, rename = "object")]
     pub objects: Vec<ObjectSpec>,
+    /// The robots, in file order, added after the objects.
+    #[serde(default, rename = "robot")]
+    pub robots: Vec<crate::scene_robots::RobotSpec>,
+    /// The folder relative paths (mesh files, URDF) are relative to: the
+    /// scene file's, when loaded from a file.
+    #[serde(skip)]
+    pub base: Option<std::path::PathBuf>,
+    /// Folders searched for `package://` URLs after each robot's own
+    /// (`gjkd serve --package-path`).
+    #[serde(skip)]
+    pub package_path: Vec<std::path::PathBuf>,
 }
 
 /// One named object.
@@ -143,11 +158,32 @@ pub enum ShapeSpec {
         #[serde(default)]
         radius: f64,
     },
+    /// A mesh file's convex hull, or its convex decomposition.
+    Mesh {
+        /// STL, OBJ or COLLADA file, relative to the scene file.
+        file: std::path::PathBuf,
+        /// Scale per axis.
+        #[serde(default = "unit_scale")]
+        scale: [f64; 3],
+        /// V-HACD resolution to decompose at, instead of taking the hull.
+        decompose: Option<u32>,
+    },
+    /// A cylinder along z: refused until gjk has an exact cylinder.
+    Cylinder {
+        /// Radius.
+        radius: f64,
+        /// Half its height.
+        half_height: f64,
+    },
     /// A union of convex pieces.
     Compound {
         /// The pieces.
         pieces: Vec<PieceSpec>,
     },
+}
+
+fn unit_scale() -> [f64; 3] {
+    [1.0; 3]
 }
 
 /// A convex piece of a compound.
@@ -217,6 +253,22 @@ impl ShapeSpec {
             ShapeSpec::Polytope { vertices, radius } => {
                 Convex::new(vertices.iter().map(|&v| p(v)).collect::<Vec<_>>(), *radius)
             }
+            ShapeSpec::Mesh {
+                file,
+                scale,
+                decompose: None,
+            } => {
+                let shape = crate::scene_robots::mesh_shape(file, *scale, None)?;
+                return match shape {
+                    Shape::Convex(c) => Ok(c),
+                    Shape::Compound(_) => Err("a mesh hull is one piece".into()),
+                };
+            }
+            ShapeSpec::Mesh { .. } => return Err("a decomposed mesh cannot be a piece".into()),
+            ShapeSpec::Cylinder {
+                radius,
+                half_height,
+            } => return gjkd_model::cylinder(*radius, *half_height).map_err(|e| e.to_string()),
             ShapeSpec::Compound { .. } => return Err("a compound cannot be a piece".into()),
         };
         made.map_err(|e| e.to_string())
@@ -243,6 +295,11 @@ impl ShapeSpec {
                 }
                 Ok(Compound::new(built).map_err(|e| e.to_string())?.into())
             }
+            ShapeSpec::Mesh {
+                file,
+                scale,
+                decompose: Some(resolution),
+            } => crate::scene_robots::mesh_shape(file, *scale, Some(*resolution)),
             _ => Ok(self.convex()?.into()),
         }
     }
@@ -268,7 +325,26 @@ impl Scene {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_toml(&text)
+        let mut scene = Self::from_toml(&text)?;
+        scene.base = path.parent().map(Path::to_path_buf);
+        scene.rebase_mesh_files();
+        Ok(scene)
+    }
+
+    /// Makes the mesh files' relative paths relative to [`Scene::base`].
+    fn rebase_mesh_files(&mut self) {
+        let Some(base) = &self.base else { return };
+        let pieces = self.objects.iter_mut().flat_map(|o| match &mut o.shape {
+            ShapeSpec::Compound { pieces } => pieces.iter_mut().map(|p| &mut p.shape).collect(),
+            shape => vec![shape],
+        });
+        for shape in pieces {
+            if let ShapeSpec::Mesh { file, .. } = shape
+                && file.is_relative()
+            {
+                *file = base.join(&*file);
+            }
+        }
     }
 
     /// Adds every object to `state` as a read-only scene object, in file
@@ -310,6 +386,15 @@ impl Scene {
                 .map_err(|e| fail(e.to_string()))?;
             ids.push(id);
         }
+        for robot in &self.robots {
+            if !seen.insert(robot.name.as_str()) {
+                return Err(SceneError::Object {
+                    name: robot.name.clone(),
+                    reason: "a robot and another robot or object share this name".into(),
+                });
+            }
+            ids.extend(robot.install(state, self.base.as_deref(), &self.package_path)?);
+        }
         state.drop_scene_objects_except(&ids);
         Ok(ids)
     }
@@ -324,6 +409,8 @@ fn shape_keys(kind: &str) -> Option<&'static [&'static str]> {
         "box" => &["half_extents", "radius"],
         "polytope" => &["vertices", "radius"],
         "compound" => &["pieces"],
+        "mesh" => &["file", "scale", "decompose"],
+        "cylinder" => &["radius", "half_height"],
         _ => return None,
     })
 }
@@ -333,7 +420,18 @@ fn shape_keys(kind: &str) -> Option<&'static [&'static str]> {
 /// flattened in beside the common ones, and flattening turns
 /// `deny_unknown_fields` off.
 fn check_keys(scene: &toml::Table) -> Result<(), SceneError> {
-    check_table(scene, &["object"], "the scene")?;
+    check_table(scene, &["object", "robot"], "the scene")?;
+    if let Some(toml::Value::Array(robots)) = scene.get("robot") {
+        for (i, robot) in robots.iter().enumerate() {
+            if let Some(robot) = robot.as_table() {
+                let place = match robot.get("name").and_then(|n| n.as_str()) {
+                    Some(name) => format!("robot `{name}`"),
+                    None => format!("robot {i}"),
+                };
+                check_table(robot, crate::scene_robots::ROBOT_KEYS, &place)?;
+            }
+        }
+    }
     let Some(toml::Value::Array(objects)) = scene.get("object") else {
         return Ok(());
     };

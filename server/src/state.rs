@@ -58,6 +58,8 @@ pub struct State {
     pub(crate) workspace: gjk::Workspace,
     /// Query clients connected, as last seen by the serving loop.
     clients: u64,
+    /// Robots: kinematics attached to link objects (see [`crate::robots`]).
+    pub(crate) robots: crate::robots::Robots,
 }
 
 impl State {
@@ -77,6 +79,7 @@ impl State {
             stats: ServerStats::default(),
             clients: 0,
             workspace: gjk::Workspace::new(),
+            robots: crate::robots::Robots::default(),
         }
     }
 

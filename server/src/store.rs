@@ -321,6 +321,12 @@ impl ObjectStore {
         self.persist_errors
     }
 
+    /// The upper 32 bits of every id of this run (also those of robots,
+    /// see [`crate::robots`]).
+    pub fn id_epoch(&self) -> u64 {
+        self.epoch
+    }
+
     /// The object with this id.
     pub fn object(&self, id: u64) -> Option<&Object> {
         self.objects.get(&id)

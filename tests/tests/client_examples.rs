@@ -84,3 +84,18 @@ fn two_processes_run() {
     let out = run("two_processes", &server);
     assert!(out.contains("owner: the watcher saw the door"), "{out}");
 }
+
+#[test]
+fn robot_arm_runs() {
+    let server = Server::start("ex-robot", &["--no-persist"]);
+    let out = run("robot_arm", &server);
+    assert!(
+        out.contains("joints, in order: [\"turn\", \"reach\"]"),
+        "{out}"
+    );
+    assert!(out.contains("gripper to crate 0.150000000000"), "{out}");
+    assert!(
+        out.contains("reach 0.9 refused: joint position outside its limits"),
+        "{out}"
+    );
+}

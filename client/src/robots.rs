@@ -1,0 +1,412 @@
+//! Meshes and robots: register a mesh (its hull or a convex decomposition)
+//! and a robot from URDF, find a robot the scene file loaded, and move a
+//! robot by its joints in one round trip.
+//!
+//! ```no_run
+//! use gjkd_client::{Client, MeshMode, PackagePath, QueryOptions};
+//! use nalgebra::Isometry3;
+//! use std::path::Path;
+//!
+//! # fn main() -> Result<(), gjkd_client::ClientError> {
+//! let mut client = Client::connect("gjkd")?;
+//! let table = client.register_mesh_file(
+//!     "table", Path::new("table.stl"), [1.0; 3], MeshMode::Hull,
+//!     &Isometry3::translation(1.0, 0.0, 0.0))?;
+//! let mut arm = client.register_robot(
+//!     "arm", Path::new("arm.urdf"), None, &PackagePath::with_env([]),
+//!     &Isometry3::identity())?;
+//! // One round trip: every link moves by forward kinematics.
+//! client.set_joints(&mut arm, &[0.1, -0.5, 0.3, 0.0, 1.0, 0.0, 0.2], None)?;
+//! let hand = arm.link("hand").expect("the hand has collision geometry");
+//! let answer = client.distance(hand, table.id, &QueryOptions::default())?;
+//! # Ok(())
+//! # }
+//! ```
+
+use std::path::Path;
+
+use gjk::Shape;
+pub use gjkd_model::{Kinematics, LimitMode, Mesh, PackagePath, RobotModel};
+use gjkd_proto::{
+    AdminOp, AdminRequest, ErrorCode, Item, ItemResult, JOINTS_PER_ITEM, ObjectId, Pose,
+    lookup_kind, pack_text,
+};
+use nalgebra::Isometry3;
+
+use crate::{Client, ClientError, Geometry, Piece};
+
+/// How a mesh becomes a shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshMode {
+    /// Its convex hull: one piece; never reports more distance than the
+    /// mesh.
+    Hull,
+    /// A V-HACD convex decomposition at this resolution (voxels along the
+    /// longest side; 64 is a fair start): a compound that follows a
+    /// non-convex mesh, within the reported deviation.
+    Decompose(u32),
+}
+
+/// A registered mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegisteredMesh {
+    /// The object.
+    pub id: ObjectId,
+    /// Number of convex pieces.
+    pub pieces: usize,
+    /// For a decomposition, the largest deviation found from the mesh (see
+    /// `gjkd_model::Decomposition::deviation`); 0 for a hull, which never
+    /// reaches closer than the mesh's own convex hull.
+    pub deviation: f64,
+}
+
+/// A robot on the server, with what a client needs to move it and query
+/// its links.
+#[derive(Clone, Debug)]
+pub struct RobotHandle {
+    /// The robot's id, for [`Item::set_joints`].
+    pub id: ObjectId,
+    /// Its name.
+    pub name: String,
+    /// Its kinematics: joint order, limits, link names.
+    pub kinematics: Kinematics,
+    /// Each link's object (in [`Kinematics::link_names`] order), `None` for
+    /// a link without collision geometry.
+    pub links: Vec<Option<ObjectId>>,
+    /// The joint positions last sent by [`Client::set_joints`] (zero, within
+    /// the limits, at first).
+    pub positions: Vec<f64>,
+}
+
+impl RobotHandle {
+    /// The object of link `name`.
+    pub fn link(&self, name: &str) -> Option<ObjectId> {
+        let i = self
+            .kinematics
+            .link_names()
+            .iter()
+            .position(|l| l == name)?;
+        self.links[i]
+    }
+
+    /// The moving joints' names, in the order of a position array.
+    pub fn joint_names(&self) -> Vec<&str> {
+        self.kinematics.joint_names()
+    }
+
+    /// Every link's name.
+    pub fn link_names(&self) -> &[String] {
+        self.kinematics.link_names()
+    }
+
+    /// The items that set `positions` (all joints, in joint order) and
+    /// `base`, to put in a batch before queries: one item per
+    /// [`JOINTS_PER_ITEM`] joints. [`RobotHandle::positions`] is not
+    /// updated (the batch may fail): [`Client::set_joints_by_name`] starts
+    /// from the positions last sent by [`Client::set_joints`].
+    pub fn joint_items(
+        &self,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        clamp: bool,
+    ) -> Vec<Item> {
+        positions
+            .chunks(JOINTS_PER_ITEM)
+            .enumerate()
+            .map(|(k, chunk)| {
+                let first = (k * JOINTS_PER_ITEM) as u32;
+                Item::set_joints(self.id, first, chunk, base.filter(|_| k == 0), clamp)
+            })
+            .collect()
+    }
+}
+
+fn model_err(e: impl std::fmt::Display) -> ClientError {
+    ClientError::Model(e.to_string())
+}
+
+impl Client {
+    /// Registers a mesh file (binary or ASCII STL, OBJ, COLLADA), scaled per
+    /// axis, as its hull or decomposed, named and at `pose`.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] for a file that is missing or not a mesh, or a
+    /// bad scale; as [`Client::register_named`] otherwise.
+    pub fn register_mesh_file(
+        &mut self,
+        name: &str,
+        path: &Path,
+        scale: [f64; 3],
+        mode: MeshMode,
+        pose: &Isometry3<f64>,
+    ) -> Result<RegisteredMesh, ClientError> {
+        let mesh = Mesh::load(path, scale).map_err(model_err)?;
+        self.register_mesh(name, &mesh, mode, pose)
+    }
+
+    /// Registers a mesh given as arrays ([`Mesh::from_arrays`]), as its hull
+    /// or decomposed, named and at `pose`.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] when the decomposition finds no pieces; as
+    /// [`Client::register_named`] otherwise.
+    pub fn register_mesh(
+        &mut self,
+        name: &str,
+        mesh: &Mesh,
+        mode: MeshMode,
+        pose: &Isometry3<f64>,
+    ) -> Result<RegisteredMesh, ClientError> {
+        match mode {
+            MeshMode::Hull => {
+                let hull = mesh.hull();
+                let geometry = Geometry::Polytope {
+                    vertices: &hull,
+                    radius: 0.0,
+                };
+                let id = self.register_named(name, &geometry, pose)?;
+                Ok(RegisteredMesh {
+                    id,
+                    pieces: 1,
+                    deviation: 0.0,
+                })
+            }
+            MeshMode::Decompose(resolution) => {
+                let parts = mesh.decompose(resolution).map_err(model_err)?;
+                let pieces: Vec<Piece<'_>> = parts
+                    .pieces
+                    .iter()
+                    .map(|p| Piece {
+                        offset: Isometry3::identity(),
+                        geometry: Geometry::Polytope {
+                            vertices: p,
+                            radius: 0.0,
+                        },
+                    })
+                    .collect();
+                let id = self.register_named(name, &Geometry::Compound(&pieces), pose)?;
+                Ok(RegisteredMesh {
+                    id,
+                    pieces: pieces.len(),
+                    deviation: parts.deviation,
+                })
+            }
+        }
+    }
+
+    /// Registers a robot from a URDF file (and optionally an SRDF for its
+    /// allowed pairs): each link with collision geometry becomes an object
+    /// named `<name>/<link>`, then the server gets the kinematics and puts
+    /// the robot at `base` with every joint at zero (clamped into its
+    /// limits). Mesh paths are resolved here, through `packages` and
+    /// relative to the URDF's folder.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] for a URDF, SRDF or mesh that cannot be
+    /// loaded (the message names the file, link or joint);
+    /// [`ClientError::Rejected`] with [`ErrorCode::NameTaken`] (a link
+    /// object of that name exists: after a server restart, use
+    /// [`Client::attach_robot`]), [`ErrorCode::InvalidRobot`], and the codes
+    /// of [`Client::register`]. Link objects registered before a failure
+    /// are removed again.
+    pub fn register_robot(
+        &mut self,
+        name: &str,
+        urdf: &Path,
+        srdf: Option<&Path>,
+        packages: &PackagePath,
+        base: &Isometry3<f64>,
+    ) -> Result<RobotHandle, ClientError> {
+        let text = std::fs::read_to_string(urdf)
+            .map_err(|e| ClientError::Model(format!("{}: {e}", urdf.display())))?;
+        let srdf = srdf
+            .map(|p| {
+                std::fs::read_to_string(p)
+                    .map_err(|e| ClientError::Model(format!("{}: {e}", p.display())))
+            })
+            .transpose()?;
+        let model = RobotModel::from_urdf_str(&text, urdf.parent(), packages).map_err(model_err)?;
+        gjkd_model::disabled_pairs(srdf.as_deref(), &model.kinematics, true).map_err(model_err)?;
+        let mut registered = Vec::new();
+        let outcome = self.register_links(name, &model, &mut registered);
+        let outcome = outcome.and_then(|()| self.attach_robot(name, &text, srdf.as_deref(), base));
+        if outcome.is_err() {
+            for id in registered {
+                let _ = self.remove(id);
+            }
+        }
+        outcome
+    }
+
+    fn register_links(
+        &mut self,
+        name: &str,
+        model: &RobotModel,
+        registered: &mut Vec<ObjectId>,
+    ) -> Result<(), ClientError> {
+        for link in &model.links {
+            let Some(shape) = &link.shape else { continue };
+            let object = format!("{name}/{}", link.name);
+            let id = match shape {
+                Shape::Convex(c) => self.register_named(
+                    &object,
+                    &Geometry::Polytope {
+                        vertices: c.vertices(),
+                        radius: c.radius(),
+                    },
+                    &Isometry3::identity(),
+                )?,
+                Shape::Compound(c) => {
+                    let pieces: Vec<Piece<'_>> = c
+                        .pieces()
+                        .iter()
+                        .map(|(offset, p)| Piece {
+                            offset: *offset,
+                            geometry: Geometry::Polytope {
+                                vertices: p.vertices(),
+                                radius: p.radius(),
+                            },
+                        })
+                        .collect();
+                    self.register_named(
+                        &object,
+                        &Geometry::Compound(&pieces),
+                        &Isometry3::identity(),
+                    )?
+                }
+            };
+            registered.push(id);
+        }
+        Ok(())
+    }
+
+    /// Attaches a robot's kinematics (URDF text, optional SRDF text) to
+    /// link objects already on the server (named `<name>/<link>`): after a
+    /// server restart, the restored links of a robot registered before. The
+    /// robot is put at `base`, joints at zero within their limits.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] for URDF text this client cannot read;
+    /// [`ClientError::Rejected`] with [`ErrorCode::InvalidRobot`] or
+    /// [`ErrorCode::NotOwner`] (another client's robot has that name).
+    pub fn attach_robot(
+        &mut self,
+        name: &str,
+        urdf: &str,
+        srdf: Option<&str>,
+        base: &Isometry3<f64>,
+    ) -> Result<RobotHandle, ClientError> {
+        let kinematics = Kinematics::from_urdf_str(urdf).map_err(model_err)?;
+        let text = match srdf {
+            Some(srdf) => format!("{urdf}\0{srdf}"),
+            None => urdf.to_owned(),
+        };
+        let mut request = AdminRequest::new(AdminOp::AttachRobot);
+        if !request.set_name(name) {
+            return Err(ClientError::InvalidArgument(
+                "name longer than MAX_NAME_LEN",
+            ));
+        }
+        request.id = text.len() as u64;
+        request.pose = Pose::from_isometry(base);
+        let reply = self.admin(&request, &pack_text(&text))?;
+        self.handle(ObjectId::from_raw(reply.id), name, kinematics)
+    }
+
+    /// Finds a robot on the server by name (one the scene file loaded, or
+    /// another client attached), given its URDF text for the joint order
+    /// and link names.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] for URDF text this client cannot read;
+    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`].
+    pub fn open_robot(&mut self, name: &str, urdf: &str) -> Result<RobotHandle, ClientError> {
+        let kinematics = Kinematics::from_urdf_str(urdf).map_err(model_err)?;
+        let mut request = AdminRequest::new(AdminOp::Lookup);
+        if !request.set_name(name) {
+            return Err(ClientError::InvalidArgument(
+                "name longer than MAX_NAME_LEN",
+            ));
+        }
+        request.shape = lookup_kind::ROBOT;
+        let reply = self.admin(&request, &[])?;
+        self.handle(ObjectId::from_raw(reply.id), name, kinematics)
+    }
+
+    fn handle(
+        &mut self,
+        id: ObjectId,
+        name: &str,
+        kinematics: Kinematics,
+    ) -> Result<RobotHandle, ClientError> {
+        let mut links = Vec::with_capacity(kinematics.link_names().len());
+        for link in kinematics.link_names() {
+            links.push(match self.lookup(&format!("{name}/{link}")) {
+                Ok(id) => Some(id),
+                Err(ClientError::Rejected(ErrorCode::UnknownName)) => None,
+                Err(e) => return Err(e),
+            });
+        }
+        let mut positions = vec![0.0; kinematics.dof()];
+        kinematics
+            .check_positions(&mut positions, LimitMode::Clamp)
+            .map_err(model_err)?;
+        Ok(RobotHandle {
+            id,
+            name: name.to_owned(),
+            kinematics,
+            links,
+            positions,
+        })
+    }
+
+    /// Sets every joint of `robot` (an array in [`RobotHandle::joint_names`]
+    /// order) and, if given, its base pose, in one round trip: the server
+    /// computes and stores every link's pose. Positions outside their
+    /// limits are refused.
+    ///
+    /// # Errors
+    /// [`ClientError::InvalidArgument`] for the wrong number of positions;
+    /// [`ClientError::Rejected`] with [`ErrorCode::OutOfLimits`],
+    /// [`ErrorCode::NonFinitePose`] (a NaN position or base),
+    /// [`ErrorCode::UnknownObject`] (robot or link gone); nothing moves
+    /// then.
+    pub fn set_joints(
+        &mut self,
+        robot: &mut RobotHandle,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+    ) -> Result<(), ClientError> {
+        if positions.len() != robot.positions.len() || positions.is_empty() {
+            return Err(ClientError::InvalidArgument(
+                "one position per moving joint of the robot",
+            ));
+        }
+        let items = robot.joint_items(positions, base, false);
+        let mut results = vec![ItemResult::default(); items.len()];
+        self.query_batch(&items, &mut results)?;
+        if let Some(r) = results.iter().find(|r| r.error != 0) {
+            return Err(ClientError::Rejected(r.error_code()));
+        }
+        robot.positions.copy_from_slice(positions);
+        Ok(())
+    }
+
+    /// [`Client::set_joints`] by joint name; joints not named keep their
+    /// last positions.
+    ///
+    /// # Errors
+    /// [`ClientError::Model`] for a name that is no moving joint; as
+    /// [`Client::set_joints`].
+    pub fn set_joints_by_name(
+        &mut self,
+        robot: &mut RobotHandle,
+        named: &[(&str, f64)],
+    ) -> Result<(), ClientError> {
+        let q = robot
+            .kinematics
+            .positions_by_name(named, &robot.positions)
+            .map_err(model_err)?;
+        self.set_joints(robot, &q, None)
+    }
+}

@@ -807,6 +807,18 @@ pub struct AdminRequest {
     /// [`shape_kind`] value, for [`AdminOp::Register`].
     pub shape: u32,
     /// Object, for [`AdminOp::Remove`].
+    ///
+    /// For [`AdminOp::Register`], the registration token: 0 for none, or
+    /// a value the client draws at random for each registration and sends
+    /// again, unchanged with the rest of the request, when it retries that
+    /// registration (after a timeout, or a server that died and came back).
+    /// A server remembers the tokens of each client's last 64 registrations,
+    /// committed with the object, so a retry gets the id of the object that
+    /// was stored (also after a crash between the commit and the reply),
+    /// never a second object. A token is forgotten with its object; the
+    /// same token with another shape or name is [`ErrorCode::Malformed`].
+    /// Added within v1 (the layout is unchanged): a server older than this
+    /// ignores the token, so a retry there may store a second object.
     pub id: u64,
     /// Number of valid entries of `pieces`.
     pub piece_count: u32,

@@ -88,7 +88,10 @@
 //! pose, so after a restart the same ids go on working and this `Client`
 //! can still remove what it registered. A server started with
 //! `--no-persist` starts empty: old ids then get
-//! [`ErrorCode::UnknownObject`], never some other object. Warm starts are
+//! [`ErrorCode::UnknownObject`], never some other object. A registration
+//! is the one call that retries by itself, safely (see [`Client::register`]):
+//! a server restarted within its timeout answers it with the object it
+//! stored, never a second one. Warm starts are
 //! not kept across a restart (the first query of each pair is cold).
 //!
 //! ## Bad input
@@ -833,8 +836,10 @@ impl Client {
     ///   [`MAX_PIECES`] pieces, more than `u32::MAX` vertices.
     /// - [`ClientError::Rejected`], and nothing is stored:
     ///   [`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`] (negative,
-    ///   NaN or infinite), [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or
-    ///   the shape reaching beyond about 5e300),
+    ///   NaN, infinite, or above 2^999, about 5e300),
+    ///   [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or the shape, its
+    ///   vertices plus its radius, reaching beyond 2^999 from its body
+    ///   origin),
     ///   [`ErrorCode::TooManyVertices`] (over the server's `--max-vertices`),
     ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
     ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
@@ -842,10 +847,11 @@ impl Client {
     ///   `--max-objects`), [`ErrorCode::StorageFull`] (the server's disk
     ///   has no room to store the object; the same call succeeds once there
     ///   is room), [`ErrorCode::Internal`] (the store failed otherwise).
-    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`]. **The
-    ///   registration may then have happened**: the request may have
-    ///   reached the server and been stored before the server died or the
-    ///   answer came too late. An object registered under a name can be
+    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`], after
+    ///   the retries below. **The registration may then have happened**:
+    ///   the request may have reached the server and been stored before
+    ///   the server died or the answer came too late, and no retry reached
+    ///   a server within the timeout. An object registered under a name can be
     ///   found again with [`Client::lookup`]; an unnamed one cannot be named
     ///   by anyone, so register what must not be orphaned with a name.
     ///

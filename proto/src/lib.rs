@@ -136,14 +136,15 @@ pub enum ErrorCode {
     EmptyVertices = 5,
     /// A shape has more vertices than the server accepts.
     TooManyVertices = 6,
-    /// A radius is negative, NaN or infinite.
+    /// A radius is negative, NaN, infinite, or above 2^999 (about 5e300).
     InvalidRadius = 7,
     /// A batch has more items than the server accepts.
     BatchTooLarge = 8,
     /// A batch has no items.
     EmptyBatch = 9,
     /// A field has a value no client should send (unknown item kind or
-    /// operation, inconsistent counts, bad UTF-8 in a name).
+    /// operation, inconsistent counts, bad UTF-8 in a name, a registration
+    /// token reused for another shape or name).
     Malformed = 10,
     /// The object belongs to another client.
     NotOwner = 11,
@@ -220,7 +221,7 @@ impl ErrorCode {
             ErrorCode::InvalidOptions => "invalid query options",
             ErrorCode::EmptyVertices => "empty vertex set",
             ErrorCode::TooManyVertices => "too many vertices",
-            ErrorCode::InvalidRadius => "radius is not a finite number >= 0",
+            ErrorCode::InvalidRadius => "radius is not a number from 0 to 5e300",
             ErrorCode::BatchTooLarge => "batch too large",
             ErrorCode::EmptyBatch => "empty batch",
             ErrorCode::Malformed => "malformed request",

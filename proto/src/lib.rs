@@ -61,7 +61,7 @@ pub const DEFAULT_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 pub const DEFAULT_MAX_ITERATIONS: u32 = 128;
 
 /// Most pieces a compound may have: the piece table travels in the fixed-size
-/// [`AdminRequest`] header.
+/// header of a registration (`AdminRequest`, in `gjkd-proto`).
 pub const MAX_PIECES: usize = 64;
 
 /// Longest object name in bytes (UTF-8).
@@ -910,7 +910,8 @@ impl WaitMode {
     }
 }
 
-/// What a server tells a client at [`AdminOp::Hello`].
+/// What a server tells a client at hello (`AdminOp::Hello`; the client
+/// crate's `Client::server_info`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v1.ServerInfo")]

@@ -26,9 +26,15 @@ fn value() -> impl Strategy<Value = f64> {
     ]
 }
 
-/// Radii: mostly valid ones, else any value.
+/// Radii: mostly valid ones, then large ones on both sides of the bound
+/// (2e300 is within it even with the largest vertices drawn), else any
+/// value.
 fn radius() -> impl Strategy<Value = f64> {
-    prop_oneof![3 => 0.0..2.0f64, 1 => value()]
+    prop_oneof![
+        3 => 0.0..2.0f64,
+        1 => prop_oneof![Just(2e300), Just(1e301), Just(1e305), Just(f64::MAX)],
+        1 => value(),
+    ]
 }
 
 fn point() -> impl Strategy<Value = Point3<f64>> {

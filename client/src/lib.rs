@@ -88,7 +88,10 @@
 //! pose, so after a restart the same ids go on working and this `Client`
 //! can still remove what it registered. A server started with
 //! `--no-persist` starts empty: old ids then get
-//! [`ErrorCode::UnknownObject`], never some other object. Warm starts are
+//! [`ErrorCode::UnknownObject`], never some other object. A registration
+//! is the one call that retries by itself, safely (see [`Client::register`]):
+//! a server restarted within its timeout answers it with the object it
+//! stored, never a second one. Warm starts are
 //! not kept across a restart (the first query of each pair is cold).
 //!
 //! ## Bad input
@@ -374,6 +377,7 @@ impl ClientBuilder {
             node,
             conn: None,
             vertex_scratch: Vec::new(),
+            tokens: TokenSource::new(),
         };
         let deadline = Instant::now() + self.connect_timeout.unwrap_or(client.timeout);
         let mut first = true;
@@ -461,6 +465,32 @@ pub struct Client {
     service: String,
     timeout: Duration,
     vertex_scratch: Vec<Vertex>,
+    tokens: TokenSource,
+}
+
+/// Draws registration tokens: random (from the standard library's
+/// randomly keyed hasher), never 0, never the same twice in a row.
+struct TokenSource {
+    keys: std::collections::hash_map::RandomState,
+    count: u64,
+}
+
+impl TokenSource {
+    fn new() -> Self {
+        TokenSource {
+            keys: std::collections::hash_map::RandomState::new(),
+            count: 0,
+        }
+    }
+
+    fn next(&mut self) -> u64 {
+        use std::hash::{BuildHasher, Hasher};
+        self.count += 1;
+        let mut h = self.keys.build_hasher();
+        h.write_u64(self.count);
+        h.write_u32(std::process::id());
+        h.finish().max(1)
+    }
 }
 
 impl std::fmt::Debug for Client {
@@ -483,6 +513,8 @@ const LIVENESS_EVERY: Duration = Duration::from_millis(100);
 /// Busy-poll this long for an answer before yielding the CPU: a spinning
 /// server answers a query in a few microseconds.
 const SPIN_FOR: Duration = Duration::from_micros(100);
+/// Pause between two attempts of a registration while the server is gone.
+const RETRY_PAUSE: Duration = Duration::from_millis(5);
 /// Hello is repeated this often while connecting.
 const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
@@ -788,7 +820,15 @@ impl Client {
         request: &AdminRequest,
         vertices: &[Vertex],
     ) -> Result<AdminReply, ClientError> {
-        let deadline = Instant::now() + self.timeout;
+        self.admin_until(request, vertices, Instant::now() + self.timeout)
+    }
+
+    fn admin_until(
+        &mut self,
+        request: &AdminRequest,
+        vertices: &[Vertex],
+        deadline: Instant,
+    ) -> Result<AdminReply, ClientError> {
         self.ensure_connected(deadline)?;
         let (reply, _) = self.admin_call(request, vertices, deadline)?;
         match reply.error_code() {
@@ -805,8 +845,10 @@ impl Client {
     ///   [`MAX_PIECES`] pieces, more than `u32::MAX` vertices.
     /// - [`ClientError::Rejected`], and nothing is stored:
     ///   [`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`] (negative,
-    ///   NaN or infinite), [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or
-    ///   the shape reaching beyond about 5e300),
+    ///   NaN, infinite, or above 2^999, about 5e300),
+    ///   [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or the shape, its
+    ///   vertices plus its radius, reaching beyond 2^999 from its body
+    ///   origin),
     ///   [`ErrorCode::TooManyVertices`] (over the server's `--max-vertices`),
     ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
     ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
@@ -814,12 +856,28 @@ impl Client {
     ///   `--max-objects`), [`ErrorCode::StorageFull`] (the server's disk
     ///   has no room to store the object; the same call succeeds once there
     ///   is room), [`ErrorCode::Internal`] (the store failed otherwise).
-    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`]. **The
-    ///   registration may then have happened**: the request may have
-    ///   reached the server and been stored before the server died or the
-    ///   answer came too late. An object registered under a name can be
+    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`], after
+    ///   the retries below. **The registration may then have happened**:
+    ///   the request may have reached the server and been stored before
+    ///   the server died or the answer came too late, and no retry reached
+    ///   a server within the timeout. An object registered under a name can be
     ///   found again with [`Client::lookup`]; an unnamed one cannot be named
     ///   by anyone, so register what must not be orphaned with a name.
+    ///
+    /// # Retries
+    /// Each registration carries a random token. When the server turns out
+    /// to be gone (it died, or was restarted), this call reconnects and
+    /// sends the same registration again, with the same token, until its
+    /// timeout has passed: a server that stored the object before it died
+    /// answers the retry with that object's id (it keeps the tokens of each
+    /// client's last 64 registrations with the objects, across restarts),
+    /// so a retry never stores a second object. So a server restarted
+    /// within the timeout costs no orphan. A [`ClientError::Timeout`] from
+    /// a server that is alive is not retried (the deadline has passed). No
+    /// other call retries by itself: a pose update or query that failed is
+    /// simply sent again by the caller, and [`Client::remove`] retried
+    /// after a lost reply answers [`ErrorCode::UnknownObject`] if the first
+    /// attempt removed the object.
     pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, ClientError> {
         self.register_with(geometry, None, &Isometry3::identity())
     }
@@ -855,12 +913,33 @@ impl Client {
                 "name longer than MAX_NAME_LEN",
             ));
         }
+        request.id = self.tokens.next();
         let mut vertices = std::mem::take(&mut self.vertex_scratch);
         vertices.clear();
         let built = Self::encode(geometry, &mut request, &mut vertices);
-        let result = built.and_then(|()| self.admin(&request, &vertices));
+        let result = built.and_then(|()| self.register_retrying(&request, &vertices));
         self.vertex_scratch = vertices;
         result.map(|r| ObjectId::from_raw(r.id))
+    }
+
+    /// Sends a registration and, while the server is gone, sends it again
+    /// with the same token (reconnecting) until the call's deadline: the
+    /// server answers a repeated token with the object it stored, so this
+    /// never registers twice.
+    fn register_retrying(
+        &mut self,
+        request: &AdminRequest,
+        vertices: &[Vertex],
+    ) -> Result<AdminReply, ClientError> {
+        let deadline = Instant::now() + self.timeout;
+        loop {
+            match self.admin_until(request, vertices, deadline) {
+                Err(ClientError::ServerGone(_)) if Instant::now() + RETRY_PAUSE < deadline => {
+                    std::thread::sleep(RETRY_PAUSE);
+                }
+                outcome => return outcome,
+            }
+        }
     }
 
     fn encode(

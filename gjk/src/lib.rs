@@ -75,13 +75,14 @@ pub enum Error {
     /// Vertex (or piece) counts must fit in `u32`, the width of warm-start indices.
     #[error("too many vertices or pieces: {0}")]
     TooManyVertices(usize),
-    /// A vertex has a NaN or infinite coordinate, or the set reaches more
-    /// than 2^999 (about 5e300) from its body origin, where queries could
-    /// overflow.
+    /// A vertex has a NaN or infinite coordinate, or the shape (its
+    /// vertices plus its rounding radius) reaches more than 2^999 (about
+    /// 5e300) from its body origin, where queries could overflow.
     #[error("vertex {0} is not finite, or the set reaches beyond 5e300")]
     NonFiniteVertex(usize),
-    /// The rounding radius is negative, NaN or infinite.
-    #[error("radius {0} is not a finite number >= 0")]
+    /// The rounding radius is negative, NaN, infinite, or above 2^999
+    /// (about 5e300).
+    #[error("radius {0} is not a finite number from 0 to 5e300")]
     InvalidRadius(f64),
     /// A compound needs at least one piece.
     #[error("compound with no pieces")]

@@ -162,9 +162,10 @@ impl Convex {
     ///
     /// # Errors
     /// [`Error::EmptyVertices`] for no vertices, [`Error::TooManyVertices`] past
-    /// `u32::MAX`, [`Error::NonFiniteVertex`] for NaN or infinity or a set
-    /// reaching more than 2^999 (about 5e300) from the body origin, and
-    /// [`Error::InvalidRadius`] for a negative or non-finite radius.
+    /// `u32::MAX`, [`Error::NonFiniteVertex`] for NaN or infinity or a shape
+    /// (vertices plus radius) reaching more than 2^999 (about 5e300) from
+    /// the body origin, and [`Error::InvalidRadius`] for a radius that is
+    /// negative, not finite, or itself above 2^999.
     pub fn new(vertices: impl Into<Vec<Point3<f64>>>, radius: f64) -> Result<Self, Error> {
         let vertices = vertices.into();
         check_input(&vertices, radius)?;
@@ -173,7 +174,9 @@ impl Convex {
         let len = vertices.len();
         let size = largest_length(&xs, &ys, &zs, widest)?;
         let centroid_norm = robust_norm(&centroid.coords);
-        if centroid_norm + size > MAX_REACH {
+        // The radius counts too: a query's distances and points are the
+        // core's grown by it, and must stay as far from overflow.
+        if centroid_norm + size + radius > MAX_REACH {
             return Err(Error::NonFiniteVertex(0));
         }
         // Pad the scan arrays to whole vector steps with copies of vertex 0:
@@ -205,7 +208,8 @@ impl Convex {
     /// A sphere: one point at the body origin with a radius.
     ///
     /// # Errors
-    /// [`Error::InvalidRadius`] for a negative or non-finite radius.
+    /// [`Error::InvalidRadius`] for a radius that is negative, not finite, or
+    /// above 2^999 (about 5e300).
     pub fn sphere(radius: f64) -> Result<Self, Error> {
         Self::new(vec![Point3::origin()], radius)
     }
@@ -460,7 +464,7 @@ fn check_input(vertices: &[Point3<f64>], radius: f64) -> Result<(), Error> {
     {
         return Err(Error::NonFiniteVertex(index));
     }
-    if !(radius.is_finite() && radius >= 0.0) {
+    if !(radius.is_finite() && (0.0..=MAX_REACH).contains(&radius)) {
         return Err(Error::InvalidRadius(radius));
     }
     Ok(())
@@ -625,7 +629,8 @@ impl Compound {
     /// # Errors
     /// [`Error::EmptyCompound`] for no pieces, [`Error::TooManyVertices`] past
     /// `u32::MAX` pieces, and [`Error::NonFinitePose`] for an offset with NaN or
-    /// infinity, or a piece reaching more than 2^999 (about 5e300) from the
+    /// infinity, or a piece (its vertices plus its radius) reaching more
+    /// than 2^999 (about 5e300) from the
     /// compound's body origin.
     pub fn new(pieces: Vec<(Isometry3<f64>, Convex)>) -> Result<Self, Error> {
         if pieces.is_empty() {
@@ -641,7 +646,7 @@ impl Compound {
         // a query's magnitudes stay far from overflow (see MAX_REACH).
         if pieces
             .iter()
-            .any(|(o, c)| robust_norm(&o.translation.vector) + c.reach() > MAX_REACH)
+            .any(|(o, c)| robust_norm(&o.translation.vector) + c.reach() + c.radius() > MAX_REACH)
         {
             return Err(Error::NonFinitePose);
         }
@@ -1581,5 +1586,64 @@ pub(crate) mod tests {
             }
         }
         assert!(checked > 30_000, "{checked}");
+    }
+}
+
+/// The documented bound on a shape's reach holds with its radius counted.
+#[cfg(test)]
+mod reach_tests {
+    use super::*;
+    use crate::{Options, distance};
+
+    #[test]
+    fn the_radius_counts_towards_the_reach() {
+        assert_eq!(MAX_REACH, 2f64.powi(999));
+        // A radius alone beyond 2^999 is an invalid radius.
+        for r in [1e305, MAX_REACH * 1.000_001] {
+            assert_eq!(Convex::sphere(r), Err(Error::InvalidRadius(r)));
+        }
+        // Within the bound alone, but vertices plus radius beyond it.
+        let half = MAX_REACH * 0.6;
+        assert_eq!(
+            Convex::new(vec![Point3::new(half, 0.0, 0.0)], half),
+            Err(Error::NonFiniteVertex(0))
+        );
+        assert_eq!(
+            Convex::cuboid(Vector3::new(half, 0.0, 0.0), half),
+            Err(Error::NonFiniteVertex(0))
+        );
+        let piece = Convex::sphere(half).expect("within the bound");
+        assert_eq!(
+            Compound::new(vec![(Isometry3::translation(half, 0.0, 0.0), piece)]),
+            Err(Error::NonFinitePose)
+        );
+        // Negative and non-finite half extents.
+        for h in [-1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                Convex::cuboid(Vector3::new(1.0, h, 1.0), 0.0),
+                Err(Error::NonFiniteVertex(0))
+            );
+        }
+        // The largest accepted sphere is queried without an error, and
+        // answers of ordinary shapes are what they were: two unit boxes 3
+        // apart along x, 1 apart between their faces.
+        let big = Convex::sphere(MAX_REACH).expect("at the bound");
+        let unit: Shape = Convex::cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)
+            .expect("box")
+            .into();
+        let o = Options::default();
+        let id = Isometry3::identity();
+        let a = distance(&big.into(), &id, &unit, &id, &o, None).expect("queried");
+        assert_eq!(a.distance, 0.0);
+        let b = distance(
+            &unit,
+            &id,
+            &unit,
+            &Isometry3::translation(3.0, 0.0, 0.0),
+            &o,
+            None,
+        )
+        .expect("queried");
+        assert_eq!(b.distance, 1.0);
     }
 }

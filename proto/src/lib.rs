@@ -61,7 +61,7 @@ pub const DEFAULT_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 pub const DEFAULT_MAX_ITERATIONS: u32 = 128;
 
 /// Most pieces a compound may have: the piece table travels in the fixed-size
-/// [`AdminRequest`] header.
+/// header of a registration (`AdminRequest`, in `gjkd-proto`).
 pub const MAX_PIECES: usize = 64;
 
 /// Most joint positions one [`ItemKind::SetJoints`] item carries.
@@ -139,14 +139,15 @@ pub enum ErrorCode {
     EmptyVertices = 5,
     /// A shape has more vertices than the server accepts.
     TooManyVertices = 6,
-    /// A radius is negative, NaN or infinite.
+    /// A radius is negative, NaN, infinite, or above 2^999 (about 5e300).
     InvalidRadius = 7,
     /// A batch has more items than the server accepts.
     BatchTooLarge = 8,
     /// A batch has no items.
     EmptyBatch = 9,
     /// A field has a value no client should send (unknown item kind or
-    /// operation, inconsistent counts, bad UTF-8 in a name).
+    /// operation, inconsistent counts, bad UTF-8 in a name, a registration
+    /// token reused for another shape or name).
     Malformed = 10,
     /// The object belongs to another client.
     NotOwner = 11,
@@ -231,7 +232,7 @@ impl ErrorCode {
             ErrorCode::InvalidOptions => "invalid query options",
             ErrorCode::EmptyVertices => "empty vertex set",
             ErrorCode::TooManyVertices => "too many vertices",
-            ErrorCode::InvalidRadius => "radius is not a finite number >= 0",
+            ErrorCode::InvalidRadius => "radius is not a number from 0 to 5e300",
             ErrorCode::BatchTooLarge => "batch too large",
             ErrorCode::EmptyBatch => "empty batch",
             ErrorCode::Malformed => "malformed request",
@@ -960,6 +961,18 @@ pub struct AdminRequest {
     /// [`shape_kind`] value, for [`AdminOp::Register`].
     pub shape: u32,
     /// Object, for [`AdminOp::Remove`].
+    ///
+    /// For [`AdminOp::Register`], the registration token: 0 for none, or
+    /// a value the client draws at random for each registration and sends
+    /// again, unchanged with the rest of the request, when it retries that
+    /// registration (after a timeout, or a server that died and came back).
+    /// A server remembers the tokens of each client's last 64 registrations,
+    /// committed with the object, so a retry gets the id of the object that
+    /// was stored (also after a crash between the commit and the reply),
+    /// never a second object. A token is forgotten with its object; the
+    /// same token with another shape or name is [`ErrorCode::Malformed`].
+    /// Added within v1 (the layout is unchanged): a server older than this
+    /// ignores the token, so a retry there may store a second object.
     pub id: u64,
     /// Number of valid entries of `pieces`.
     pub piece_count: u32,
@@ -1050,7 +1063,8 @@ impl WaitMode {
     }
 }
 
-/// What a server tells a client at [`AdminOp::Hello`].
+/// What a server tells a client at hello (`AdminOp::Hello`; the client
+/// crate's `Client::server_info`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v1.ServerInfo")]

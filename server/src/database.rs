@@ -45,6 +45,7 @@ use tracing::{error, info, warn};
 
 use crate::legacy;
 use crate::stored::{Snapshot, StoredObject};
+use crate::tokens::TokenKey;
 
 /// Version of this layout, kept in the `meta` table; the `GJKDOBJS` state
 /// file was version 1.
@@ -52,6 +53,10 @@ pub const FORMAT_VERSION: u64 = 2;
 
 const OBJECTS: TableDefinition<u64, &[u8]> = TableDefinition::new("objects");
 const META: TableDefinition<&str, u64> = TableDefinition::new("meta");
+/// Registration tokens ([`crate::tokens`]): (owner, token) to object id.
+/// Added within format 2: a store without it has no tokens, and a server
+/// before it leaves the table alone.
+const TOKENS: TableDefinition<(u128, u64), u64> = TableDefinition::new("tokens");
 const FORMAT: &str = "format";
 const EPOCH: &str = "epoch";
 const NEXT_INDEX: &str = "next_index";
@@ -268,11 +273,18 @@ impl Database {
         result
     }
 
-    /// Stores a registered object with the id counter after it, durably.
+    /// Stores a registered object with the id counter after it, and its
+    /// registration token (`token`, with the token it pushes out), durably:
+    /// all in one transaction, so a retry after a crash finds the object.
     ///
     /// # Errors
     /// When the transaction cannot be committed; nothing of it is stored.
-    pub fn register(&mut self, object: &StoredObject, next_index: u32) -> Result<(), StoreError> {
+    pub fn register(
+        &mut self,
+        object: &StoredObject,
+        next_index: u32,
+        token: Option<(TokenKey, Option<TokenKey>)>,
+    ) -> Result<(), StoreError> {
         let bytes = postcard::to_stdvec(object).map_err(|e| StoreError::Database {
             what: "cannot encode an object for",
             path: self.path.clone(),
@@ -283,19 +295,58 @@ impl Database {
                 .insert(object.id, bytes.as_slice())?;
             tx.open_table(META)?
                 .insert(NEXT_INDEX, u64::from(next_index))?;
+            if let Some((key, pushed_out)) = token {
+                let mut tokens = tx.open_table(TOKENS)?;
+                tokens.insert(key, object.id)?;
+                if let Some(old) = pushed_out {
+                    tokens.remove(old)?;
+                }
+            }
             Ok(true)
         })
     }
 
-    /// Removes the objects `ids` in one durable transaction.
+    /// Every registration token stored, with its object's id.
+    ///
+    /// # Errors
+    /// When the table cannot be read.
+    pub fn tokens(&mut self) -> Result<Vec<(TokenKey, u64)>, StoreError> {
+        let path = self.path.clone();
+        let fail = |e: &dyn std::fmt::Display| StoreError::Database {
+            what: "cannot read the registration tokens of",
+            path: path.clone(),
+            reason: e.to_string(),
+        };
+        let tx = self.live()?.begin_read().map_err(|e| fail(&e))?;
+        let table = match tx.open_table(TOKENS) {
+            Ok(t) => t,
+            Err(redb::TableError::TableDoesNotExist(_)) => return Ok(Vec::new()),
+            Err(e) => return Err(fail(&e)),
+        };
+        let mut out = Vec::new();
+        for entry in table.iter().map_err(|e| fail(&e))? {
+            let (k, v) = entry.map_err(|e| fail(&e))?;
+            out.push((k.value(), v.value()));
+        }
+        Ok(out)
+    }
+
+    /// Removes the objects `ids`, and the registration tokens `tokens` of
+    /// theirs, in one durable transaction.
     ///
     /// # Errors
     /// When the transaction cannot be committed; then none is removed.
-    pub fn remove(&mut self, ids: &[u64]) -> Result<(), StoreError> {
+    pub fn remove(&mut self, ids: &[u64], tokens: &[TokenKey]) -> Result<(), StoreError> {
         self.write(|tx| {
             let mut table = tx.open_table(OBJECTS)?;
             for id in ids {
                 table.remove(id)?;
+            }
+            if !tokens.is_empty() {
+                let mut table = tx.open_table(TOKENS)?;
+                for key in tokens {
+                    table.remove(key)?;
+                }
             }
             Ok(true)
         })
@@ -842,8 +893,8 @@ mod tests {
         assert_eq!((opened.snapshot.epoch, opened.snapshot.next_index), (5, 1));
         db.sync(&sample()).expect("sync");
         let extra = object(9, 1, Some("extra"));
-        db.register(&extra, 10).expect("register");
-        db.remove(&[id(1)]).expect("remove");
+        db.register(&extra, 10, None).expect("register");
+        db.remove(&[id(1)], &[]).expect("remove");
         drop(db);
         let (_, opened) = Database::open(&path, 6).expect("reopen");
         let mut want = sample();
@@ -876,7 +927,7 @@ mod tests {
         let err = Database::open(&path, 6).expect_err("in use");
         assert!(matches!(err, StoreError::InUse(_)), "{err}");
         assert!(err.to_string().contains("stop it first"), "{err}");
-        db.register(&object(9, 1, None), 10)
+        db.register(&object(9, 1, None), 10, None)
             .expect("the first still writes");
         drop(db);
         let (_, opened) = Database::open(&path, 6).expect("free again");
@@ -894,7 +945,8 @@ mod tests {
         let (mut db, _) = Database::open(&path, 5).expect("create");
         db.sync(&sample()).expect("sync");
         for i in 10..14 {
-            db.register(&object(i, i, None), i + 1).expect("register");
+            db.register(&object(i, i, None), i + 1, None)
+                .expect("register");
         }
         drop(db);
         let good = std::fs::read(&path).expect("file");
@@ -965,11 +1017,11 @@ mod tests {
         let mut want = sample();
         for i in 10..40 {
             let o = object(i, i, None);
-            db.register(&o, i + 1).expect("register");
+            db.register(&o, i + 1, None).expect("register");
             want.objects.push(o);
             want.next_index = i + 1;
         }
-        db.remove(&[id(1)]).expect("remove");
+        db.remove(&[id(1)], &[]).expect("remove");
         want.objects.remove(0);
         let at_kill = std::fs::read(&path).expect("read while open");
         drop(db);
@@ -978,7 +1030,8 @@ mod tests {
         assert!(opened.set_aside.is_empty(), "{opened:?}");
         assert_eq!(opened.snapshot, want);
         // And it is writable again.
-        db.register(&object(50, 50, None), 51).expect("register");
+        db.register(&object(50, 50, None), 51, None)
+            .expect("register");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
@@ -992,11 +1045,14 @@ mod tests {
         let (mut db, _) = Database::open(&path, 5).expect("create");
         db.sync(&sample()).expect("sync");
         db.simulate_full_disk(true);
-        let err = db.register(&object(9, 1, None), 10).expect_err("full");
+        let err = db
+            .register(&object(9, 1, None), 10, None)
+            .expect_err("full");
         assert!(matches!(err, StoreError::Full(_)), "{err}");
-        assert!(db.remove(&[id(1)]).is_err());
+        assert!(db.remove(&[id(1)], &[]).is_err());
         db.simulate_full_disk(false);
-        db.register(&object(10, 1, None), 11).expect("room again");
+        db.register(&object(10, 1, None), 11, None)
+            .expect("room again");
         drop(db);
         let (_, opened) = Database::open(&path, 6).expect("reopen");
         let ids: Vec<u64> = opened.snapshot.objects.iter().map(|o| o.id).collect();

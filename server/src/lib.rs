@@ -50,3 +50,4 @@ pub mod server;
 pub mod state;
 pub mod store;
 pub mod stored;
+pub mod tokens;

@@ -45,7 +45,15 @@ pub fn run(path: &std::path::Path, remove: bool) -> Result<(), String> {
         return Ok(());
     }
     let ids: Vec<u64> = removed.iter().map(|o| o.id).collect();
-    db.remove(&ids).map_err(|e| e.to_string())?;
+    // Their registration tokens go with them (nobody can retry them).
+    let tokens: Vec<_> = db
+        .tokens()
+        .map_err(|e| e.to_string())?
+        .into_iter()
+        .filter(|(_, id)| ids.contains(id))
+        .map(|(key, _)| key)
+        .collect();
+    db.remove(&ids, &tokens).map_err(|e| e.to_string())?;
     println!(
         "removed {} object(s) whose owner is gone: {}",
         removed.len(),

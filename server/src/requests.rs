@@ -186,7 +186,8 @@ impl State {
             Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
                 .and_then(|new| {
                     let max = self.limits.max_objects;
-                    self.store.register(new, Owner::Client(requester), max)
+                    self.store
+                        .register(new, Owner::Client(requester), max, request.id)
                 }),
             Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
             Some(AdminOp::Lookup) => match (request.name(), request.shape) {

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use gjkd_proto::{
-    AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, Vertex, WaitMode,
+    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, Vertex, WaitMode,
     admin_service_name, query_service_name, wake_service_name,
 };
 use iceoryx2::port::listener::Listener;
@@ -567,8 +567,33 @@ fn serve_admin(admin: &AdminServer, service: &AdminService, state: &mut State) -
             ErrorCode::Ok => debug!(op = header.op, id = reply.id, "admin ok"),
             code => info!(op = header.op, ?code, "admin request refused"),
         }
+        if header.op == AdminOp::Register as u32
+            && reply.error_code() == ErrorCode::Ok
+            && fault_kill_after_register()
+        {
+            // Fault injection for the tests: a crash between the commit
+            // and the reply, as `kill -9` would make it.
+            error!(
+                id = reply.id,
+                "{KILL_AFTER_REGISTER} is set: killing this server before the reply"
+            );
+            // SAFETY: kill(2) on our own pid; no memory is involved.
+            unsafe { libc::kill(libc::getpid(), libc::SIGKILL) };
+        }
         if let Err(e) = request.send_copy(reply) {
             debug!(error = ?e, "admin reply not delivered (client gone?)");
         }
     }
+}
+
+/// Fault-injection hook for the tests, not for production: when this
+/// environment variable is `1` at start, the server kills itself with
+/// `SIGKILL` right after committing a registration and before replying,
+/// as a `kill -9` between the store and the reply would.
+pub const KILL_AFTER_REGISTER: &str = "GJKD_FAULT_KILL_AFTER_REGISTER";
+
+/// Whether [`KILL_AFTER_REGISTER`] is set (read once).
+fn fault_kill_after_register() -> bool {
+    static SET: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *SET.get_or_init(|| std::env::var(KILL_AFTER_REGISTER).is_ok_and(|v| v == "1"))
 }

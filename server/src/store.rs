@@ -13,6 +13,7 @@ use crate::cache::FxBuild;
 use crate::database::{Database, StoreError};
 use crate::journal::Journal;
 use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredPose, StoredShape};
+use crate::tokens::Tokens;
 
 /// Who may remove an object.
 ///
@@ -110,6 +111,8 @@ pub struct ObjectStore {
     next_slot: u32,
     /// Commits to the database and journal writes that failed.
     persist_errors: u64,
+    /// Registration tokens of recent registrations, as in the database.
+    tokens: Tokens,
 }
 
 impl ObjectStore {
@@ -126,6 +129,7 @@ impl ObjectStore {
             free_slots: Vec::new(),
             next_slot: 0,
             persist_errors: 0,
+            tokens: Tokens::default(),
         }
     }
 
@@ -241,6 +245,19 @@ impl ObjectStore {
             report_unverified_poses(&path, &found, &unverified);
         }
         self.journal = Some(journal);
+        let mut database = database;
+        match database.tokens() {
+            Ok(entries) => {
+                let objects = &self.objects;
+                self.tokens = Tokens::load(entries, |id| objects.contains_key(&id));
+            }
+            // Without its tokens the store still serves; only a retry of a
+            // registration from before the restart could store a second
+            // object.
+            Err(e) => {
+                tracing::error!("{e}: registrations from before the restart cannot be retried")
+            }
+        }
         self.database = Some(database);
         let slots: Vec<(u32, u64)> = self.objects.iter().map(|(&id, o)| (o.slot, id)).collect();
         for (slot, id) in slots {
@@ -472,24 +489,59 @@ impl ObjectStore {
     /// persistence is on) before returning its id; if the commit fails, the
     /// object is not kept.
     ///
+    /// A client's registration `token` (not 0, see [`crate::tokens`]) is
+    /// committed with the object; a registration whose token this owner
+    /// used before, while that object is still stored, returns that
+    /// object's id and stores nothing.
+    ///
     /// # Errors
     /// As [`ObjectStore::insert`], and [`ErrorCode::StorageFull`] (no room
-    /// on the disk) or [`ErrorCode::Internal`] when the commit fails.
+    /// on the disk) or [`ErrorCode::Internal`] when the commit fails;
+    /// [`ErrorCode::Malformed`] for a token used before with another shape
+    /// or name.
     pub fn register(
         &mut self,
         new: NewObject,
         owner: Owner,
         max_objects: usize,
+        token: u64,
     ) -> Result<u64, ErrorCode> {
+        let key = match owner {
+            Owner::Client(c) if token != 0 => Some((c, token)),
+            _ => None,
+        };
+        if let Some(id) = key.and_then(|k| self.tokens.find(k))
+            && let Some(old) = self.objects.get(&id)
+        {
+            // A retry: the same object, or a client reusing a token.
+            return if old.shape == new.shape && old.name == new.name {
+                Ok(id)
+            } else {
+                Err(ErrorCode::Malformed)
+            };
+        }
         let id = self.insert(new, owner, max_objects)?;
         // Just inserted, so always there.
         let stored = self.stored(id).ok_or(ErrorCode::Internal)?;
         let next = self.next_index;
-        self.commit(|db| db.register(&stored, next))
-            .map(|()| id)
-            .inspect_err(|_| {
+        let token_write = key.map(|k| (k, self.tokens.pushed_out_by_next(k.0)));
+        match self.commit(|db| db.register(&stored, next, token_write)) {
+            Ok(()) => {
+                if let Some(k) = key {
+                    self.tokens.remember(k, id);
+                }
+                Ok(id)
+            }
+            Err(e) => {
                 self.unlink_object(id);
-            })
+                Err(e)
+            }
+        }
+    }
+
+    /// Test and fault-injection view: the registration tokens remembered.
+    pub fn tokens(&self) -> &Tokens {
+        &self.tokens
     }
 
     /// Removes the objects of every client for which `alive` is false (its
@@ -536,12 +588,19 @@ impl ObjectStore {
             .filter_map(|&(id, _)| Some((id, self.unlink_object(id)?)))
             .collect();
         let ids: Vec<u64> = dropped.iter().map(|&(id, _)| id).collect();
-        if let Err(code) = self.commit(|db| db.remove(&ids)) {
+        let keys: Vec<_> = ids
+            .iter()
+            .filter_map(|&id| self.tokens.key_of(id))
+            .collect();
+        if let Err(code) = self.commit(|db| db.remove(&ids, &keys)) {
             // In reverse: each object's slot is then on top of the stack.
             for (id, object) in dropped.into_iter().rev() {
                 self.relink_object(id, object);
             }
             return (Vec::new(), Some(code));
+        }
+        for &id in &ids {
+            self.tokens.forget_object(id);
         }
         (ids, None)
     }
@@ -598,10 +657,12 @@ impl ObjectStore {
         let Some(object) = self.unlink_object(id) else {
             return Err(ErrorCode::UnknownObject);
         };
-        if let Err(e) = self.commit(|db| db.remove(&[id])) {
+        let keys: Vec<_> = self.tokens.key_of(id).into_iter().collect();
+        if let Err(e) = self.commit(|db| db.remove(&[id], &keys)) {
             self.relink_object(id, object);
             return Err(e);
         }
+        self.tokens.forget_object(id);
         Ok(id)
     }
 }
@@ -913,6 +974,58 @@ mod tests {
                 .all(|&id| r.object(id).expect("there").pose == Isometry3::identity())
         );
         assert!(kept(&bytes));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A registration retried with its token gets the object stored the
+    /// first time, also after a restart (the token is committed with the
+    /// object); another client's same token, or the token after the object
+    /// is removed, registers anew; the token with another shape is refused.
+    #[test]
+    fn a_retried_registration_gets_the_stored_object_across_a_restart() {
+        let (dir, path, mut s) = stored("tokens");
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0].vertex_count = 1;
+        req.pieces[0].radius = 0.5;
+        req.id = 0xfeed;
+        let v = [Vertex::default()];
+        let first = s.handle_admin(1, &req, &v);
+        assert_eq!(first.error_code(), ErrorCode::Ok);
+        assert_eq!(s.handle_admin(1, &req, &v).id, first.id, "same token");
+        assert_eq!(s.len(), 1);
+        drop(s);
+        // As a server killed after the commit finds it.
+        let (db, opened) = Database::open(&path, 9).expect("reopen");
+        let mut r =
+            State::restore(Limits::default(), WaitMode::Spin, &opened.snapshot).expect("valid");
+        r.set_database(db).expect("journal");
+        let again = r.handle_admin(1, &req, &v);
+        assert_eq!((again.error_code(), again.id), (ErrorCode::Ok, first.id));
+        assert_eq!(r.len(), 1, "one object, not two");
+        // Another owner's token is its own.
+        let other = r.handle_admin(2, &req, &v);
+        assert_ne!(other.id, first.id);
+        // The same token for another shape is a client bug.
+        let mut changed = req;
+        changed.pieces[0].radius = 0.75;
+        assert_eq!(
+            r.handle_admin(1, &changed, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        // Token 0 is no token: two objects.
+        let mut plain = req;
+        plain.id = 0;
+        let (p1, p2) = (r.handle_admin(1, &plain, &v), r.handle_admin(1, &plain, &v));
+        assert_ne!(p1.id, p2.id);
+        // Removed: the token is forgotten with the object, on disk too.
+        r.remove(first.id, 1).expect("owner");
+        assert_eq!(r.store().tokens().find((1, 0xfeed)), None);
+        drop(r);
+        let (mut db, _) = Database::open(&path, 9).expect("reopen");
+        let tokens = db.tokens().expect("tokens");
+        assert_eq!(tokens, vec![((2, 0xfeed), other.id)]);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

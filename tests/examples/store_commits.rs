@@ -33,7 +33,7 @@ fn main() {
             slot: i - 1,
         };
         let start = Instant::now();
-        db.register(&object, i + 1).expect("commit");
+        db.register(&object, i + 1, None).expect("commit");
         times.push(start.elapsed());
     }
     let median = |t: &[Duration]| {

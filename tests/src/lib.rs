@@ -75,6 +75,8 @@ pub struct Server {
     pub service: String,
     args: Vec<String>,
     state_dir: Option<PathBuf>,
+    /// Extra environment variables of the server process.
+    env: Vec<(String, String)>,
 }
 
 impl Server {
@@ -84,8 +86,28 @@ impl Server {
         Self::start_on(&unique_service(tag), args)
     }
 
+    /// As [`Server::start`], with extra environment variables (such as a
+    /// fault-injection hook) until [`Server::clear_env`].
+    pub fn start_with_env(tag: &str, args: &[&str], env: &[(&str, &str)]) -> Self {
+        let env = env
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        Self::start_on_with_env(&unique_service(tag), args, env)
+    }
+
+    /// Drops the extra environment variables for the next
+    /// [`Server::restart`].
+    pub fn clear_env(&mut self) {
+        self.env.clear();
+    }
+
     /// Starts `gjkd serve --service SERVICE` with `args`.
     pub fn start_on(service: &str, args: &[&str]) -> Self {
+        Self::start_on_with_env(service, args, Vec::new())
+    }
+
+    fn start_on_with_env(service: &str, args: &[&str], env: Vec<(String, String)>) -> Self {
         let mut args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
         let mut state_dir = None;
         if !args
@@ -107,6 +129,7 @@ impl Server {
             service: service.to_owned(),
             args,
             state_dir,
+            env,
         };
         server.spawn();
         server
@@ -127,6 +150,7 @@ impl Server {
                 "RUST_LOG",
                 std::env::var("GJKD_TEST_LOG").unwrap_or_else(|_| "warn".into()),
             )
+            .envs(self.env.iter().map(|(k, v)| (k, v)))
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .spawn()

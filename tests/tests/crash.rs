@@ -341,3 +341,56 @@ fn a_server_killed_after_many_changes_keeps_every_acknowledged_one() {
         removed.len()
     );
 }
+
+/// A server that dies between committing a registration and replying to
+/// it (killed by its own fault-injection hook, `SIGKILL` right after the
+/// commit): the client's `register` reconnects to the restarted server and
+/// sends the registration again with its token, and gets the id of the
+/// object that was stored. The store holds that one object, not two.
+#[test]
+fn a_registration_retried_across_a_kill_between_store_and_reply_is_stored_once() {
+    use std::os::unix::process::ExitStatusExt;
+    let mut server = Server::start_with_env(
+        "kill-after-register",
+        &["--wait", "adaptive"],
+        &[(gjkd_server::server::KILL_AFTER_REGISTER, "1")],
+    );
+    let service = server.service.clone();
+    // A call timeout long enough for the restart below.
+    let registering = std::thread::spawn(move || {
+        let mut client = gjkd_e2e::connect(&service, Duration::from_secs(30));
+        client.register_sphere(0.5)
+    });
+    let mut status = None;
+    for _ in 0..6 {
+        status = server.wait_exit();
+        if status.is_some() {
+            break;
+        }
+    }
+    let status = status.expect("the hook killed the server after the commit");
+    assert_eq!(status.signal(), Some(libc::SIGKILL), "{status:?}");
+    server.clear_env();
+    server.restart();
+    let id = registering
+        .join()
+        .expect("registering thread")
+        .expect("the retry is answered by the restarted server");
+    let mut client = server.client(Duration::from_secs(5));
+    assert_eq!(
+        client.stats().expect("stats").objects,
+        1,
+        "one object, not two"
+    );
+    let other = client.register_sphere(0.5).expect("registered");
+    let answer = client
+        .distance_at(
+            id,
+            &Isometry3::identity(),
+            other,
+            &Isometry3::translation(3.0, 0.0, 0.0),
+            &QueryOptions::cold(),
+        )
+        .expect("the stored object answers");
+    assert_eq!(answer.distance, 2.0);
+}

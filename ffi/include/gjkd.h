@@ -130,6 +130,14 @@ enum gjkd_error_code
   GJKD_CODE_TOO_MANY_OBJECTS = 18,
   // The server failed in a way that is its own fault; it keeps serving.
   GJKD_CODE_INTERNAL = 19,
+  // The server's disk has no room to store a registration or removal:
+  // the change was not made; the same call succeeds once there is room.
+  GJKD_CODE_STORAGE_FULL = 20,
+  // A joint position is outside its joint's limits.
+  GJKD_CODE_OUT_OF_LIMITS = 21,
+  // A robot's URDF is malformed, or its links do not form one tree of
+  // supported joints.
+  GJKD_CODE_INVALID_ROBOT = 22,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -501,7 +509,8 @@ struct gjkd_query_options gjkd_query_options_default(void);
 // `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`,
 // `GJKD_CODE_EMPTY_VERTICES`, `GJKD_CODE_NON_FINITE_VERTEX`,
 // `GJKD_CODE_TOO_MANY_VERTICES`, `GJKD_CODE_NAME_TAKEN`,
-// `GJKD_CODE_TOO_MANY_OBJECTS`, `GJKD_CODE_INTERNAL` (nothing stored);
+// `GJKD_CODE_TOO_MANY_OBJECTS`, `GJKD_CODE_STORAGE_FULL`,
+// `GJKD_CODE_INTERNAL` (nothing stored);
 // `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (the registration may then
 // have happened: register what must not be orphaned with a name and look
 // it up).

@@ -166,7 +166,8 @@ unsafe fn register_entry(
 /// `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`,
 /// `GJKD_CODE_EMPTY_VERTICES`, `GJKD_CODE_NON_FINITE_VERTEX`,
 /// `GJKD_CODE_TOO_MANY_VERTICES`, `GJKD_CODE_NAME_TAKEN`,
-/// `GJKD_CODE_TOO_MANY_OBJECTS`, `GJKD_CODE_INTERNAL` (nothing stored);
+/// `GJKD_CODE_TOO_MANY_OBJECTS`, `GJKD_CODE_STORAGE_FULL`,
+/// `GJKD_CODE_INTERNAL` (nothing stored);
 /// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (the registration may then
 /// have happened: register what must not be orphaned with a name and look
 /// it up).

@@ -164,7 +164,7 @@ pub fn last_code() -> u32 {
 
 /// The `GJKD_CODE_*` name of error code `raw`.
 pub fn code_name(raw: u32) -> &'static str {
-    const NAMES: [&str; 20] = [
+    const NAMES: [&str; 23] = [
         "GJKD_CODE_OK",
         "GJKD_CODE_UNKNOWN_OBJECT",
         "GJKD_CODE_NON_FINITE_POSE",
@@ -185,6 +185,9 @@ pub fn code_name(raw: u32) -> &'static str {
         "GJKD_CODE_NAME_TAKEN",
         "GJKD_CODE_TOO_MANY_OBJECTS",
         "GJKD_CODE_INTERNAL",
+        "GJKD_CODE_STORAGE_FULL",
+        "GJKD_CODE_OUT_OF_LIMITS",
+        "GJKD_CODE_INVALID_ROBOT",
     ];
     NAMES
         .get(raw as usize)

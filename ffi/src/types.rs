@@ -253,6 +253,14 @@ pub enum gjkd_error_code {
     GJKD_CODE_TOO_MANY_OBJECTS = 18,
     /// The server failed in a way that is its own fault; it keeps serving.
     GJKD_CODE_INTERNAL = 19,
+    /// The server's disk has no room to store a registration or removal:
+    /// the change was not made; the same call succeeds once there is room.
+    GJKD_CODE_STORAGE_FULL = 20,
+    /// A joint position is outside its joint's limits.
+    GJKD_CODE_OUT_OF_LIMITS = 21,
+    /// A robot's URDF is malformed, or its links do not form one tree of
+    /// supported joints.
+    GJKD_CODE_INVALID_ROBOT = 22,
 }
 
 /// The answer to one pair query. Distances are after radii; points are in

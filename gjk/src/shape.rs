@@ -349,15 +349,19 @@ impl Convex {
         self.vertices.is_empty()
     }
 
-    /// Index of the vertex that maximises `(v - centroid)·d`: the support point
-    /// (3.7). A linear scan, as the paper prescribes, over a layout made for
-    /// vector lanes, or for large sets the block search, which finds the
-    /// scan's own vertex. Exact ties go to the lowest index; a near-tie within the
-    /// last bit may go either way between the AVX2 and portable paths (each
-    /// is a valid support point), but always the same way on one machine.
+    /// The support point (3.7) for `d`, relative to the centroid, with its
+    /// index: the vertex that maximises `(v - centroid)·d`, or for a
+    /// cylinder its closed form and code. For vertex sets a linear scan, as
+    /// the paper prescribes, over a layout made for vector lanes, or for
+    /// large sets the block search, which finds the scan's own vertex. Exact
+    /// ties go to the lowest index; a near-tie within the last bit may go
+    /// either way between the AVX2 and portable paths (each is a valid
+    /// support point), but always the same way on one machine. Index and
+    /// point come from one match, so that polytopes pay no test for the
+    /// cylinder's points.
     #[inline(always)]
-    pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
-        match self.kind {
+    pub(crate) fn support_point(&self, d: &Vector3<f64>) -> (usize, Vector3<f64>) {
+        let i = match self.kind {
             // A sphere's core: nothing to scan.
             SupportKind::Point => 0,
             // A box's support is its direction's sign pattern. A zero
@@ -374,17 +378,6 @@ impl Convex {
             SupportKind::Scan => self.scan_portable(d),
             SupportKind::Cones { fused } => self.cones_index(d, fused),
             SupportKind::Blocks => self.search_index(d),
-            SupportKind::Cylinder { .. } => cylinder::support_code(d) as usize,
-        }
-    }
-
-    /// The support point for `d` relative to the centroid, with its index
-    /// (a cylinder's code): [`support_index`](Self::support_index) and
-    /// [`point`](Self::point) in one match, so that polytopes pay no test
-    /// for the cylinder's points.
-    #[inline(always)]
-    pub(crate) fn support_point(&self, d: &Vector3<f64>) -> (usize, Vector3<f64>) {
-        let i = match self.kind {
             SupportKind::Cylinder {
                 radius,
                 half_height,
@@ -392,14 +385,22 @@ impl Convex {
                 let code = cylinder::support_code(d);
                 return (code as usize, cylinder::point(code, radius, half_height));
             }
-            _ => self.support_index(d),
         };
         (i, self.local(i))
     }
 
+    /// The index of [`support_point`](Self::support_point), for the tests.
+    #[cfg(test)]
+    pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
+        self.support_point(d).0
+    }
+
     /// [`support_point`](Self::support_point) for
-    /// [`Precision::Single`](crate::Precision::Single), by
-    /// [`support_index_single`](Self::support_index_single).
+    /// [`Precision::Single`](crate::Precision::Single): an f32 scan, twice the
+    /// lanes per instruction, on shapes that have the f32 copy (see
+    /// [`has_single`](Self::has_single)); the exact support elsewhere,
+    /// cylinders included. The vertex found is within `SINGLE_SLACK · size ·
+    /// |d|` of the support value, not always the exact maximiser.
     #[inline(always)]
     pub(crate) fn support_point_single(&self, d: &Vector3<f64>) -> (usize, Vector3<f64>) {
         if self.has_single() {
@@ -412,13 +413,20 @@ impl Convex {
 
     /// Point `i` relative to the centroid: vertex `i`, or for a cylinder the
     /// rim or cap point of code `i`.
+    /// A polytope's index is below its scan arrays' length, the test that
+    /// [`local`](Self::local)'s bounds check makes anyway; a cylinder has
+    /// none, so its codes all go past it.
     #[inline(always)]
     pub(crate) fn point(&self, i: usize) -> Vector3<f64> {
+        if i < self.xs.len() {
+            return self.local(i);
+        }
         match self.kind {
             SupportKind::Cylinder {
                 radius,
                 half_height,
             } => cylinder::point(i as u32, radius, half_height),
+            // Out of range: `local`'s bounds check reports it.
             _ => self.local(i),
         }
     }
@@ -444,7 +452,7 @@ impl Convex {
         }
     }
 
-    /// [`support_index`](Self::support_index) for [`SupportKind::Cones`]: the
+    /// [`support_point`](Self::support_point) for [`SupportKind::Cones`]: the
     /// direction's candidates with the scan's arithmetic, or for a direction
     /// the map declines, the scan itself.
     #[inline(always)]
@@ -472,7 +480,7 @@ impl Convex {
         scan_top(&self.xs, &self.ys, &self.zs, d).1
     }
 
-    /// [`support_index`](Self::support_index) by the block search when the
+    /// [`support_point`](Self::support_point) by the block search when the
     /// shape has one, else (or for a direction it declines) the scan.
     #[inline(never)]
     fn search_index(&self, d: &Vector3<f64>) -> usize {
@@ -484,19 +492,15 @@ impl Convex {
         self.scan_index(d)
     }
 
-    /// Whether [`support_index_single`](Self::support_index_single) scans in
+    /// Whether [`support_point_single`](Self::support_point_single) scans in
     /// f32 (and so may miss the support value by `SINGLE_SLACK · size · |d|`).
     #[inline(always)]
     pub(crate) fn has_single(&self) -> bool {
         self.single.is_some()
     }
 
-    /// [`support_index`](Self::support_index) for
-    /// [`Precision::Single`](crate::Precision::Single): an f32 scan, twice the
-    /// lanes per instruction, on shapes that have the f32 copy; the exact
-    /// support elsewhere. The vertex found is within `SINGLE_SLACK · size ·
-    /// |d|` of the support value, not always the exact maximiser.
-    /// The query takes [`support_point_single`](Self::support_point_single).
+    /// The index of [`support_point_single`](Self::support_point_single),
+    /// for the tests.
     #[cfg(test)]
     pub(crate) fn support_index_single(&self, d: &Vector3<f64>) -> usize {
         if self.has_single() {
@@ -535,7 +539,7 @@ impl Convex {
         scan_single(&s.xs, &s.ys, &s.zs, d32)
     }
 
-    /// [`support_index`](Self::support_index) by the scan, inlined into its
+    /// [`support_point`](Self::support_point) by the scan, inlined into its
     /// out-of-line callers: the closed forms are inlined into the query, the
     /// scan is not.
     #[inline(always)]

@@ -31,6 +31,7 @@
 
 mod blocks;
 mod cones;
+mod cylinder;
 mod dd;
 mod johnson;
 mod query;

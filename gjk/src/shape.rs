@@ -10,6 +10,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use crate::Error;
 use crate::blocks::Blocks;
 use crate::cones::{self, Cones};
+use crate::cylinder;
 
 /// A convex object: the convex hull of a vertex set, grown by a radius `r >= 0`
 /// (the paper's r-spherical extension, Section 2).
@@ -150,6 +151,10 @@ enum SupportKind {
     /// Larger sets: the block search, exact and the scan's own choice, which
     /// skips blocks of vertices that cannot hold the support point.
     Blocks,
+    /// A cylinder about the body z axis ([`Convex::cylinder`]): no vertices,
+    /// the closed form of [`crate::cylinder`], whose support "indices" are
+    /// codes of rim points.
+    Cylinder { radius: f64, half_height: f64 },
 }
 
 impl Convex {
@@ -245,8 +250,66 @@ impl Convex {
         Self::new(vertices, radius)
     }
 
+    /// A cylinder about the body z axis, centred at the body origin: the disk
+    /// of radius `radius` swept from `z = -half_height` to `z = +half_height`,
+    /// its edges rounded by `rounding` (0 for sharp rims). Its support
+    /// function is the disk's closed form, exact to f64 precision, not a
+    /// polytope's; warm-start indices of a cylinder are codes of its support
+    /// points (any `u32` names a point of it), not vertex positions.
+    ///
+    /// ```
+    /// use gjk::{distance, Convex, Options, Shape};
+    /// use nalgebra::Isometry3;
+    ///
+    /// let can: Shape = Convex::cylinder(0.5, 1.0, 0.0)?.into();
+    /// let ball: Shape = Convex::sphere(0.25)?.into();
+    /// let beside = Isometry3::translation(2.0, 0.0, 0.3);
+    /// let answer = distance(&can, &Isometry3::identity(), &ball, &beside, &Options::default(), None)?;
+    /// assert!((answer.distance - 1.25).abs() < 1e-12);
+    /// # Ok::<(), gjk::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteVertex`] for a negative, NaN or infinite radius or
+    /// half-height, or a cylinder reaching more than 2^999 (about 5e300)
+    /// from its body origin; [`Error::InvalidRadius`] for a negative or
+    /// non-finite rounding radius.
+    pub fn cylinder(radius: f64, half_height: f64, rounding: f64) -> Result<Self, Error> {
+        if ![radius, half_height]
+            .iter()
+            .all(|x| x.is_finite() && *x >= 0.0)
+        {
+            return Err(Error::NonFiniteVertex(0));
+        }
+        if !(rounding.is_finite() && rounding >= 0.0) {
+            return Err(Error::InvalidRadius(rounding));
+        }
+        let size = radius.hypot(half_height);
+        if size > MAX_REACH {
+            return Err(Error::NonFiniteVertex(0));
+        }
+        Ok(Self {
+            vertices: Vec::new(),
+            radius: rounding,
+            centroid: Point3::origin(),
+            centroid_norm: 0.0,
+            size,
+            xs: Vec::new(),
+            ys: Vec::new(),
+            zs: Vec::new(),
+            kind: SupportKind::Cylinder {
+                radius,
+                half_height,
+            },
+            single: None,
+            blocks: None,
+            cones: None,
+        })
+    }
+
     /// The vertices as given, in the body frame. Warm-start indices refer to
-    /// positions in this slice.
+    /// positions in this slice. Empty for a cylinder, whose warm-start
+    /// indices are codes of its support points (see [`Convex::cylinder`]).
     pub fn vertices(&self) -> &[Point3<f64>] {
         &self.vertices
     }
@@ -279,26 +342,30 @@ impl Convex {
         self.size
     }
 
-    /// Number of vertices.
+    /// Number of vertices: 0 for a cylinder.
     pub fn len(&self) -> usize {
         self.vertices.len()
     }
 
-    /// Always false: a convex shape has at least one vertex. Present because
-    /// `len` is.
+    /// Whether the shape has no vertices: false but for a cylinder, whose
+    /// support function is a closed form.
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty()
     }
 
-    /// Index of the vertex that maximises `(v - centroid)·d`: the support point
-    /// (3.7). A linear scan, as the paper prescribes, over a layout made for
-    /// vector lanes, or for large sets the block search, which finds the
-    /// scan's own vertex. Exact ties go to the lowest index; a near-tie within the
-    /// last bit may go either way between the AVX2 and portable paths (each
-    /// is a valid support point), but always the same way on one machine.
+    /// The support point (3.7) for `d`, relative to the centroid, with its
+    /// index: the vertex that maximises `(v - centroid)·d`, or for a
+    /// cylinder its closed form and code. For vertex sets a linear scan, as
+    /// the paper prescribes, over a layout made for vector lanes, or for
+    /// large sets the block search, which finds the scan's own vertex. Exact
+    /// ties go to the lowest index; a near-tie within the last bit may go
+    /// either way between the AVX2 and portable paths (each is a valid
+    /// support point), but always the same way on one machine. Index and
+    /// point come from one match, so that polytopes pay no test for the
+    /// cylinder's points.
     #[inline(always)]
-    pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
-        match self.kind {
+    pub(crate) fn support_point(&self, d: &Vector3<f64>) -> (usize, Vector3<f64>) {
+        let i = match self.kind {
             // A sphere's core: nothing to scan.
             SupportKind::Point => 0,
             // A box's support is its direction's sign pattern. A zero
@@ -315,10 +382,81 @@ impl Convex {
             SupportKind::Scan => self.scan_portable(d),
             SupportKind::Cones { fused } => self.cones_index(d, fused),
             SupportKind::Blocks => self.search_index(d),
+            SupportKind::Cylinder {
+                radius,
+                half_height,
+            } => {
+                let code = cylinder::support_code(d);
+                return (code as usize, cylinder::point(code, radius, half_height));
+            }
+        };
+        (i, self.local(i))
+    }
+
+    /// The index of [`support_point`](Self::support_point), for the tests.
+    #[cfg(test)]
+    pub(crate) fn support_index(&self, d: &Vector3<f64>) -> usize {
+        self.support_point(d).0
+    }
+
+    /// [`support_point`](Self::support_point) for
+    /// [`Precision::Single`](crate::Precision::Single): an f32 scan, twice the
+    /// lanes per instruction, on shapes that have the f32 copy (see
+    /// [`has_single`](Self::has_single)); the exact support elsewhere,
+    /// cylinders included. The vertex found is within `SINGLE_SLACK · size ·
+    /// |d|` of the support value, not always the exact maximiser.
+    #[inline(always)]
+    pub(crate) fn support_point_single(&self, d: &Vector3<f64>) -> (usize, Vector3<f64>) {
+        if self.has_single() {
+            let i = self.scan_single(d);
+            (i, self.local(i))
+        } else {
+            self.support_point(d)
         }
     }
 
-    /// [`support_index`](Self::support_index) for [`SupportKind::Cones`]: the
+    /// Point `i` relative to the centroid: vertex `i`, or for a cylinder the
+    /// rim or cap point of code `i`.
+    /// A polytope's index is below its scan arrays' length, the test that
+    /// [`local`](Self::local)'s bounds check makes anyway; a cylinder has
+    /// none, so its codes all go past it.
+    #[inline(always)]
+    pub(crate) fn point(&self, i: usize) -> Vector3<f64> {
+        if i < self.xs.len() {
+            return self.local(i);
+        }
+        match self.kind {
+            SupportKind::Cylinder {
+                radius,
+                half_height,
+            } => cylinder::point(i as u32, radius, half_height),
+            // Out of range: `local`'s bounds check reports it.
+            _ => self.local(i),
+        }
+    }
+
+    /// How many indices a warm start may name: the vertex count, or for a
+    /// cylinder every `u32` (each code is a point of it).
+    #[inline]
+    pub(crate) fn index_count(&self) -> usize {
+        match self.kind {
+            SupportKind::Cylinder { .. } => usize::MAX,
+            _ => self.len(),
+        }
+    }
+
+    /// `(radius, half_height)` of a cylinder's core, `None` for a polytope.
+    pub fn cylinder_dimensions(&self) -> Option<(f64, f64)> {
+        match self.kind {
+            SupportKind::Cylinder {
+                radius,
+                half_height,
+            } => Some((radius, half_height)),
+            _ => None,
+        }
+    }
+
+    /// [`support_point`](Self::support_point) for [`SupportKind::Cones`]: the
     /// direction's candidates with the scan's arithmetic, or for a direction
     /// the map declines, the scan itself.
     #[inline(always)]
@@ -346,7 +484,7 @@ impl Convex {
         scan_top(&self.xs, &self.ys, &self.zs, d).1
     }
 
-    /// [`support_index`](Self::support_index) by the block search when the
+    /// [`support_point`](Self::support_point) by the block search when the
     /// shape has one, else (or for a direction it declines) the scan.
     #[inline(never)]
     fn search_index(&self, d: &Vector3<f64>) -> usize {
@@ -358,19 +496,16 @@ impl Convex {
         self.scan_index(d)
     }
 
-    /// Whether [`support_index_single`](Self::support_index_single) scans in
+    /// Whether [`support_point_single`](Self::support_point_single) scans in
     /// f32 (and so may miss the support value by `SINGLE_SLACK · size · |d|`).
     #[inline(always)]
     pub(crate) fn has_single(&self) -> bool {
         self.single.is_some()
     }
 
-    /// [`support_index`](Self::support_index) for
-    /// [`Precision::Single`](crate::Precision::Single): an f32 scan, twice the
-    /// lanes per instruction, on shapes that have the f32 copy; the exact
-    /// support elsewhere. The vertex found is within `SINGLE_SLACK · size ·
-    /// |d|` of the support value, not always the exact maximiser.
-    #[inline(always)]
+    /// The index of [`support_point_single`](Self::support_point_single),
+    /// for the tests.
+    #[cfg(test)]
     pub(crate) fn support_index_single(&self, d: &Vector3<f64>) -> usize {
         if self.has_single() {
             self.scan_single(d)
@@ -408,7 +543,7 @@ impl Convex {
         scan_single(&s.xs, &s.ys, &s.zs, d32)
     }
 
-    /// [`support_index`](Self::support_index) by the scan, inlined into its
+    /// [`support_point`](Self::support_point) by the scan, inlined into its
     /// out-of-line callers: the closed forms are inlined into the query, the
     /// scan is not.
     #[inline(always)]

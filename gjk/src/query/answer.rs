@@ -138,7 +138,7 @@ impl ConvexPair<'_> {
         let mut len = 0;
         for (slot, (vertex, weight)) in simplex.vertices.iter().zip(lambda).enumerate() {
             if run.solution.mask & (1 << slot) != 0 {
-                nearest_a += self.a.local(vertex.ia as usize) * weight;
+                nearest_a += self.a.point(vertex.ia as usize) * weight;
                 pairs[len & 3] = [vertex.ia, vertex.ib];
                 len += 1;
             }

@@ -28,15 +28,13 @@ pub(super) fn axis_gap(
 ) -> f64 {
     let axis_in_a = offset_a.rotation.inverse_transform_vector(axis);
     let axis_in_b = placed_b.rotation.inverse_transform_vector(axis);
-    let (top_index, bottom_index) = (
-        convex_a.support_index(&axis_in_a),
-        convex_b.support_index(&-axis_in_b),
+    let ((_, top_point), (_, bottom_point)) = (
+        convex_a.support_point(&axis_in_a),
+        convex_b.support_point(&-axis_in_b),
     );
-    let top_a = (axis_in_a.dot(&convex_a.centroid().coords)
-        + axis_in_a.dot(&convex_a.local(top_index)))
+    let top_a = (axis_in_a.dot(&convex_a.centroid().coords) + axis_in_a.dot(&top_point))
         + axis.dot(&offset_a.translation.vector);
-    let bottom_b = (axis_in_b.dot(&convex_b.centroid().coords)
-        + axis_in_b.dot(&convex_b.local(bottom_index)))
+    let bottom_b = (axis_in_b.dot(&convex_b.centroid().coords) + axis_in_b.dot(&bottom_point))
         + axis.dot(&placed_b.translation.vector);
     let gap = (bottom_b - top_a) - (convex_a.radius() + convex_b.radius());
     // Each product and sum above errs by a few ε of the magnitudes involved,

@@ -174,12 +174,24 @@ impl<'s> ConvexPair<'s> {
         }
     }
 
-    /// `y = z1 - z2` for vertex `ia` of A and `ib` of B. The centroid-midpoint
+    /// `y = z1 - z2` for point `ia` of A and `ib` of B (vertex indices, or
+    /// a cylinder's codes). The centroid-midpoint
     /// origin of (6.1) cancels in the difference; what matters is that both
     /// terms are small vectors relative to their centroids.
     #[inline(always)]
     pub(super) fn difference_vertex(&self, ia: usize, ib: usize) -> Vertex {
-        let (za, zb) = (self.a.local(ia), rotate(&self.rotation, &self.b.local(ib)));
+        self.difference_of((ia, self.a.point(ia)), (ib, self.b.point(ib)))
+    }
+
+    /// `y = z1 - z2` for A's point `za` (index `ia`) and B's point `zb`
+    /// (index `ib`), both relative to their centroids in their own frames.
+    #[inline(always)]
+    fn difference_of(
+        &self,
+        (ia, za): (usize, Vector3<f64>),
+        (ib, zb): (usize, Vector3<f64>),
+    ) -> Vertex {
+        let zb = rotate(&self.rotation, &zb);
         // k is 1 but for shapes beyond 2^±64 in size: skip the products
         // then. Each point is scaled after the rotation, not through a
         // scaled matrix, whose entries could be subnormal.
@@ -195,18 +207,18 @@ impl<'s> ConvexPair<'s> {
         }
     }
 
-    /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one scan of each vertex set.
+    /// `s_K(η) = s_A(η) - s_B(-η)` (3.8): one support search on each shape.
     #[inline(always)]
     pub(super) fn support(&self, eta: &Vector3<f64>) -> Vertex {
         let eta_b = -rotate_back(&self.rotation, eta);
-        let (ia, ib) = if self.single_precision {
+        let (a, b) = if self.single_precision {
             (
-                self.a.support_index_single(eta),
-                self.b.support_index_single(&eta_b),
+                self.a.support_point_single(eta),
+                self.b.support_point_single(&eta_b),
             )
         } else {
-            (self.a.support_index(eta), self.b.support_index(&eta_b))
+            (self.a.support_point(eta), self.b.support_point(&eta_b))
         };
-        self.difference_vertex(ia, ib)
+        self.difference_of(a, b)
     }
 }

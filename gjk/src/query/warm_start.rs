@@ -3,7 +3,9 @@
 use crate::johnson::Simplex;
 use crate::shape::Shape;
 
-/// One piece pair's final simplex: its pieces and vertex index pairs.
+/// One piece pair's final simplex: its pieces and vertex index pairs (a
+/// cylinder's entries are codes of its support points, see
+/// [`Convex::cylinder`](crate::Convex::cylinder)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub(super) struct PieceSimplex {
     pub(super) pieces: [u32; 2],
@@ -31,7 +33,7 @@ impl PieceSimplex {
         ) else {
             return false;
         };
-        let (len_a, len_b) = (convex_a.len(), convex_b.len());
+        let (len_a, len_b) = (convex_a.index_count(), convex_b.index_count());
         let mut ok = self.len <= 4;
         for &[i, j] in self.pairs() {
             ok &= (i as usize) < len_a;
@@ -75,7 +77,9 @@ pub struct WarmStart {
 impl WarmStart {
     /// A warm start from explicit `[vertex of A, vertex of B]` index pairs (at
     /// most 4; more return `None`) in the given pieces (`[0, 0]` for two convex
-    /// shapes). Indices are checked against the shapes at query time.
+    /// shapes). Indices are checked against the shapes at query time. For a
+    /// cylinder, an entry is a code of one of its points (any `u32` is one),
+    /// best taken from an earlier answer's [`pairs`](Self::pairs).
     pub fn new(pieces: [u32; 2], pairs: &[[u32; 2]]) -> Option<Self> {
         if pairs.len() > 4 {
             return None;
@@ -92,7 +96,8 @@ impl WarmStart {
         })
     }
 
-    /// The `[vertex of A, vertex of B]` index pairs of the simplex.
+    /// The `[vertex of A, vertex of B]` index pairs of the simplex (for a
+    /// cylinder, the codes of its support points).
     pub fn pairs(&self) -> &[[u32; 2]] {
         self.first.pairs()
     }

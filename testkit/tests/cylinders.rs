@@ -1,0 +1,520 @@
+//! Cylinders against independent answers: closed forms (parallel axes side
+//! by side, coaxial caps, a cap on a box face, a sphere against side, cap
+//! and rim, crossing axes) at sizes from 1e-9 to 1e6 and far from the
+//! origin; fine prisms that bracket the truth from inside and outside; warm
+//! starts along a motion; every path (compounds, margins, f32, warm start).
+
+use gjk::{Compound, Convex, Options, Precision, Shape, Status, WarmStart, distance};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+/// The judged error bound: relative 1e-6, absolute 1e-9 × size near zero.
+fn within(got: f64, exact: f64, size: f64) -> bool {
+    (got - exact).abs() <= 1e-6 * exact.abs() + 1e-9 * size
+}
+
+/// What a query should answer: the exact distance, the shapes' size (for
+/// the absolute part of the error bound) and the magnitude of the
+/// coordinates the closed form was computed from (for its own round-off).
+struct Expect {
+    exact: f64,
+    size: f64,
+    mag: f64,
+}
+
+/// The query's answer, checked against `e.exact`: within the error bound,
+/// the bounds bracketing it (to the round-off of `exact` itself, a few ε of
+/// `e.mag`).
+fn check(
+    a: &Shape,
+    pa: &Isometry3<f64>,
+    b: &Shape,
+    pb: &Isometry3<f64>,
+    e: Expect,
+    what: &str,
+) -> gjk::Answer {
+    let Expect { exact, size, mag } = e;
+    let ans = distance(a, pa, b, pb, &Options::default(), None).unwrap();
+    assert_eq!(ans.status, Status::Converged, "{what}");
+    assert!(
+        within(ans.distance, exact, size),
+        "{what}: {} vs {exact}",
+        ans.distance
+    );
+    let fuzz = 8.0 * f64::EPSILON * mag;
+    assert!(
+        ans.lower <= exact + fuzz && exact <= ans.upper + fuzz,
+        "{what}: [{}, {}] vs {exact}",
+        ans.lower,
+        ans.upper
+    );
+    // The nearest points are that far apart (0 when they touch or overlap).
+    if exact > 0.0 {
+        let gap = (ans.point_b - ans.point_a).norm();
+        // Far from the origin the points' coordinates round by ε of it.
+        assert!(
+            within(gap, exact, size) || (gap - exact).abs() <= fuzz,
+            "{what}: points {gap} apart vs {exact}"
+        );
+    }
+    ans
+}
+
+fn cyl(r: f64, h: f64, rounding: f64) -> Shape {
+    Convex::cylinder(r, h, rounding).unwrap().into()
+}
+
+fn at(x: f64, y: f64, z: f64) -> Isometry3<f64> {
+    Isometry3::translation(x, y, z)
+}
+
+/// Scales and base offsets the closed forms are checked at.
+const SCALES: [f64; 5] = [1e-9, 1e-3, 1.0, 1e3, 1e6];
+const BASES: [f64; 3] = [0.0, 1e3, 1e9];
+
+/// Two poses `base` and `base + off`, and the offset as the poses hold it
+/// (the sum rounds far from the origin; the closed form must use what the
+/// query sees).
+fn pair_at(base: f64, off: Vector3<f64>) -> (Isometry3<f64>, Isometry3<f64>, Vector3<f64>) {
+    let pa = at(base, -base, base);
+    let pb = at(base + off.x, -base + off.y, base + off.z);
+    let held = pb.translation.vector - pa.translation.vector;
+    (pa, pb, held)
+}
+
+#[test]
+fn parallel_axes_side_by_side() {
+    for s in SCALES {
+        for base in BASES {
+            if base * 1e-12 > s {
+                continue; // The offset would round to nothing.
+            }
+            let (r1, h1, r2, h2, rho1, rho2) = (0.5 * s, 1.0 * s, 0.3 * s, 2.0 * s, 0.05 * s, 0.0);
+            let a = cyl(r1, h1, rho1);
+            let b = cyl(r2, h2, rho2);
+            for (gap, dz) in [
+                (0.2, 0.5),
+                (1e-3, -1.5),
+                (0.0, 0.0),
+                (-0.1, 0.3),
+                (3.0, 2.9),
+            ] {
+                let centre = r1 + r2 + rho1 + rho2 + gap * s;
+                let dir = Vector3::new(0.6, -0.8, 0.0);
+                let (pa, pb, held) = pair_at(base, dir * centre + Vector3::new(0.0, 0.0, dz * s));
+                let exact = (held.xy().norm() - r1 - r2 - rho1 - rho2).max(0.0);
+                check(
+                    &a,
+                    &pa,
+                    &b,
+                    &pb,
+                    Expect {
+                        exact,
+                        size: s,
+                        mag: s + base,
+                    },
+                    &format!("side s {s} base {base} gap {gap}"),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn coaxial_end_caps() {
+    for s in SCALES {
+        for base in BASES {
+            if base * 1e-12 > s {
+                continue;
+            }
+            let a = cyl(1.0 * s, 0.5 * s, 0.0);
+            let b = cyl(0.2 * s, 0.7 * s, 0.01 * s);
+            for (gap, lateral) in [(0.3, 0.0), (1e-4, 0.9), (0.0, 0.5), (2.0, 1.1)] {
+                let off = Vector3::new(lateral * s, 0.0, (0.5 + 0.7 + 0.01 + gap) * s);
+                let (pa, pb, held) = pair_at(base, off);
+                let exact = (held.z - 0.5 * s - 0.7 * s - 0.01 * s).max(0.0);
+                check(
+                    &a,
+                    &pa,
+                    &b,
+                    &pb,
+                    Expect {
+                        exact,
+                        size: s,
+                        mag: s + base,
+                    },
+                    &format!("caps s {s} base {base} gap {gap}"),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn end_cap_and_side_against_a_box_face() {
+    for s in SCALES {
+        for base in BASES {
+            if base * 1e-12 > s {
+                continue;
+            }
+            let boxed: Shape = Convex::cuboid(Vector3::new(2.0, 3.0, 0.5) * s, 0.0)
+                .unwrap()
+                .into();
+            let can = cyl(0.4 * s, 0.6 * s, 0.0);
+            for gap in [0.25, 1e-5, 0.0] {
+                // Upright, its bottom cap over the box's top face.
+                let (pa, pb, held) = pair_at(base, Vector3::new(0.7, -1.1, 0.5 + 0.6 + gap) * s);
+                let exact = held.z - 1.1 * s;
+                check(
+                    &boxed,
+                    &pa,
+                    &can,
+                    &pb,
+                    Expect {
+                        exact: exact.max(0.0),
+                        size: s,
+                        mag: s + base,
+                    },
+                    &format!("cap/face s {s} base {base} gap {gap}"),
+                );
+                // Lying on its side (axis along x): its side over the face.
+                let (pa, pb, held) = pair_at(base, Vector3::new(0.2, 0.3, 0.5 + 0.4 + gap) * s);
+                let lying =
+                    pb * UnitQuaternion::from_euler_angles(0.0, std::f64::consts::FRAC_PI_2, 0.0);
+                let exact = held.z - 0.9 * s;
+                check(
+                    &boxed,
+                    &pa,
+                    &can,
+                    &lying,
+                    Expect {
+                        exact: exact.max(0.0),
+                        size: s,
+                        mag: s + base,
+                    },
+                    &format!("side/face s {s} base {base} gap {gap}"),
+                );
+            }
+        }
+    }
+}
+
+/// A distance in closed form, of a sphere centre's offset.
+type ClosedForm = fn(Vector3<f64>) -> f64;
+
+#[test]
+fn sphere_against_side_cap_and_rim() {
+    let (r, h, ball) = (0.8, 1.2, 0.3);
+    for s in SCALES {
+        for base in BASES {
+            if base * 1e-12 > s {
+                continue;
+            }
+            let can = cyl(r * s, h * s, 0.0);
+            let sphere: Shape = Convex::sphere(ball * s).unwrap().into();
+            let cases: [(Vector3<f64>, ClosedForm); 3] = [
+                // Beside the side, within the height.
+                (Vector3::new(1.5, 0.4, 0.9), |c| c.xy().norm() - 0.8 - 0.3),
+                // Over the cap, within the disk.
+                (Vector3::new(0.3, -0.2, 1.9), |c| c.z - 1.2 - 0.3),
+                // Off the rim: beyond the side and above the cap.
+                (Vector3::new(-1.1, 0.6, -1.7), |c| {
+                    (c.xy().norm() - 0.8).hypot(c.z.abs() - 1.2) - 0.3
+                }),
+            ];
+            for (centre, form) in cases {
+                let (pa, pb, held) = pair_at(base, centre * s);
+                let exact = form(held / s) * s;
+                check(
+                    &can,
+                    &pa,
+                    &sphere,
+                    &pb,
+                    Expect {
+                        exact,
+                        size: s,
+                        mag: s + base,
+                    },
+                    &format!("sphere s {s} base {base} at {centre:?}"),
+                );
+            }
+        }
+    }
+}
+
+/// Two long cylinders whose axes cross at any angle, `D` apart along their
+/// common perpendicular: the nearest points lie on it, `D - r1 - r2` apart.
+#[test]
+fn crossing_axes() {
+    let mut seed = 0x5eed_c0ffee_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for s in SCALES {
+        for k in 0..40 {
+            let angle = 0.2 + 2.7 * next();
+            let (r1, r2) = (0.3 + next(), 0.1 + next());
+            let gap = if k % 4 == 0 { 0.0 } else { next() * 2.0 };
+            let d = (r1 + r2 + gap) * s;
+            let a = cyl(r1 * s, 5.0 * s, 0.0);
+            let b = cyl(r2 * s, 5.0 * s, 0.0);
+            // A along z; B's axis turned about y (the common perpendicular)
+            // by `angle`, then moved D along y, and both turned at random.
+            let turn = UnitQuaternion::from_euler_angles(next() * 6.0, next() * 6.0, next() * 6.0);
+            let pa = Isometry3::from_parts(Translation3::identity(), turn);
+            let pb = Isometry3::from_parts(
+                Translation3::from(turn * Vector3::new(0.0, d, 0.0)),
+                turn * UnitQuaternion::from_euler_angles(0.0, angle, 0.0),
+            );
+            check(
+                &a,
+                &pa,
+                &b,
+                &pb,
+                Expect {
+                    exact: gap * s,
+                    size: s,
+                    mag: s,
+                },
+                &format!("crossing s {s} angle {angle}"),
+            );
+        }
+    }
+}
+
+/// An `n`-sided prism with its vertices at radius `rim`.
+fn prism(rim: f64, h: f64, n: usize) -> Convex {
+    let mut pts = Vec::with_capacity(2 * n);
+    for k in 0..n {
+        let t = std::f64::consts::TAU * k as f64 / n as f64;
+        for z in [-h, h] {
+            pts.push(Point3::new(rim * t.cos(), rim * t.sin(), z));
+        }
+    }
+    Convex::new(pts, 0.0).unwrap()
+}
+
+/// The inscribed and circumscribed prisms bracket the cylinder: its
+/// distance to anything lies between theirs, so between the outer prism's
+/// lower bound and the inner prism's upper bound; at random poses, against
+/// boxes, cylinders and point clouds, its answer and its bounds agree.
+#[test]
+fn fine_prisms_bracket_random_poses() {
+    let n = 4096;
+    let widen = 1.0 / (std::f64::consts::PI / n as f64).cos();
+    let mut seed = 0x5eed_b7ac_4e70_0001_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let (r, h) = (0.7, 1.1);
+    let can = cyl(r, h, 0.0);
+    let inner: Shape = prism(r, h, n).into();
+    let outer: Shape = prism(r * widen, h, n).into();
+    let others: Vec<Shape> = vec![
+        Convex::cuboid(Vector3::new(0.5, 0.2, 0.9), 0.0)
+            .unwrap()
+            .into(),
+        cyl(0.4, 0.3, 0.1),
+        Convex::new(
+            (0..30)
+                .map(|_| Point3::new(next(), next(), next()))
+                .collect::<Vec<_>>(),
+            0.0,
+        )
+        .unwrap()
+        .into(),
+    ];
+    for k in 0..600 {
+        let other = &others[k % others.len()];
+        let reach = if k % 5 == 0 { 1.6 } else { 4.0 };
+        let pb = Isometry3::from_parts(
+            Translation3::new(next() * reach, next() * reach, next() * reach),
+            UnitQuaternion::from_euler_angles(next() * 3.0, next() * 3.0, next() * 3.0),
+        );
+        let pa = Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_euler_angles(next() * 3.0, next() * 3.0, next() * 3.0),
+        );
+        let opts = Options::default();
+        let got = distance(&can, &pa, other, &pb, &opts, None).unwrap();
+        let lo = distance(&outer, &pa, other, &pb, &opts, None)
+            .unwrap()
+            .lower;
+        let hi = distance(&inner, &pa, other, &pb, &opts, None)
+            .unwrap()
+            .upper;
+        let fuzz = 1e-12;
+        assert!(
+            lo - fuzz <= got.distance && got.distance <= hi + fuzz,
+            "{k}: {} not in [{lo}, {hi}]",
+            got.distance
+        );
+        // The bounds hold the bracket's part of the truth: they cannot both
+        // miss it.
+        assert!(
+            got.lower <= hi + fuzz && got.upper >= lo - fuzz,
+            "{k}: [{}, {}] vs [{lo}, {hi}]",
+            got.lower,
+            got.upper
+        );
+        assert!(
+            got.upper - got.lower <= 1e-6 * got.distance + 1e-9,
+            "{k}: loose bounds"
+        );
+    }
+}
+
+/// Along a motion past a cylinder, the warm start gives the cold answers
+/// within the tolerance and takes fewer iterations; its codes round-trip
+/// through the public `WarmStart`.
+#[test]
+fn warm_start_along_a_motion_matches_cold() {
+    let can = cyl(0.5, 1.0, 0.02);
+    let other = cyl(0.3, 0.6, 0.0);
+    let (mut warm, mut cold_iterations, mut warm_iterations) = (None::<WarmStart>, 0, 0);
+    for k in 0..500 {
+        let t = k as f64 / 499.0;
+        let pose = Isometry3::from_parts(
+            Translation3::new(-3.0 + 6.0 * t, 0.2, 0.9 * (4.0 * t).sin()),
+            UnitQuaternion::from_scaled_axis(Vector3::new(0.3, 1.0, 0.5).normalize() * 6.0 * t),
+        );
+        let id = Isometry3::identity();
+        let opts = Options::default();
+        let cold = distance(&can, &id, &other, &pose, &opts, None).unwrap();
+        let hot = distance(&can, &id, &other, &pose, &opts, warm.as_ref()).unwrap();
+        assert!(
+            within(hot.distance, cold.distance, 1.0),
+            "{k}: {} vs {}",
+            hot.distance,
+            cold.distance
+        );
+        assert!(hot.lower <= cold.upper && cold.lower <= hot.upper, "{k}");
+        cold_iterations += cold.iterations;
+        warm_iterations += hot.iterations;
+        let pairs = hot.warm_start.pairs();
+        warm = WarmStart::new(hot.warm_start.pieces(), pairs);
+    }
+    assert!(
+        warm_iterations < cold_iterations,
+        "{warm_iterations} vs {cold_iterations}"
+    );
+}
+
+/// Compounds holding cylinders, margins, f32 and hand-made warm starts
+/// (any code is a point of the cylinder) all give the plain answer.
+#[test]
+fn every_path_takes_cylinders() {
+    let can = Convex::cylinder(0.5, 1.0, 0.0).unwrap();
+    let ball: Shape = Convex::sphere(0.25).unwrap().into();
+    let pb = at(2.0, 0.0, 0.3);
+    let exact = 1.25;
+    let id = Isometry3::identity();
+    let plain: Shape = can.clone().into();
+    // As a compound's piece, beside a far one, the compound moved.
+    let dumbbell: Shape = Compound::new(vec![
+        (at(1.0, 0.0, 0.0), can.clone()),
+        (
+            at(-9.0, 0.0, 0.0),
+            Convex::cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0).unwrap(),
+        ),
+    ])
+    .unwrap()
+    .into();
+    let ans = distance(
+        &dumbbell,
+        &at(-1.0, 0.0, 0.0),
+        &ball,
+        &pb,
+        &Options::default(),
+        None,
+    )
+    .unwrap();
+    assert!(
+        within(ans.distance, exact, 1.0) && ans.pieces == [0, 0],
+        "{ans:?}"
+    );
+    // Swapped order.
+    let ans = distance(
+        &ball,
+        &pb,
+        &dumbbell,
+        &at(-1.0, 0.0, 0.0),
+        &Options::default(),
+        None,
+    )
+    .unwrap();
+    assert!(within(ans.distance, exact, 1.0), "{ans:?}");
+    // A margin the pair is proved beyond, and one it is within.
+    for (margin, beyond) in [(1.0, true), (2.0, false)] {
+        let opts = Options {
+            margin: Some(margin),
+            ..Options::default()
+        };
+        let ans = distance(&plain, &id, &ball, &pb, &opts, None).unwrap();
+        assert!(ans.lower <= exact && exact <= ans.upper);
+        assert_eq!(ans.lower > margin, beyond, "{ans:?}");
+    }
+    // f32 falls back to the exact support.
+    let opts = Options {
+        precision: Precision::Single,
+        ..Options::default()
+    };
+    let ans = distance(&plain, &id, &ball, &pb, &opts, None).unwrap();
+    assert!(within(ans.distance, exact, 1.0), "{ans:?}");
+    // Any code is a valid warm start, the largest included.
+    for pairs in [[[u32::MAX, 0]], [[0, 0]], [[1 << 31, 0]], [[12345, 0]]] {
+        let w = WarmStart::new([0, 0], &pairs).unwrap();
+        let ans = distance(&plain, &id, &ball, &pb, &Options::default(), Some(&w)).unwrap();
+        assert!(within(ans.distance, exact, 1.0), "{pairs:?}: {ans:?}");
+    }
+    // A vertex index past the sphere's one vertex is still refused.
+    let w = WarmStart::new([0, 0], &[[0, 1]]).unwrap();
+    assert!(matches!(
+        distance(&plain, &id, &ball, &pb, &Options::default(), Some(&w)),
+        Err(gjk::Error::WarmStartOutOfRange)
+    ));
+}
+
+#[test]
+fn bad_dimensions_are_refused() {
+    for (r, h, rounding) in [
+        (-1.0, 1.0, 0.0),
+        (1.0, f64::NAN, 0.0),
+        (f64::INFINITY, 1.0, 0.0),
+        (1.0, 6e300, 0.0),
+        (4e300, 4e300, 0.0),
+    ] {
+        assert_eq!(
+            Convex::cylinder(r, h, rounding),
+            Err(gjk::Error::NonFiniteVertex(0))
+        );
+    }
+    for rounding in [-0.1, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            Convex::cylinder(1.0, 1.0, rounding),
+            Err(gjk::Error::InvalidRadius(_))
+        ));
+    }
+    let c = Convex::cylinder(2.0, 3.0, 0.5).unwrap();
+    assert_eq!(c.cylinder_dimensions(), Some((2.0, 3.0)));
+    assert_eq!(c.radius(), 0.5);
+    assert!(c.vertices().is_empty());
+    // Flat and needle cylinders are valid: a disk and a segment.
+    let disk = cyl(1.0, 0.0, 0.0);
+    let needle = cyl(0.0, 1.0, 0.0);
+    let ans = distance(
+        &disk,
+        &Isometry3::identity(),
+        &needle,
+        &at(0.0, 0.0, 1.5),
+        &Options::default(),
+        None,
+    )
+    .unwrap();
+    assert!(within(ans.distance, 0.5, 1.0), "{ans:?}");
+}

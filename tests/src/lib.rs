@@ -15,7 +15,7 @@ use iceoryx2::prelude::*;
 
 /// The `gjkd` binary of this build profile: `$GJKD_BIN` if set, else
 /// `target/<profile>/gjkd` next to the test executable's `deps/` folder,
-/// built with `cargo build -p gjkd --bin gjkd` once per test process (cargo
+/// built with `cargo build --workspace --bins` once per test process (cargo
 /// does not build another package's binary for a test).
 pub fn gjkd_binary() -> PathBuf {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
@@ -35,7 +35,10 @@ pub fn gjkd_binary() -> PathBuf {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut build = Command::new(cargo);
         build
-            .args(["build", "--quiet", "-p", "gjkd", "--bin", "gjkd"])
+            // The whole workspace's binaries, so that features resolve as in
+            // `cargo test --workspace` and its build is reused, not redone
+            // for one package's feature set.
+            .args(["build", "--quiet", "--workspace", "--bins"])
             .current_dir(env!("CARGO_MANIFEST_DIR"));
         if release {
             build.arg("--release");
@@ -45,7 +48,7 @@ pub fn gjkd_binary() -> PathBuf {
             build.env("CARGO_TARGET_DIR", target);
         }
         let status = build.status().expect("run cargo build for gjkd");
-        assert!(status.success(), "cargo build -p gjkd failed: {status}");
+        assert!(status.success(), "cargo build --workspace --bins failed: {status}");
         assert!(bin.exists(), "{} missing after the build", bin.display());
         bin
     })
@@ -313,7 +316,7 @@ pub fn load_binary() -> PathBuf {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut build = Command::new(cargo);
         build
-            .args(["build", "--quiet", "-p", "gjkd-e2e", "--bin", "gjkd-load"])
+            .args(["build", "--quiet", "--workspace", "--bins"])
             .current_dir(env!("CARGO_MANIFEST_DIR"));
         if bin
             .parent()
@@ -323,7 +326,7 @@ pub fn load_binary() -> PathBuf {
             build.arg("--release");
         }
         let status = build.status().expect("run cargo build for gjkd-load");
-        assert!(status.success(), "cargo build gjkd-load failed: {status}");
+        assert!(status.success(), "cargo build --workspace --bins failed: {status}");
     }
     bin
 }

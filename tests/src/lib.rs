@@ -48,7 +48,10 @@ pub fn gjkd_binary() -> PathBuf {
             build.env("CARGO_TARGET_DIR", target);
         }
         let status = build.status().expect("run cargo build for gjkd");
-        assert!(status.success(), "cargo build --workspace --bins failed: {status}");
+        assert!(
+            status.success(),
+            "cargo build --workspace --bins failed: {status}"
+        );
         assert!(bin.exists(), "{} missing after the build", bin.display());
         bin
     })
@@ -326,7 +329,10 @@ pub fn load_binary() -> PathBuf {
             build.arg("--release");
         }
         let status = build.status().expect("run cargo build for gjkd-load");
-        assert!(status.success(), "cargo build --workspace --bins failed: {status}");
+        assert!(
+            status.success(),
+            "cargo build --workspace --bins failed: {status}"
+        );
     }
     bin
 }

@@ -123,15 +123,7 @@ pub fn distance_in(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
-    let query = Query {
-        a,
-        pose_a,
-        b,
-        pose_b,
-        options,
-        warm,
-        swapped: false,
-    };
+    let query = Query::new(a, pose_a, b, pose_b, options, warm);
     #[cfg(target_arch = "x86_64")]
     if crate::has_avx2_fma() {
         // SAFETY: the CPU supports AVX2 and FMA, checked just above.
@@ -157,15 +149,7 @@ pub fn distance_in_baseline(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
-    let query = Query {
-        a,
-        pose_a,
-        b,
-        pose_b,
-        options,
-        warm,
-        swapped: false,
-    };
+    let query = Query::new(a, pose_a, b, pose_b, options, warm);
     distance_base(workspace, &query)
 }
 
@@ -182,6 +166,29 @@ struct Query<'q> {
     /// This is the second opinion of
     /// [`second_opinion`](recovery::second_opinion): asked no further.
     swapped: bool,
+}
+
+impl<'q> Query<'q> {
+    /// A query asked the way round its caller gave it.
+    #[inline(always)]
+    fn new(
+        a: &'q Shape,
+        pose_a: &'q Isometry3<f64>,
+        b: &'q Shape,
+        pose_b: &'q Isometry3<f64>,
+        options: &'q Options,
+        warm: Option<&'q WarmStart>,
+    ) -> Self {
+        Query {
+            a,
+            pose_a,
+            b,
+            pose_b,
+            options,
+            warm,
+            swapped: false,
+        }
+    }
 }
 
 /// [`distance_body`] for any CPU, out of line, so that [`distance_in`] stays

@@ -13,6 +13,7 @@
 //! |---|---|---|---|
 //! | [`query_service_name`] `{service}/v1/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
 //! | [`admin_service_name`] `{service}/v1/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
+//! | [`scene_service_name`] `{service}/v1/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
 //! | [`wake_service_name`] `{service}/v1/wake` | event | | |
 //!
 //! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
@@ -44,6 +45,12 @@ use std::fmt;
 
 use iceoryx2::prelude::ZeroCopySend;
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+mod scene;
+
+pub use scene::{
+    PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags, scene_reply_flags,
+};
 
 /// Protocol version, part of every service name: a client and a server of
 /// different versions never see each other's services, instead of misreading
@@ -78,6 +85,13 @@ pub fn query_service_name(service: &str) -> String {
 /// Name of the admin service (registration, removal, look-up, statistics).
 pub fn admin_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/admin")
+}
+
+/// Name of the scene service (whole-scene questions: clearance, pairs
+/// within a margin, nearest objects, paths), added within v1: a server older
+/// than it has no such service, and a client finds none to open.
+pub fn scene_service_name(service: &str) -> String {
+    format!("{service}/v{PROTOCOL_VERSION}/scene")
 }
 
 /// Name of the event service a client notifies after sending, so that a
@@ -275,6 +289,12 @@ pub enum Status {
     /// Round-off stopped progress before the tolerance was met; the bounds
     /// still hold.
     ToleranceNotMet = 5,
+    /// Scene requests only: answered without running GJK, from the pair's
+    /// last certified interval widened by how far either object can have
+    /// moved since; the interval holds, the distance and points are the last
+    /// answer's carried with the objects (see
+    /// [`scene_flags::MOTION_BOUNDS`]).
+    Bounded = 6,
 }
 
 impl Status {
@@ -287,6 +307,7 @@ impl Status {
             3 => Some(Status::Closer),
             4 => Some(Status::IterationCap),
             5 => Some(Status::ToleranceNotMet),
+            6 => Some(Status::Bounded),
             _ => None,
         }
     }
@@ -310,6 +331,14 @@ pub enum ItemKind {
     /// server computes every link's pose by forward kinematics and stores
     /// them. See [`Item::set_joints`] for the layout.
     SetJoints = 3,
+    /// Scene requests only: object `a` is a member of the request's group
+    /// (when [`SceneRequest::group`] is 0).
+    Member = 4,
+    /// Scene requests only: the pair `a`, `b` is never reported (an allowed
+    /// pair, on top of a robot's own).
+    Allow = 5,
+    /// Scene requests only: ends one step of a path.
+    Step = 6,
 }
 
 impl ItemKind {
@@ -319,6 +348,9 @@ impl ItemKind {
             1 => Some(ItemKind::SetPose),
             2 => Some(ItemKind::Distance),
             3 => Some(ItemKind::SetJoints),
+            4 => Some(ItemKind::Member),
+            5 => Some(ItemKind::Allow),
+            6 => Some(ItemKind::Step),
             _ => None,
         }
     }
@@ -637,6 +669,33 @@ impl Item {
             [t0, t1, t2, r0, r1, r2, r3, self.tolerance, self.margin],
             count,
         ))
+    }
+
+    /// A scene request's group member (see [`ItemKind::Member`]).
+    pub fn member(id: ObjectId) -> Self {
+        Item {
+            kind: ItemKind::Member as u32,
+            a: id.raw(),
+            ..Item::set_pose(id, &Isometry3::identity())
+        }
+    }
+
+    /// A scene request's allowed pair (see [`ItemKind::Allow`]).
+    pub fn allow(a: ObjectId, b: ObjectId) -> Self {
+        Item {
+            kind: ItemKind::Allow as u32,
+            b: b.raw(),
+            ..Item::member(a)
+        }
+    }
+
+    /// The end of a path step in a scene request (see [`ItemKind::Step`]).
+    pub fn step() -> Self {
+        Item {
+            kind: ItemKind::Step as u32,
+            a: 0,
+            ..Item::member(ObjectId(0))
+        }
     }
 
     /// The kind, if it is one this version knows.

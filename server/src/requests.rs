@@ -61,7 +61,11 @@ impl State {
                 Ok(()) => ItemResult::default(),
                 Err(e) => ItemResult::error(e),
             },
-            None => ItemResult::error(ErrorCode::Malformed),
+            // Group members, allowed pairs and path steps mean something
+            // only in a scene request.
+            Some(ItemKind::Member | ItemKind::Allow | ItemKind::Step) | None => {
+                ItemResult::error(ErrorCode::Malformed)
+            }
         }
     }
 

@@ -294,7 +294,9 @@ impl ShapeSpec {
                     (Some(h), None) => *h,
                     (None, Some(l)) => l / 2.0,
                     _ => {
-                        return Err("a cylinder takes `half_height` or `length`, one of them".into());
+                        return Err(
+                            "a cylinder takes `half_height` or `length`, one of them".into()
+                        );
                     }
                 };
                 return gjkd_model::cylinder(*radius, half_height, *rounding)

@@ -764,7 +764,48 @@ radius = 0.1
         let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
         let ids = scene.install(&mut state).expect("valid");
         assert_eq!(ids.len(), scene.objects.len());
-        assert!(ids.len() >= 5, "the example shows every shape type");
+        assert!(ids.len() >= 7, "the example shows every shape type");
+        let bottle = state.object(state.lookup("bottle").expect("there"));
+        let Some(Shape::Convex(bottle)) = bottle.map(|o| &o.shape) else {
+            panic!("a cylinder is one piece");
+        };
+        assert_eq!(bottle.cylinder_dimensions(), Some((0.04, 0.125)));
+        let rack = state.object(state.lookup("rack").expect("there"));
+        let Some(Shape::Compound(rack)) = rack.map(|o| &o.shape) else {
+            panic!("the rack is a compound");
+        };
+        for (_, piece) in rack.pieces() {
+            assert_eq!(piece.cylinder_dimensions(), Some((0.01, 0.3)));
+            assert_eq!(piece.radius(), 0.002);
+        }
+    }
+
+    /// The README's scene-file example (its one TOML block), with the
+    /// closed form of a ball's distance to its pillar.
+    #[test]
+    fn the_readme_example_loads() {
+        let doc: String = include_str!("../../README.md")
+            .lines()
+            .skip_while(|l| !l.starts_with("```toml"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("```"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let scene = Scene::from_toml(&doc).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        assert_eq!(scene.install(&mut state).expect("valid").len(), 2);
+        let pillar = state
+            .object(state.lookup("pillar").expect("there"))
+            .expect("there");
+        let ball: Shape = Convex::sphere(0.1).expect("ball").into();
+        let at = Isometry3::translation(1.0, 1.5, 0.5);
+        let options = gjk::Options::default();
+        let a = gjk::distance(&pillar.shape, &pillar.pose, &ball, &at, &options, None).expect("ok");
+        assert!(
+            (a.distance - (1.0 - 0.15 - 0.1)).abs() < 1e-12,
+            "{}",
+            a.distance
+        );
     }
 
     #[test]

@@ -999,7 +999,7 @@ pub mod shape_kind {
 /// Values of [`PieceDesc::reserved`]: what a piece's vertices describe.
 ///
 /// Added within v1 (the layout is unchanged): a server older than
-/// [`CYLINDER`] refuses any non-zero value as [`ErrorCode::Malformed`], so
+/// [`CYLINDER`](piece_kind::CYLINDER) refuses any non-zero value as [`ErrorCode::Malformed`], so
 /// a cylinder is never misread there as a one-point hull.
 pub mod piece_kind {
     /// The convex hull of the piece's vertices grown by its radius (0, the

@@ -41,8 +41,8 @@ mod within;
 mod tests;
 
 use gjkd_proto::{
-    ErrorCode, Item, ItemKind, ItemResult, PathMode, SceneKind, SceneReply, SceneRequest,
-    SceneRow, item_flags, scene_flags, scene_reply_flags,
+    ErrorCode, Item, ItemKind, ItemResult, PathMode, SceneKind, SceneReply, SceneRequest, SceneRow,
+    item_flags, scene_flags, scene_reply_flags,
 };
 use nalgebra::Isometry3;
 
@@ -123,7 +123,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
     {
         return Err(ErrorCode::Malformed);
     }
-    let number = |x: f64| x >= 0.0 && x <= f64::MAX;
+    let number = |x: f64| (0.0..=f64::MAX).contains(&x);
     if ![r.margin, r.tolerance, r.accept_absolute, r.accept_relative]
         .into_iter()
         .all(number)

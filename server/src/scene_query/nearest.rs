@@ -38,7 +38,11 @@ pub(crate) fn nearest_of(
             let mut guard = state.borrow_mut();
             let (ctx, found) = &mut *guard;
             let eb = bp.entry(leaf);
-            if leaf == a || !eb.live || ctx.group.allowed(ea.id, eb.id) || sphere_gap(&ea, eb) >= kth {
+            if leaf == a
+                || !eb.live
+                || ctx.group.allowed(ea.id, eb.id)
+                || sphere_gap(&ea, eb) >= kth
+            {
                 return None;
             }
             ctx.counters.candidates += 1;
@@ -54,7 +58,11 @@ pub(crate) fn nearest_of(
             }
             found.insert(at, (leaf, r));
             found.truncate(k);
-            let new_kth = if found.len() == k { found[k - 1].1.upper } else { f64::INFINITY };
+            let new_kth = if found.len() == k {
+                found[k - 1].1.upper
+            } else {
+                f64::INFINITY
+            };
             (new_kth < kth).then_some(new_kth)
         },
     );

@@ -119,7 +119,12 @@ fn joint_poses(
         .kinematics
         .link_poses_into(&base, positions, mode, &mut overlay.poses)
         .map_err(joint_code)?;
-    if robot.links.iter().flatten().any(|&id| store.object(id).is_none()) {
+    if robot
+        .links
+        .iter()
+        .flatten()
+        .any(|&id| store.object(id).is_none())
+    {
         return Err(ErrorCode::UnknownObject);
     }
     state.positions.copy_from_slice(positions);

@@ -12,12 +12,21 @@ use super::rows::Rows;
 /// Writes the rows of slot `a`'s pairs within the margin at step `step`;
 /// with `all_pairs`, only those with a later slot (each pair once), else
 /// only those with non-members. Returns how many it found.
-pub(crate) fn within_of(ctx: &mut Ctx<'_>, a: u32, all_pairs: bool, step: u32, rows: &mut Rows<'_>) -> u64 {
+pub(crate) fn within_of(
+    ctx: &mut Ctx<'_>,
+    a: u32,
+    all_pairs: bool,
+    step: u32,
+    rows: &mut Rows<'_>,
+) -> u64 {
     let bp = ctx.bp;
     let ea = *bp.entry(a);
     let m = ctx.q.margin;
     let mut hits = 0;
-    for leaf in bp.bvh().leaves(|node| node_gap(&ea.mins, &ea.maxs, node) <= m) {
+    for leaf in bp
+        .bvh()
+        .leaves(|node| node_gap(&ea.mins, &ea.maxs, node) <= m)
+    {
         let eb = bp.entry(leaf);
         let skip = if all_pairs {
             leaf <= a

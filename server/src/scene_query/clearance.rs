@@ -17,7 +17,7 @@ use std::cell::RefCell;
 
 use gjkd_proto::{ItemResult, SceneRow};
 
-use super::broadphase::{node_gap, sphere_gap};
+use super::broadphase::{node_gap_squared, root_up, sphere_gap, square_up};
 use super::motion_bound::{accepted, bounded_result, widen};
 use super::pair::{Ask, Ctx};
 
@@ -125,10 +125,12 @@ pub(crate) fn clearance_of(
         }
     }
     let search = RefCell::new(search);
+    // The tree compares squared distances (see node_gap_squared).
     bp.bvh().find_best(
-        bound,
-        |node, _| node_gap(&ea.mins, &ea.maxs, node),
-        |leaf, best_cost| {
+        square_up(bound),
+        |node, _| node_gap_squared(&ea.mins, &ea.maxs, node),
+        |leaf, best_squared| {
+            let best_cost = root_up(best_squared);
             let mut search = search.borrow_mut();
             let eb = bp.entry(leaf);
             let group = search.ctx.group;
@@ -142,7 +144,7 @@ pub(crate) fn clearance_of(
                 return None;
             }
             search.ctx.counters.candidates += 1;
-            search.visit(a, leaf, best_cost)
+            search.visit(a, leaf, best_cost).map(square_up)
         },
     );
     let mut search = search.into_inner();

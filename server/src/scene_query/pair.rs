@@ -20,6 +20,9 @@ pub(crate) enum Ask {
     Within(f64),
     /// Could it be nearer than this (the current best's upper bound)?
     Below(f64),
+    /// As `Below`, but an accepted width does not settle the pair (nearest
+    /// k, whose order an approximate answer could get wrong).
+    BelowExactly(f64),
 }
 
 /// How a pair was settled.
@@ -85,6 +88,7 @@ impl Ctx<'_> {
             let (ruled, settled) = match ask {
                 Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
                 Ask::Below(best) => (w.lower >= best, ok),
+                Ask::BelowExactly(best) => (w.lower >= best, false),
             };
             if ruled {
                 self.counters.bounded += 1;
@@ -109,7 +113,7 @@ impl Ctx<'_> {
         let mut options = q.options;
         options.margin = match ask {
             Ask::Within(m) => Some(m),
-            Ask::Below(_) => None,
+            Ask::Below(_) | Ask::BelowExactly(_) => None,
         };
         let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;

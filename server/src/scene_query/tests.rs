@@ -302,7 +302,7 @@ fn moved(pose: &Isometry3<f64>, m: &Motion, centre: &Vector3<f64>) -> Isometry3<
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     /// Along random motions, near and far from the origin, with motion
     /// bounds and an accepted accuracy: no pair within the margin is

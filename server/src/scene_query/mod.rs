@@ -359,11 +359,10 @@ impl State {
             &mut engine.poses,
         );
         for &(id, pose) in &engine.poses {
-            let (Some(slot), Some(object)) = (engine.broadphase.slot(id), self.store.object(id))
-            else {
+            let Some(slot) = engine.broadphase.slot(id) else {
                 continue;
             };
-            engine.broadphase.place(slot, &object.shape, &pose);
+            engine.broadphase.place(slot, &pose);
             if !engine.broadphase.entry(slot).overlaid {
                 engine.broadphase.set_overlaid(slot, true);
                 engine.touched.push(slot);
@@ -377,7 +376,7 @@ impl State {
         for &slot in &engine.touched {
             let id = engine.broadphase.entry(slot).id;
             if let Some(object) = self.store.object(id) {
-                engine.broadphase.place(slot, &object.shape, &object.pose);
+                engine.broadphase.place(slot, &object.pose);
             }
             engine.broadphase.set_overlaid(slot, false);
         }

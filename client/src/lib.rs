@@ -132,7 +132,7 @@ use open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 
 use gjkd_proto::{
     AdminOp, AdminReply, AdminRequest, PieceDesc, ReplyHeader, Vertex, admin_service_name,
-    query_service_name, shape_kind, wake_service_name,
+    piece_kind, query_service_name, shape_kind, wake_service_name,
 };
 pub use gjkd_proto::{
     Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemKind,
@@ -272,6 +272,20 @@ pub enum Geometry<'a> {
         /// Rounding radius, `>= 0`.
         radius: f64,
     },
+    /// An exact cylinder about the body z axis, centred on the body origin:
+    /// the disk of `radius` swept from `z = -half_height` to
+    /// `z = +half_height`, its edges rounded by `rounding` (0 for sharp
+    /// rims). Never a polytope: the server answers with the cylinder's own
+    /// support function. Needs a server that knows cylinders (an older one
+    /// refuses it with [`ErrorCode::Malformed`]).
+    Cylinder {
+        /// Radius of the disk, `>= 0`.
+        radius: f64,
+        /// Half the length along z, `>= 0`.
+        half_height: f64,
+        /// Rounding radius, `>= 0`.
+        rounding: f64,
+    },
     /// A union of convex pieces (at most [`MAX_PIECES`], none of them itself
     /// a compound). Answers name the pieces that realise the distance, by
     /// position in this slice.
@@ -288,20 +302,53 @@ pub struct Piece<'a> {
     pub geometry: Geometry<'a>,
 }
 
-impl Geometry<'_> {
-    /// Vertices and radius of a convex geometry, appended to `out`; the order
-    /// is the one the `gjk` crate's constructors use, so that the server's
-    /// answers equal in-process ones bit for bit.
-    fn push_convex(&self, out: &mut Vec<Vertex>) -> Result<f64, ClientError> {
-        match *self {
+impl<'a> Geometry<'a> {
+    /// The geometry that registers `convex` as it is: a cylinder as a
+    /// [`Geometry::Cylinder`], anything else as the
+    /// [`Geometry::Polytope`] of its vertices and radius (vertex order
+    /// kept, so the server builds the very same shape).
+    pub fn of_convex(convex: &'a gjk::Convex) -> Self {
+        match convex.cylinder_dimensions() {
+            Some((radius, half_height)) => Geometry::Cylinder {
+                radius,
+                half_height,
+                rounding: convex.radius(),
+            },
+            None => Geometry::Polytope {
+                vertices: convex.vertices(),
+                radius: convex.radius(),
+            },
+        }
+    }
+
+    /// Vertices, radius and piece kind ([`piece_kind`]) of a convex
+    /// geometry, the vertices appended to `out`; the order is the one the
+    /// `gjk` crate's constructors use, so that the server's answers equal
+    /// in-process ones bit for bit.
+    fn push_convex(&self, out: &mut Vec<Vertex>) -> Result<(f64, u32), ClientError> {
+        let radius = match *self {
             Geometry::Sphere { radius } => {
                 out.push(Vertex::default());
-                Ok(radius)
+                radius
             }
             Geometry::Capsule { a, b, radius } => {
                 out.push(a.into());
                 out.push(b.into());
-                Ok(radius)
+                radius
+            }
+            Geometry::Cylinder {
+                radius,
+                half_height,
+                rounding,
+            } => {
+                // The wire's cylinder layout: one vertex holding the
+                // dimensions (see `piece_kind::CYLINDER`).
+                out.push(Vertex {
+                    x: radius,
+                    y: half_height,
+                    z: 0.0,
+                });
+                return Ok((rounding, piece_kind::CYLINDER));
             }
             Geometry::Cuboid {
                 half_extents: h,
@@ -319,16 +366,19 @@ impl Geometry<'_> {
                         z: if i & 4 == 0 { -h.z } else { h.z },
                     });
                 }
-                Ok(radius)
+                radius
             }
             Geometry::Polytope { vertices, radius } => {
                 out.extend(vertices.iter().map(|&p| Vertex::from(p)));
-                Ok(radius)
+                radius
             }
-            Geometry::Compound(_) => Err(ClientError::InvalidArgument(
-                "a compound cannot be a piece of a compound",
-            )),
-        }
+            Geometry::Compound(_) => {
+                return Err(ClientError::InvalidArgument(
+                    "a compound cannot be a piece of a compound",
+                ));
+            }
+        };
+        Ok((radius, piece_kind::HULL))
     }
 }
 
@@ -957,27 +1007,27 @@ impl Client {
                 request.piece_count = pieces.len() as u32;
                 for (desc, piece) in request.pieces.iter_mut().zip(pieces.iter()) {
                     let before = vertices.len();
-                    let radius = piece.geometry.push_convex(vertices)?;
+                    let (radius, kind) = piece.geometry.push_convex(vertices)?;
                     *desc = PieceDesc {
                         offset: Pose::from_isometry(&piece.offset),
                         radius,
                         vertex_count: u32::try_from(vertices.len() - before).map_err(|_| {
                             ClientError::InvalidArgument("too many vertices in a piece")
                         })?,
-                        reserved: 0,
+                        reserved: kind,
                     };
                 }
             }
             convex => {
                 request.shape = shape_kind::CONVEX;
                 request.piece_count = 1;
-                let radius = convex.push_convex(vertices)?;
+                let (radius, kind) = convex.push_convex(vertices)?;
                 request.pieces[0] = PieceDesc {
                     offset: Pose::IDENTITY,
                     radius,
                     vertex_count: u32::try_from(vertices.len())
                         .map_err(|_| ClientError::InvalidArgument("too many vertices"))?,
-                    reserved: 0,
+                    reserved: kind,
                 };
             }
         }
@@ -1018,6 +1068,47 @@ impl Client {
         self.register(&Geometry::Cuboid {
             half_extents,
             radius,
+        })
+    }
+
+    /// Registers an exact cylinder about the body z axis, centred on the
+    /// body origin, of `radius` and `half_height` (half its length), its
+    /// edges rounded by `rounding` (0 for sharp rims): see
+    /// [`Geometry::Cylinder`]. For a name and an initial pose, pass that
+    /// geometry to [`Client::register_named`]; a compound takes cylinder
+    /// pieces too.
+    ///
+    /// ```no_run
+    /// use gjkd_client::{Client, Geometry, QueryOptions};
+    /// use nalgebra::Isometry3;
+    ///
+    /// # fn main() -> Result<(), gjkd_client::ClientError> {
+    /// let mut client = Client::connect("gjkd")?;
+    /// let can = client.register_cylinder(0.5, 1.0, 0.0)?;
+    /// let ball = client.register_named(
+    ///     "ball", &Geometry::Sphere { radius: 0.25 }, &Isometry3::translation(2.0, 0.0, 0.3))?;
+    /// // Beside the curved face: 2 - 0.5 - 0.25.
+    /// let d = client.distance(can, ball, &QueryOptions::default())?.distance;
+    /// assert!((d - 1.25).abs() < 1e-12);
+    /// # Ok(())
+    /// # }
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Client::register`]: [`ErrorCode::InvalidRadius`] for a
+    /// negative, NaN or infinite radius, half-height or rounding (or a
+    /// cylinder reaching beyond 2^999), and [`ErrorCode::Malformed`] from
+    /// a server older than cylinders.
+    pub fn register_cylinder(
+        &mut self,
+        radius: f64,
+        half_height: f64,
+        rounding: f64,
+    ) -> Result<ObjectId, ClientError> {
+        self.register(&Geometry::Cylinder {
+            radius,
+            half_height,
+            rounding,
         })
     }
 
@@ -1302,7 +1393,7 @@ mod tests {
             half_extents: Vector3::new(1.0, 0.0, -0.0),
             radius: 0.0,
         };
-        assert_eq!(flat.push_convex(&mut v), Ok(0.0));
+        assert_eq!(flat.push_convex(&mut v), Ok((0.0, piece_kind::HULL)));
     }
 
     #[test]
@@ -1312,7 +1403,7 @@ mod tests {
             half_extents: Vector3::new(1.0, 2.0, 3.0),
             radius: 0.0,
         };
-        assert_eq!(g.push_convex(&mut v), Ok(0.0));
+        assert_eq!(g.push_convex(&mut v), Ok((0.0, piece_kind::HULL)));
         assert_eq!(v.len(), 8);
         assert_eq!(
             v[0],
@@ -1366,6 +1457,59 @@ mod tests {
         assert!(matches!(
             Client::encode(&Geometry::Compound(&nested), &mut req, &mut v),
             Err(ClientError::InvalidArgument(_))
+        ));
+    }
+
+    #[test]
+    fn cylinders_travel_as_one_dimension_vertex() {
+        let can = Geometry::Cylinder {
+            radius: 0.5,
+            half_height: 2.0,
+            rounding: 0.125,
+        };
+        let mut req = AdminRequest::new(AdminOp::Register);
+        let mut v = Vec::new();
+        Client::encode(&can, &mut req, &mut v).expect("valid");
+        assert_eq!((req.shape, req.piece_count), (shape_kind::CONVEX, 1));
+        let desc = req.pieces[0];
+        assert_eq!(
+            (desc.reserved, desc.vertex_count),
+            (piece_kind::CYLINDER, 1)
+        );
+        assert_eq!(desc.radius, 0.125);
+        assert_eq!(
+            v,
+            [Vertex {
+                x: 0.5,
+                y: 2.0,
+                z: 0.0
+            }]
+        );
+
+        let pieces = [
+            Piece {
+                offset: Isometry3::translation(0.0, 0.0, 1.0),
+                geometry: Geometry::Sphere { radius: 0.5 },
+            },
+            Piece {
+                offset: Isometry3::identity(),
+                geometry: can,
+            },
+        ];
+        let mut v = Vec::new();
+        Client::encode(&Geometry::Compound(&pieces), &mut req, &mut v).expect("valid");
+        assert_eq!(req.pieces[0].reserved, piece_kind::HULL);
+        assert_eq!(req.pieces[1].reserved, piece_kind::CYLINDER);
+        assert_eq!(v.len(), 2);
+
+        // A gjk cylinder maps back to the same geometry, a polytope to its
+        // vertices.
+        let c = gjk::Convex::cylinder(0.5, 2.0, 0.125).expect("valid");
+        assert_eq!(Geometry::of_convex(&c), can);
+        let b = gjk::Convex::sphere(0.3).expect("valid");
+        assert!(matches!(
+            Geometry::of_convex(&b),
+            Geometry::Polytope { vertices, radius } if vertices.len() == 1 && radius == 0.3
         ));
     }
 }

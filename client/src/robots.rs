@@ -267,24 +267,16 @@ impl Client {
             let Some(shape) = &link.shape else { continue };
             let object = format!("{name}/{}", link.name);
             let id = match shape {
-                Shape::Convex(c) => self.register_named(
-                    &object,
-                    &Geometry::Polytope {
-                        vertices: c.vertices(),
-                        radius: c.radius(),
-                    },
-                    &Isometry3::identity(),
-                )?,
+                Shape::Convex(c) => {
+                    self.register_named(&object, &Geometry::of_convex(c), &Isometry3::identity())?
+                }
                 Shape::Compound(c) => {
                     let pieces: Vec<Piece<'_>> = c
                         .pieces()
                         .iter()
                         .map(|(offset, p)| Piece {
                             offset: *offset,
-                            geometry: Geometry::Polytope {
-                                vertices: p.vertices(),
-                                radius: p.radius(),
-                            },
+                            geometry: Geometry::of_convex(p),
                         })
                         .collect();
                     self.register_named(

@@ -1,15 +1,13 @@
 //! A robot from URDF: its kinematic tree and one shape per link.
 //!
 //! A link's shape is made of its `<collision>` elements, each at its
-//! `<origin>` in the link frame: `<box>`, `<sphere>`, `<capsule>` (a
-//! non-standard element some tools write: a cylinder of `length` between two
-//! half balls, along z) and `<mesh>` (its convex hull, scaled). One element
-//! at the link origin is a convex shape, several a compound. A link without
-//! collision elements has no shape.
-//!
-//! `<cylinder>` is refused with [`RobotError::Cylinder`] until gjk has an
-//! exact cylinder (see [`cylinder`]): gjkd never approximates one by a
-//! polytope.
+//! `<origin>` in the link frame: `<box>`, `<sphere>`, `<cylinder>` (an
+//! exact cylinder of `length` along the element's z axis, see [`cylinder`];
+//! never a polytope), `<capsule>` (a non-standard element some tools write:
+//! a cylinder of `length` between two half balls, along z) and `<mesh>`
+//! (its convex hull, scaled). One element at the link origin is a convex
+//! shape, several a compound. A link without collision elements has no
+//! shape.
 
 use std::path::{Path, PathBuf};
 
@@ -49,15 +47,6 @@ pub enum RobotError {
         link: String,
         /// What is wrong with the mesh.
         source: MeshError,
-    },
-    /// A `<cylinder>` collision element: not supported until gjk has an
-    /// exact cylinder shape (never approximated by a polytope).
-    #[error(
-        "link `{link}`: cylinder collision elements are not supported yet (gjkd has no exact cylinder shape; it does not approximate one)"
-    )]
-    Cylinder {
-        /// The link.
-        link: String,
     },
     /// A collision element's size or origin is not valid (negative, NaN).
     #[error("link `{link}`: {reason}")]
@@ -161,36 +150,40 @@ fn link_shape(
     Ok(Some(shape))
 }
 
-/// Why a cylinder could not be made.
+/// Why a cylinder could not be made: a size is negative, not finite, or
+/// the cylinder would reach beyond 2^999 (about 5e300) from its centre.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum CylinderError {
-    /// gjk has no exact cylinder yet, and gjkd does not approximate one.
-    #[error(
-        "cylinders are not supported yet (gjkd has no exact cylinder shape; it does not approximate one)"
-    )]
-    Unsupported,
-    /// A size is negative or not finite.
-    #[error("{0}")]
-    Invalid(String),
-}
+#[error("{0}")]
+pub struct CylinderError(pub String);
 
-/// A cylinder along z, centred on its frame's origin: the one place where
-/// URDF `<cylinder>` elements and scene-file cylinders become a shape.
+/// The farthest gjk lets a shape reach from its origin, 2^999.
+const MAX_REACH: f64 = 5.357543035931337e300;
+
+/// An exact cylinder along z, centred on its frame's origin: the disk of
+/// `radius` swept from `z = -half_height` to `z = +half_height`, edges
+/// rounded by `rounding` (gjk's [`Convex::cylinder`], a support function,
+/// never a polytope). The one place where URDF `<cylinder>` elements (along
+/// their frame's z axis, as gjk's) and scene-file cylinders become a shape.
+///
+/// ```
+/// let can = gjkd_model::cylinder(0.05, 0.2, 0.0)?;
+/// assert_eq!(can.cylinder_dimensions(), Some((0.05, 0.2)));
+/// # Ok::<(), gjkd_model::CylinderError>(())
+/// ```
 ///
 /// # Errors
-/// [`CylinderError::Invalid`] for a negative or non-finite size;
-/// [`CylinderError::Unsupported`] always otherwise, for now.
-pub fn cylinder(radius: f64, half_height: f64) -> Result<Convex, CylinderError> {
-    if !(radius.is_finite() && radius >= 0.0 && half_height.is_finite() && half_height >= 0.0) {
-        return Err(CylinderError::Invalid(format!(
-            "cylinder radius {radius} and half height {half_height} must be finite and >= 0"
+/// [`CylinderError`] for a negative or non-finite size, or one reaching
+/// beyond 2^999.
+pub fn cylinder(radius: f64, half_height: f64, rounding: f64) -> Result<Convex, CylinderError> {
+    let sizes = [radius, half_height, rounding];
+    if !sizes.iter().all(|x| x.is_finite() && *x >= 0.0)
+        || radius.hypot(half_height) + rounding > MAX_REACH
+    {
+        return Err(CylinderError(format!(
+            "cylinder radius {radius}, half height {half_height} and rounding {rounding} must be finite, >= 0 and at most 5e300"
         )));
     }
-    // CYLINDER HOOK: when gjk has an exact cylinder (a disk swept along a
-    // segment, by its support function), build it here from `radius` and
-    // `half_height`, axis z as in URDF. Until then it is refused, never
-    // approximated by a polytope.
-    Err(CylinderError::Unsupported)
+    Convex::cylinder(radius, half_height, rounding).map_err(|e| CylinderError(e.to_string()))
 }
 
 /// One collision element as a convex shape in its own frame.
@@ -226,12 +219,7 @@ fn element_convex(
             Convex::capsule(Point3::new(0.0, 0.0, -h), Point3::new(0.0, 0.0, h), *radius)
         }
         G::Cylinder { radius, length } => {
-            return cylinder(*radius, length / 2.0).map_err(|e| match e {
-                CylinderError::Unsupported => RobotError::Cylinder {
-                    link: link.to_owned(),
-                },
-                CylinderError::Invalid(reason) => bad(reason),
-            });
+            return cylinder(*radius, length / 2.0, 0.0).map_err(|e| bad(e.0));
         }
         G::Mesh { filename, scale } => {
             let path =

@@ -142,12 +142,17 @@ fn bad_robots_get_their_errors() {
     );
     let no_package = RobotModel::from_urdf_str(&text, base, &PackagePath::default()).unwrap_err();
     assert!(matches!(&no_package, RobotError::MeshPath { link, .. } if link == "slider"));
-    let cylinder = try_text(&text.replace(
-        r#"<sphere radius="0.05"/>"#,
-        r#"<cylinder radius="0.05" length="0.2"/>"#,
-    ));
-    assert!(matches!(&cylinder, RobotError::Cylinder { link } if link == "shoulder"));
-    assert!(cylinder.to_string().contains("not supported"), "{cylinder}");
+    for bad in [
+        r#"radius="-0.05" length="0.2""#,
+        r#"radius="0.05" length="NaN""#,
+    ] {
+        let cylinder =
+            try_text(&text.replace(r#"<sphere radius="0.05"/>"#, &format!("<cylinder {bad}/>")));
+        assert!(
+            matches!(&cylinder, RobotError::Geometry { link, .. } if link == "shoulder"),
+            "{cylinder}"
+        );
+    }
     let negative =
         try_text(&text.replace(r#"<sphere radius="0.05"/>"#, r#"<sphere radius="-1"/>"#));
     assert!(matches!(&negative, RobotError::Geometry { link, .. } if link == "shoulder"));
@@ -162,4 +167,66 @@ fn bad_robots_get_their_errors() {
         RobotError::Kinematics(KinematicsError::UnknownLink { link, .. }) if link == "wrist2"
     ));
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `<cylinder>` elements are exact cylinders along their element's z axis:
+/// laid along the link's y axis by their origin's roll, the distance from a
+/// ball past the end cap is `|y - y0| - length/2 - r_ball`, beside the
+/// curved face `|(x, z) - (x0, z0)| - radius - r_ball`, to round-off.
+#[test]
+fn cylinder_elements_are_exact_along_their_z_axis() {
+    use nalgebra::{Isometry3, Vector3};
+    let urdf = r#"<robot name="can">
+  <link name="rod">
+    <collision>
+      <origin xyz="0.5 0 0.2" rpy="1.5707963267948966 0 0"/>
+      <geometry><cylinder radius="0.1" length="0.6"/></geometry>
+    </collision>
+    <collision>
+      <geometry><box size="0.2 0.2 0.2"/></geometry>
+    </collision>
+  </link>
+  <link name="can">
+    <collision><geometry><cylinder radius="0.25" length="1.0"/></geometry></collision>
+  </link>
+  <joint name="fix" type="fixed"><parent link="rod"/><child link="can"/></joint>
+</robot>"#;
+    let model = RobotModel::from_urdf_str(urdf, None, &PackagePath::default()).unwrap();
+    let Some(Shape::Compound(rod)) = &model.links[0].shape else {
+        panic!("two elements make a compound");
+    };
+    assert_eq!(rod.pieces()[0].1.cylinder_dimensions(), Some((0.1, 0.3)));
+    assert_eq!(rod.pieces()[1].1.cylinder_dimensions(), None);
+    let Some(Shape::Convex(can)) = &model.links[1].shape else {
+        panic!("one element at the origin is convex");
+    };
+    assert_eq!(can.cylinder_dimensions(), Some((0.25, 0.5)));
+
+    let ball: Shape = gjk::Convex::sphere(0.05).unwrap().into();
+    let rod = model.links[0].shape.as_ref().unwrap();
+    let options = gjk::Options::default();
+    // (ball centre in the link frame, exact distance)
+    let cases = [
+        (Vector3::new(0.5, 1.0, 0.2), 1.0 - 0.3 - 0.05),
+        (Vector3::new(0.5, -0.45, 0.2), 0.45 - 0.3 - 0.05),
+        (Vector3::new(0.5, 0.1, 0.9), 0.7 - 0.1 - 0.05),
+        (Vector3::new(0.8, -0.2, 0.6), 0.5 - 0.1 - 0.05),
+    ];
+    for (at, want) in cases {
+        let a = gjk::distance(
+            rod,
+            &Isometry3::identity(),
+            &ball,
+            &Isometry3::translation(at.x, at.y, at.z),
+            &options,
+            None,
+        )
+        .unwrap();
+        assert!(
+            (a.distance - want).abs() < 1e-12,
+            "{at:?}: {} vs {want}",
+            a.distance
+        );
+        assert!(a.lower <= want && want <= a.upper, "{at:?}");
+    }
 }

@@ -153,7 +153,9 @@ pub enum ErrorCode {
     EmptyVertices = 5,
     /// A shape has more vertices than the server accepts.
     TooManyVertices = 6,
-    /// A radius is negative, NaN, infinite, or above 2^999 (about 5e300).
+    /// A radius is negative, NaN, infinite, or above 2^999 (about 5e300);
+    /// also a cylinder's radius or half-height, or its whole reach
+    /// (`hypot(r, h)` plus rounding) above 2^999.
     InvalidRadius = 7,
     /// A batch has more items than the server accepts.
     BatchTooLarge = 8,
@@ -986,15 +988,52 @@ pub mod lookup_kind {
 
 /// Values of [`AdminRequest::shape`].
 pub mod shape_kind {
-    /// One convex piece: `pieces[0]` describes it (its offset is ignored).
+    /// One convex piece: `pieces[0]` describes it (its offset is ignored);
+    /// a hull or a cylinder ([`piece_kind`](crate::piece_kind)).
     pub const CONVEX: u32 = 1;
-    /// A union of `piece_count` convex pieces, each with its offset.
+    /// A union of `piece_count` convex pieces, each with its offset, each a
+    /// hull or a cylinder ([`piece_kind`](crate::piece_kind)).
     pub const COMPOUND: u32 = 2;
+}
+
+/// Values of [`PieceDesc::reserved`]: what a piece's vertices describe.
+///
+/// Added within v1 (the layout is unchanged): a server older than
+/// [`CYLINDER`] refuses any non-zero value as [`ErrorCode::Malformed`], so
+/// a cylinder is never misread there as a one-point hull.
+pub mod piece_kind {
+    /// The convex hull of the piece's vertices grown by its radius (0, the
+    /// only kind before cylinders).
+    pub const HULL: u32 = 0;
+    /// An exact cylinder about the piece's z axis, centred at the piece's
+    /// origin: the piece has exactly one vertex, `(r, h, 0)`, the
+    /// cylinder's radius `r` and half-height `h` (each finite, `>= 0`, at
+    /// most 2^999; a `z` other than 0 is [`Malformed`](crate::ErrorCode::Malformed),
+    /// a bad `r` or `h` [`InvalidRadius`](crate::ErrorCode::InvalidRadius)),
+    /// and [`PieceDesc::radius`](crate::PieceDesc::radius) rounds its edges.
+    pub const CYLINDER: u32 = 1;
 }
 
 /// One convex piece of a registration: its offset in the object's body frame,
 /// radius, and how many of the slice's vertices are its own (pieces take
 /// consecutive runs of the slice, in order).
+///
+/// A cylinder piece ([`piece_kind::CYLINDER`] in `reserved`) carries its
+/// dimensions as its one vertex:
+///
+/// ```
+/// use gjkd_proto::{piece_kind, PieceDesc, Pose, Vertex};
+///
+/// // Radius 0.05, length 0.4 (half-height 0.2), sharp rims.
+/// let desc = PieceDesc {
+///     offset: Pose::IDENTITY,
+///     radius: 0.0,
+///     vertex_count: 1,
+///     reserved: piece_kind::CYLINDER,
+/// };
+/// let dimensions = Vertex { x: 0.05, y: 0.2, z: 0.0 };
+/// # let _ = (desc, dimensions);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v1.PieceDesc")]
@@ -1003,9 +1042,11 @@ pub struct PieceDesc {
     pub offset: Pose,
     /// Rounding radius, `>= 0`.
     pub radius: f64,
-    /// Number of vertices of this piece.
+    /// Number of vertices of this piece (1 for a cylinder).
     pub vertex_count: u32,
-    /// Zero.
+    /// The piece's kind, a [`piece_kind`] value: 0 (a hull) unless the
+    /// piece is a cylinder. The name is the field's from before
+    /// cylinders, kept so that code building pieces still compiles.
     pub reserved: u32,
 }
 

@@ -892,7 +892,15 @@ mod tests {
         assert!(opened.fresh);
         assert_eq!((opened.snapshot.epoch, opened.snapshot.next_index), (5, 1));
         db.sync(&sample()).expect("sync");
-        let extra = object(9, 1, Some("extra"));
+        // A registration holding a cylinder takes the newer stored form.
+        let mut extra = object(9, 1, Some("extra"));
+        let can = Convex::cylinder(0.5, 2.0, 0.125).expect("cylinder");
+        let pieces = vec![
+            (Isometry3::translation(0.0, 0.0, 1.0), can),
+            (Isometry3::identity(), Convex::sphere(0.5).expect("ball")),
+        ];
+        let extra_shape: gjk::Shape = gjk::Compound::new(pieces).expect("valid").into();
+        extra.shape = StoredShape::from_shape(&extra_shape);
         db.register(&extra, 10, None).expect("register");
         db.remove(&[id(1)], &[]).expect("remove");
         drop(db);
@@ -908,6 +916,8 @@ mod tests {
         );
         let shape = want.objects[1].shape.to_shape().expect("valid");
         assert_eq!(StoredShape::from_shape(&shape), want.objects[1].shape);
+        let reloaded = opened.snapshot.objects[1].shape.to_shape().expect("valid");
+        assert_eq!(reloaded, extra_shape, "the cylinder piece comes back exact");
         let mode = |p: &Path| std::fs::metadata(p).expect("exists").permissions().mode() & 0o777;
         assert_eq!(mode(&path), 0o600);
         assert_eq!(mode(path.parent().expect("dir")), 0o700);

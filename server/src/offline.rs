@@ -16,7 +16,7 @@ use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 
 use crate::database::Database;
-use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredShape};
+use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredPiece, StoredPose, StoredShape};
 
 /// `gjkd objects`: prints the table of the objects stored at `path` and,
 /// with `remove`, removes those whose owner is gone, printing their ids.
@@ -152,14 +152,7 @@ pub fn table(snapshot: &Snapshot, states: &[Liveness]) -> String {
             Liveness::Running => "running",
             Liveness::Gone => "gone",
         };
-        let geometry = match &o.shape {
-            StoredShape::Convex(c) => format!("convex, {} vertices", c.vertices.len()),
-            StoredShape::Compound(p) => format!(
-                "compound, {} pieces, {} vertices",
-                p.len(),
-                p.iter().map(|(_, c)| c.vertices.len()).sum::<usize>()
-            ),
-        };
+        let geometry = geometry(&o.shape);
         let _ = writeln!(
             out,
             "{:#018x}  {owner:<34}  {state:<8}  {:<20}  {geometry}",
@@ -170,10 +163,44 @@ pub fn table(snapshot: &Snapshot, states: &[Liveness]) -> String {
     out
 }
 
+/// The geometry column: kind, pieces, vertices, cylinders.
+fn geometry(shape: &StoredShape) -> String {
+    let cylinders = |p: &[(StoredPose, StoredPiece)]| {
+        p.iter()
+            .filter(|(_, p)| matches!(p, StoredPiece::Cylinder(_)))
+            .count()
+    };
+    let vertices = |p: &StoredPiece| match p {
+        StoredPiece::Hull(c) => c.vertices.len(),
+        StoredPiece::Cylinder(_) => 0,
+    };
+    match shape {
+        StoredShape::Convex(c) => format!("convex, {} vertices", c.vertices.len()),
+        StoredShape::Compound(p) => format!(
+            "compound, {} pieces, {} vertices",
+            p.len(),
+            p.iter().map(|(_, c)| c.vertices.len()).sum::<usize>()
+        ),
+        StoredShape::Piece(StoredPiece::Cylinder(c)) => format!(
+            "cylinder, radius {}, half-height {}, rounding {}",
+            c.radius, c.half_height, c.rounding
+        ),
+        StoredShape::Piece(StoredPiece::Hull(c)) => {
+            format!("convex, {} vertices", c.vertices.len())
+        }
+        StoredShape::Pieces(p) => format!(
+            "compound, {} pieces ({} cylinders), {} vertices",
+            p.len(),
+            cylinders(p),
+            p.iter().map(|(_, c)| vertices(c)).sum::<usize>()
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stored::{StoredConvex, StoredPose};
+    use crate::stored::StoredConvex;
 
     /// Object `index` of a store of epoch 3.
     fn object(index: u64, owner: StoredOwner, name: Option<&str>) -> StoredObject {
@@ -227,5 +254,29 @@ mod tests {
         assert!(snapshot.validate().is_ok());
         // Nothing else to remove the second time.
         assert!(remove_departed(&mut snapshot, alive).is_empty());
+    }
+
+    #[test]
+    fn the_table_describes_cylinders() {
+        let can: gjk::Shape = gjk::Convex::cylinder(0.5, 2.0, 0.0).expect("valid").into();
+        assert_eq!(
+            geometry(&StoredShape::from_shape(&can)),
+            "cylinder, radius 0.5, half-height 2, rounding 0"
+        );
+        let pair = gjk::Compound::new(vec![
+            (
+                nalgebra::Isometry3::identity(),
+                gjk::Convex::cylinder(0.5, 2.0, 0.0).expect("valid"),
+            ),
+            (
+                nalgebra::Isometry3::identity(),
+                gjk::Convex::sphere(1.0).expect("valid"),
+            ),
+        ])
+        .expect("valid");
+        assert_eq!(
+            geometry(&StoredShape::from_shape(&pair.into())),
+            "compound, 2 pieces (1 cylinders), 1 vertices"
+        );
     }
 }

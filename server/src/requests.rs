@@ -7,8 +7,8 @@
 
 use gjk::{Compound, Convex, Shape};
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemKind, ItemResult, MAX_PIECES, Pose,
-    Vertex, item_flags, result_flags, shape_kind,
+    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemKind, ItemResult, MAX_PIECES,
+    PieceDesc, Pose, Vertex, item_flags, piece_kind, result_flags, shape_kind,
 };
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
@@ -304,17 +304,16 @@ pub fn decode_registration(
                 return Err(ErrorCode::Malformed);
             }
             let piece = &request.pieces[0];
-            if piece.reserved != 0 {
-                return Err(ErrorCode::Malformed);
-            }
             if piece.vertex_count as usize != vertices.len() {
-                return Err(if vertices.is_empty() {
-                    ErrorCode::EmptyVertices
-                } else {
-                    ErrorCode::Malformed
-                });
+                return Err(
+                    if vertices.is_empty() && piece.reserved == piece_kind::HULL {
+                        ErrorCode::EmptyVertices
+                    } else {
+                        ErrorCode::Malformed
+                    },
+                );
             }
-            Shape::Convex(convex(vertices, piece.radius)?)
+            Shape::Convex(decode_piece(piece, vertices)?)
         }
         shape_kind::COMPOUND => {
             if count == 0 {
@@ -324,9 +323,6 @@ pub fn decode_registration(
                 return Err(ErrorCode::TooManyPieces);
             }
             let table = &request.pieces[..count];
-            if table.iter().any(|p| p.reserved != 0) {
-                return Err(ErrorCode::Malformed);
-            }
             let total: u64 = table.iter().map(|p| u64::from(p.vertex_count)).sum();
             if total != vertices.len() as u64 {
                 return Err(ErrorCode::Malformed);
@@ -336,7 +332,7 @@ pub fn decode_registration(
             for p in table {
                 let end = start + p.vertex_count as usize;
                 let offset = check_pose(&p.offset)?;
-                pieces.push((offset, convex(&vertices[start..end], p.radius)?));
+                pieces.push((offset, decode_piece(p, &vertices[start..end])?));
                 start = end;
             }
             Shape::Compound(Compound::new(pieces).map_err(map_gjk_error)?)
@@ -344,6 +340,40 @@ pub fn decode_registration(
         _ => return Err(ErrorCode::Malformed),
     };
     Ok(NewObject { shape, pose, name })
+}
+
+/// One piece of a registration, `vertices` its own run of the slice: a
+/// hull, or a cylinder whose one vertex holds its dimensions (see
+/// [`piece_kind::CYLINDER`]). A kind this version does not know is
+/// malformed, as every server before cylinders refused any but 0.
+fn decode_piece(desc: &PieceDesc, vertices: &[Vertex]) -> Result<Convex, ErrorCode> {
+    match desc.reserved {
+        piece_kind::HULL => convex(vertices, desc.radius),
+        piece_kind::CYLINDER => match vertices {
+            [v] if v.z == 0.0 => cylinder(v.x, v.y, desc.radius),
+            _ => Err(ErrorCode::Malformed),
+        },
+        _ => Err(ErrorCode::Malformed),
+    }
+}
+
+/// The farthest a shape may reach from its body origin, 2^999 (gjk's own
+/// limit, about 5e300), so that no query's arithmetic can overflow.
+const MAX_REACH: f64 = 5.357543035931337e300;
+
+/// An exact cylinder of `radius` and `half_height` rounded by `rounding`:
+/// each a number from 0 to 2^999, and the whole within 2^999 of its
+/// origin, else [`ErrorCode::InvalidRadius`] (gjk would call a bad
+/// dimension a bad vertex, which a cylinder sent none of).
+pub fn cylinder(radius: f64, half_height: f64, rounding: f64) -> Result<Convex, ErrorCode> {
+    let dimensions = [radius, half_height, rounding];
+    if !dimensions.iter().all(|x| (0.0..=MAX_REACH).contains(x)) {
+        return Err(ErrorCode::InvalidRadius);
+    }
+    if radius.hypot(half_height) + rounding > MAX_REACH {
+        return Err(ErrorCode::InvalidRadius);
+    }
+    Convex::cylinder(radius, half_height, rounding).map_err(map_gjk_error)
 }
 
 fn convex(vertices: &[Vertex], radius: f64) -> Result<Convex, ErrorCode> {
@@ -363,6 +393,142 @@ mod tests {
     use crate::state::test_support::*;
     use gjkd_proto::{ObjectId, PieceDesc, QueryOptions};
     use nalgebra::Vector3;
+
+    /// A cylinder registration: one piece of kind `CYLINDER` whose one
+    /// vertex holds `(r, h, z)`.
+    fn cylinder_request(r: f64, h: f64, z: f64, rounding: f64) -> (AdminRequest, [Vertex; 1]) {
+        let mut req = AdminRequest::new(AdminOp::Register);
+        req.shape = shape_kind::CONVEX;
+        req.piece_count = 1;
+        req.pieces[0] = PieceDesc {
+            offset: Pose::IDENTITY,
+            radius: rounding,
+            vertex_count: 1,
+            reserved: piece_kind::CYLINDER,
+        };
+        (req, [Vertex { x: r, y: h, z }])
+    }
+
+    /// Beside the curved face the distance to a ball is
+    /// `|centre_xy| - r - r_ball`, beyond a cap `|z| - h - r_ball`; a
+    /// compound's cylinder piece answers the same, moved by its offset.
+    #[test]
+    fn cylinders_register_and_answer_exactly() {
+        let mut s = state();
+        let (req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
+        let reply = s.handle_admin(1, &req, &v);
+        assert_eq!(reply.error_code(), ErrorCode::Ok);
+        let can = ObjectId::from_raw(reply.id);
+        let mut ball = cylinder_request(0.0, 0.0, 0.0, 0.25).0;
+        ball.pieces[0].reserved = piece_kind::HULL;
+        let ball = s.handle_admin(1, &ball, &[Vertex::default()]);
+        assert_eq!(ball.error_code(), ErrorCode::Ok);
+        let ball = ObjectId::from_raw(ball.id);
+        let cases = [
+            (Vector3::new(1.2, -1.6, 0.3), 2.0 - 0.5 - 0.25),
+            (Vector3::new(0.1, 0.2, -3.0), 3.0 - 1.0 - 0.25),
+        ];
+        for (at, want) in cases {
+            let item = Item::distance(can, ball, &QueryOptions::cold())
+                .with_pose_b(&Isometry3::translation(at.x, at.y, at.z));
+            let got = one(&mut s, 1, item).answer().expect("ok");
+            assert!(
+                (got.distance - want).abs() < 1e-12,
+                "{at:?}: {}",
+                got.distance
+            );
+            assert!(got.lower <= want && want <= got.upper);
+        }
+
+        let mut pair = AdminRequest::new(AdminOp::Register);
+        pair.shape = shape_kind::COMPOUND;
+        pair.piece_count = 2;
+        pair.pieces[0] = req.pieces[0];
+        pair.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(5.0, 0.0, 0.0));
+        pair.pieces[1].vertex_count = 1;
+        let verts = [v[0], Vertex::default()];
+        let reply = s.handle_admin(1, &pair, &verts);
+        assert_eq!(reply.error_code(), ErrorCode::Ok);
+        let Shape::Compound(c) = &s.object(reply.id).expect("stored").shape else {
+            panic!("not a compound");
+        };
+        assert_eq!(c.pieces()[0].1.cylinder_dimensions(), Some((0.5, 1.0)));
+        assert_eq!(c.pieces()[1].1.cylinder_dimensions(), None);
+        let item = Item::distance(ObjectId::from_raw(reply.id), ball, &QueryOptions::cold())
+            .with_pose_b(&Isometry3::translation(5.0, 2.0, 0.0));
+        let got = one(&mut s, 1, item).answer().expect("ok");
+        assert!((got.distance - 1.25).abs() < 1e-12, "{}", got.distance);
+    }
+
+    /// Every bad cylinder gets its code and stores nothing.
+    #[test]
+    fn bad_cylinders_get_their_codes_and_change_nothing() {
+        let mut s = state();
+        let before = s.stats().objects;
+        let huge = 4e300;
+        let cases = [
+            ((-0.5, 1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, -1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((f64::NAN, 1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, f64::NAN, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, f64::INFINITY, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, 1.0, 0.0, -0.1), ErrorCode::InvalidRadius),
+            ((0.5, 1.0, 0.0, f64::NAN), ErrorCode::InvalidRadius),
+            ((huge, huge, 0.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, 1.0, 1.0, 0.0), ErrorCode::Malformed),
+            ((0.5, 1.0, f64::NAN, 0.0), ErrorCode::Malformed),
+        ];
+        for ((r, h, z, rounding), want) in cases {
+            let (req, v) = cylinder_request(r, h, z, rounding);
+            assert_eq!(
+                s.handle_admin(1, &req, &v).error_code(),
+                want,
+                "{r} {h} {z}"
+            );
+        }
+        // One vertex, no more, no less.
+        let (mut req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
+        let two = [v[0], v[0]];
+        req.pieces[0].vertex_count = 2;
+        assert_eq!(
+            s.handle_admin(1, &req, &two).error_code(),
+            ErrorCode::Malformed
+        );
+        req.pieces[0].vertex_count = 0;
+        assert_eq!(
+            s.handle_admin(1, &req, &[]).error_code(),
+            ErrorCode::Malformed
+        );
+        // A piece kind from the future is malformed, in a compound too.
+        let (mut req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
+        req.pieces[0].reserved = 2;
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        req.shape = shape_kind::COMPOUND;
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::Malformed
+        );
+        // A compound whose cylinder piece is bad, or sits too far away.
+        req.pieces[0].reserved = piece_kind::CYLINDER;
+        let bad = [Vertex {
+            x: -1.0,
+            y: 1.0,
+            z: 0.0,
+        }];
+        assert_eq!(
+            s.handle_admin(1, &req, &bad).error_code(),
+            ErrorCode::InvalidRadius
+        );
+        req.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(6e300, 0.0, 0.0));
+        assert_eq!(
+            s.handle_admin(1, &req, &v).error_code(),
+            ErrorCode::NonFinitePose
+        );
+        assert_eq!(s.stats().objects, before);
+    }
 
     #[test]
     fn answers_match_gjk_bit_for_bit() {
@@ -599,7 +765,7 @@ mod tests {
         reg.shape = shape_kind::CONVEX;
         reg.piece_count = 1;
         reg.pieces[0].vertex_count = 1;
-        reg.pieces[0].reserved = 3;
+        reg.pieces[0].reserved = 3; // a piece kind from the future
         assert_eq!(
             s.handle_admin(1, &reg, &v).error_code(),
             ErrorCode::Malformed

@@ -40,9 +40,23 @@
 //! offset = { translation = [1.0, 0.0, 0.0] }
 //! ```
 //!
+//! A cylinder is exact (gjk's support function, never a polytope), along
+//! its body z axis, centred on its origin: `radius`, and `half_height` or
+//! `length` (one of the two), optionally `rounding`; a compound takes
+//! cylinder pieces too:
+//!
+//! ```toml
+//! [[object]]
+//! name = "can"
+//! type = "cylinder"
+//! radius = 0.5
+//! half_height = 1.0        # or length = 2.0
+//! rounding = 0.01          # optional (default 0)
+//! pose = { translation = [0.0, 3.0, 0.0], axis_angle = [1.5707963267948966, 0.0, 0.0] }
+//! ```
+//!
 //! Meshes (`type = "mesh"`) and robots (`[[robot]]`) are described in
-//! [`crate::scene_robots`]; `type = "cylinder"` (`radius`, `half_height`)
-//! is refused until gjk has an exact cylinder.
+//! [`crate::scene_robots`].
 //!
 //! A pose has an optional `translation` and at most one of `quaternion`
 //! (`[i, j, k, w]`, normalised on load) and `axis_angle` (the rotation axis
@@ -168,12 +182,17 @@ pub enum ShapeSpec {
         /// V-HACD resolution to decompose at, instead of taking the hull.
         decompose: Option<u32>,
     },
-    /// A cylinder along z: refused until gjk has an exact cylinder.
+    /// An exact cylinder along z, centred on the origin.
     Cylinder {
-        /// Radius.
+        /// Radius of the disk.
         radius: f64,
-        /// Half its height.
-        half_height: f64,
+        /// Half its length along z (or give `length`).
+        half_height: Option<f64>,
+        /// Its whole length along z (or give `half_height`).
+        length: Option<f64>,
+        /// Rounding radius of its edges.
+        #[serde(default)]
+        rounding: f64,
     },
     /// A union of convex pieces.
     Compound {
@@ -268,7 +287,21 @@ impl ShapeSpec {
             ShapeSpec::Cylinder {
                 radius,
                 half_height,
-            } => return gjkd_model::cylinder(*radius, *half_height).map_err(|e| e.to_string()),
+                length,
+                rounding,
+            } => {
+                let half_height = match (half_height, length) {
+                    (Some(h), None) => *h,
+                    (None, Some(l)) => l / 2.0,
+                    _ => {
+                        return Err(
+                            "a cylinder takes `half_height` or `length`, one of them".into()
+                        );
+                    }
+                };
+                return gjkd_model::cylinder(*radius, half_height, *rounding)
+                    .map_err(|e| e.to_string());
+            }
             ShapeSpec::Compound { .. } => return Err("a compound cannot be a piece".into()),
         };
         made.map_err(|e| e.to_string())
@@ -410,7 +443,7 @@ fn shape_keys(kind: &str) -> Option<&'static [&'static str]> {
         "polytope" => &["vertices", "radius"],
         "compound" => &["pieces"],
         "mesh" => &["file", "scale", "decompose"],
-        "cylinder" => &["radius", "half_height"],
+        "cylinder" => &["radius", "half_height", "length", "rounding"],
         _ => return None,
     })
 }
@@ -577,18 +610,104 @@ offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
         assert!((crate_pose.rotation.angle() - 0.7).abs() < 1e-12);
     }
 
+    /// Every TOML block of this module's documentation, one after the
+    /// other.
     #[test]
-    fn the_module_doc_example_loads() {
-        let doc: String = include_str!("scene.rs")
-            .lines()
-            .skip_while(|l| !l.starts_with("//! ```toml"))
-            .skip(1)
-            .take_while(|l| !l.starts_with("//! ```"))
-            .map(|l| format!("{}\n", l.trim_start_matches("//!").trim_start()))
-            .collect();
+    fn the_module_doc_examples_load() {
+        let mut doc = String::new();
+        let mut inside = false;
+        for line in include_str!("scene.rs").lines() {
+            match (inside, line.trim_start().strip_prefix("//!")) {
+                (false, Some(l)) if l.trim() == "```toml" => inside = true,
+                (true, Some(l)) if l.trim() == "```" => inside = false,
+                (true, Some(l)) => doc.extend([l.strip_prefix(' ').unwrap_or(l), "\n"]),
+                _ => {}
+            }
+        }
         let scene = Scene::from_toml(&doc).expect("parses");
         let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
-        assert_eq!(scene.install(&mut state).expect("valid").len(), 5);
+        assert_eq!(scene.install(&mut state).expect("valid").len(), 6);
+        let can = state.lookup("can").expect("the cylinder is there");
+        let can = state.object(can).expect("there");
+        let Shape::Convex(c) = &can.shape else {
+            panic!("a cylinder is one piece");
+        };
+        assert_eq!(c.cylinder_dimensions(), Some((0.5, 1.0)));
+        assert_eq!(c.radius(), 0.01);
+    }
+
+    /// A scene cylinder, alone (given by `length`) or as a compound's piece
+    /// (by `half_height`), answers exactly: beside the curved face
+    /// `|centre_xy| - r - r_ball`, beyond a cap `|z| - h - r_ball`.
+    #[test]
+    fn scene_cylinders_are_exact() {
+        let text = r#"
+[[object]]
+name = "can"
+type = "cylinder"
+radius = 0.5
+length = 2.0
+
+[[object]]
+name = "pair"
+type = "compound"
+[[object.pieces]]
+type = "cylinder"
+radius = 0.5
+half_height = 1.0
+offset = { translation = [0.0, 0.0, 10.0] }
+[[object.pieces]]
+type = "sphere"
+radius = 0.1
+"#;
+        let scene = Scene::from_toml(text).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        let ball: Shape = Convex::sphere(0.25).expect("ball").into();
+        let options = gjk::Options::default();
+        let cases = [
+            (ids[0], Vector3::new(1.2, -1.6, 0.3), 2.0 - 0.5 - 0.25),
+            (ids[0], Vector3::new(0.1, 0.2, -3.0), 3.0 - 1.0 - 0.25),
+            (ids[1], Vector3::new(0.0, 3.0, 10.5), 3.0 - 0.5 - 0.25),
+            (ids[1], Vector3::new(0.3, 0.0, 12.0), 2.0 - 1.0 - 0.25),
+        ];
+        for (id, at, want) in cases {
+            let o = state.object(id).expect("there");
+            let pose = Isometry3::translation(at.x, at.y, at.z);
+            let a = gjk::distance(&o.shape, &o.pose, &ball, &pose, &options, None).expect("ok");
+            assert!((a.distance - want).abs() < 1e-12, "{at:?}: {}", a.distance);
+            assert!(a.lower <= want && want <= a.upper);
+        }
+    }
+
+    /// Every bad cylinder is refused with a message naming the problem.
+    #[test]
+    fn bad_scene_cylinders_are_reported() {
+        let can = "[[object]]\nname='c'\ntype='cylinder'\n";
+        let cases = [
+            ("radius=1\nhalf_height=1\nlength=2\n", "one of them"),
+            ("radius=1\n", "one of them"),
+            ("radius=-1\nhalf_height=1\n", "must be finite"),
+            ("radius=1\nlength=-2\n", "must be finite"),
+            ("radius=1\nhalf_height=nan\n", "must be finite"),
+            ("radius=1\nhalf_height=1\nrounding=-0.5\n", "must be finite"),
+            ("radius=4e300\nhalf_height=4e300\n", "at most 5e300"),
+        ];
+        for (keys, message) in cases {
+            let text = format!("{can}{keys}");
+            let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+            let err = Scene::from_toml(&text)
+                .expect("parses")
+                .install(&mut state)
+                .expect_err(keys);
+            assert!(err.to_string().contains(message), "{keys}: {err}");
+            assert_eq!(state.len(), 0, "nothing loaded");
+        }
+        let typo = format!("{can}radius=1\nhalf_height=1\nrounded=0.1\n");
+        match Scene::from_toml(&typo) {
+            Err(SceneError::UnknownKey { key, .. }) => assert_eq!(key, "rounded"),
+            other => panic!("expected UnknownKey, got {other:?}"),
+        }
     }
 
     #[test]
@@ -645,7 +764,48 @@ offset = { translation = [1.0, 0.0, 0.0], quaternion = [0.0, 0.0, 0.0, 2.0] }
         let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
         let ids = scene.install(&mut state).expect("valid");
         assert_eq!(ids.len(), scene.objects.len());
-        assert!(ids.len() >= 5, "the example shows every shape type");
+        assert!(ids.len() >= 7, "the example shows every shape type");
+        let bottle = state.object(state.lookup("bottle").expect("there"));
+        let Some(Shape::Convex(bottle)) = bottle.map(|o| &o.shape) else {
+            panic!("a cylinder is one piece");
+        };
+        assert_eq!(bottle.cylinder_dimensions(), Some((0.04, 0.125)));
+        let rack = state.object(state.lookup("rack").expect("there"));
+        let Some(Shape::Compound(rack)) = rack.map(|o| &o.shape) else {
+            panic!("the rack is a compound");
+        };
+        for (_, piece) in rack.pieces() {
+            assert_eq!(piece.cylinder_dimensions(), Some((0.01, 0.3)));
+            assert_eq!(piece.radius(), 0.002);
+        }
+    }
+
+    /// The README's scene-file example (its one TOML block), with the
+    /// closed form of a ball's distance to its pillar.
+    #[test]
+    fn the_readme_example_loads() {
+        let doc: String = include_str!("../../README.md")
+            .lines()
+            .skip_while(|l| !l.starts_with("```toml"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("```"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let scene = Scene::from_toml(&doc).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        assert_eq!(scene.install(&mut state).expect("valid").len(), 2);
+        let pillar = state
+            .object(state.lookup("pillar").expect("there"))
+            .expect("there");
+        let ball: Shape = Convex::sphere(0.1).expect("ball").into();
+        let at = Isometry3::translation(1.0, 1.5, 0.5);
+        let options = gjk::Options::default();
+        let a = gjk::distance(&pillar.shape, &pillar.pose, &ball, &at, &options, None).expect("ok");
+        assert!(
+            (a.distance - (1.0 - 0.15 - 0.1)).abs() < 1e-12,
+            "{}",
+            a.distance
+        );
     }
 
     #[test]

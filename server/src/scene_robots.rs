@@ -195,7 +195,7 @@ mod tests {
         f 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
 
     const URDF: &str = r#"<robot name="pointer">
-      <link name="post"><collision><geometry><box size="0.2 0.2 1"/></geometry></collision></link>
+      <link name="post"><collision><geometry><cylinder radius="0.1" length="1"/></geometry></collision></link>
       <link name="hand"><collision><geometry>
         <mesh filename="package://pointer/cube.obj" scale="0.1 0.1 0.1"/></geometry></collision></link>
       <joint name="turn" type="revolute"><parent link="post"/><child link="hand"/>
@@ -251,6 +251,23 @@ joints = { turn = 0.5 }
         };
         let max_x = c.vertices().iter().map(|p| p.x).fold(f64::MIN, f64::max);
         assert_eq!(max_x, 2.0);
+        // The post is an exact cylinder at the base pose: a ball beside it
+        // is `2 - 0.1 - 0.25` away, one above its top `0.8 - 0.5 - 0.25`.
+        let post = state.object(state.lookup("pointer/post").unwrap()).unwrap();
+        let gjk::Shape::Convex(c) = &post.shape else {
+            panic!("one element at the link origin is convex")
+        };
+        assert_eq!(c.cylinder_dimensions(), Some((0.1, 0.5)));
+        let ball: gjk::Shape = gjk::Convex::sphere(0.25).unwrap().into();
+        for (at, want) in [
+            (Vector3::new(1.0, 2.0, 0.2), 2.0 - 0.1 - 0.25),
+            (Vector3::new(1.05, 0.0, -0.8), 0.8 - 0.5 - 0.25),
+        ] {
+            let at = Isometry3::translation(at.x, at.y, at.z);
+            let options = gjk::Options::default();
+            let a = gjk::distance(&post.shape, &post.pose, &ball, &at, &options, None).unwrap();
+            assert!((a.distance - want).abs() < 1e-12, "{}", a.distance);
+        }
         let robot = state
             .robots
             .get(state.robots.lookup("pointer").unwrap())
@@ -279,10 +296,6 @@ joints = { turn = 0.5 }
         assert!(e.contains("unknown key `joint`"), "{e}");
         let e = err(&SCENE.replace("file = \"cube.obj\"", "file = \"gone.obj\""));
         assert!(e.contains("gone.obj"), "{e}");
-        let e = err(
-            "[[object]]\nname = \"can\"\ntype = \"cylinder\"\nradius = 1.0\nhalf_height = 2.0\n",
-        );
-        assert!(e.contains("cylinders are not supported yet"), "{e}");
         let e = err(&format!(
             "{SCENE}\n[[object]]\nname = \"pointer\"\ntype = \"sphere\"\nradius = 1.0\n"
         ));

@@ -74,32 +74,111 @@ pub struct StoredConvex {
     pub vertices: Vec<[f64; 3]>,
 }
 
+/// An exact cylinder as stored: its dimensions, as registered.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StoredCylinder {
+    /// Radius of the disk.
+    pub radius: f64,
+    /// Half its length along the piece's z axis.
+    pub half_height: f64,
+    /// Rounding radius.
+    pub rounding: f64,
+}
+
+/// A convex piece of any kind, as stored by the shapes added with
+/// cylinders ([`StoredShape::Piece`], [`StoredShape::Pieces`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StoredPiece {
+    /// A hull of vertices grown by a radius.
+    Hull(StoredConvex),
+    /// An exact cylinder.
+    Cylinder(StoredCylinder),
+}
+
 /// A shape as stored.
+///
+/// postcard writes a variant as its position, so variants are only ever
+/// added at the end: a store written before cylinders holds only the first
+/// two and still loads. A shape without a cylinder is still written with
+/// those two, so a store without cylinders stays readable by a server
+/// older than them; only a shape holding a cylinder takes the last two.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum StoredShape {
-    /// One convex piece.
+    /// One convex hull.
     Convex(StoredConvex),
-    /// Pieces with their offsets, in registration order.
+    /// Hulls with their offsets, in registration order.
     Compound(Vec<(StoredPose, StoredConvex)>),
+    /// One piece of any kind (a cylinder: a hull is written as `Convex`).
+    Piece(StoredPiece),
+    /// Pieces of any kind with their offsets, in registration order (a
+    /// compound with at least one cylinder).
+    Pieces(Vec<(StoredPose, StoredPiece)>),
+}
+
+impl StoredPiece {
+    /// The stored form of `c`.
+    fn of(c: &Convex) -> Self {
+        match c.cylinder_dimensions() {
+            Some((radius, half_height)) => StoredPiece::Cylinder(StoredCylinder {
+                radius,
+                half_height,
+                rounding: c.radius(),
+            }),
+            None => StoredPiece::Hull(StoredConvex {
+                radius: c.radius(),
+                vertices: c.vertices().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            }),
+        }
+    }
+
+    /// The piece, with the checks of a registration.
+    fn to_convex(&self) -> Result<Convex, String> {
+        match self {
+            StoredPiece::Hull(c) => {
+                let points: Vec<Point3<f64>> = c.vertices.iter().map(|&v| v.into()).collect();
+                Convex::new(points, c.radius).map_err(|e| e.to_string())
+            }
+            StoredPiece::Cylinder(c) => {
+                crate::requests::cylinder(c.radius, c.half_height, c.rounding)
+                    .map_err(|e| format!("cylinder {c:?}: {e}"))
+            }
+        }
+    }
 }
 
 impl StoredShape {
-    /// The stored form of `shape`.
+    /// The stored form of `shape`: the old variants unless it holds a
+    /// cylinder.
     pub fn from_shape(shape: &Shape) -> Self {
-        fn convex(c: &Convex) -> StoredConvex {
-            StoredConvex {
-                radius: c.radius(),
-                vertices: c.vertices().iter().map(|p| [p.x, p.y, p.z]).collect(),
-            }
-        }
+        let hull = |p: StoredPiece| match p {
+            StoredPiece::Hull(c) => Ok(c),
+            cylinder => Err(cylinder),
+        };
         match shape {
-            Shape::Convex(c) => StoredShape::Convex(convex(c)),
-            Shape::Compound(c) => StoredShape::Compound(
-                c.pieces()
+            Shape::Convex(c) => match hull(StoredPiece::of(c)) {
+                Ok(c) => StoredShape::Convex(c),
+                Err(p) => StoredShape::Piece(p),
+            },
+            Shape::Compound(c) => {
+                let pieces: Vec<(StoredPose, StoredPiece)> = c
+                    .pieces()
                     .iter()
-                    .map(|(o, p)| (StoredPose::from_isometry(o), convex(p)))
-                    .collect(),
-            ),
+                    .map(|(o, p)| (StoredPose::from_isometry(o), StoredPiece::of(p)))
+                    .collect();
+                if pieces
+                    .iter()
+                    .all(|(_, p)| matches!(p, StoredPiece::Hull(_)))
+                {
+                    StoredShape::Compound(
+                        pieces
+                            .into_iter()
+                            .filter_map(|(o, p)| hull(p).ok().map(|c| (o, c)))
+                            .collect(),
+                    )
+                } else {
+                    StoredShape::Pieces(pieces)
+                }
+            }
         }
     }
 
@@ -108,27 +187,34 @@ impl StoredShape {
     /// # Errors
     /// A description of what is wrong.
     pub fn to_shape(&self) -> Result<Shape, String> {
-        fn convex(c: &StoredConvex) -> Result<Convex, String> {
-            let points: Vec<Point3<f64>> = c.vertices.iter().map(|&v| v.into()).collect();
-            Convex::new(points, c.radius).map_err(|e| e.to_string())
-        }
         match self {
-            StoredShape::Convex(c) => Ok(convex(c)?.into()),
-            StoredShape::Compound(pieces) => {
-                if pieces.len() > gjkd_proto::MAX_PIECES {
-                    return Err(format!("compound of {} pieces", pieces.len()));
-                }
-                let pieces = pieces
+            StoredShape::Convex(c) => Ok(StoredPiece::Hull(c.clone()).to_convex()?.into()),
+            StoredShape::Piece(p) => Ok(p.to_convex()?.into()),
+            StoredShape::Compound(pieces) => compound(
+                pieces
                     .iter()
-                    .map(|(o, c)| {
-                        let offset = o.to_isometry().ok_or("bad piece offset")?;
-                        Ok((offset, convex(c)?))
-                    })
-                    .collect::<Result<Vec<_>, String>>()?;
-                Ok(Compound::new(pieces).map_err(|e| e.to_string())?.into())
+                    .map(|(o, c)| (o, StoredPiece::Hull(c.clone()).to_convex())),
+                pieces.len(),
+            ),
+            StoredShape::Pieces(pieces) => {
+                compound(pieces.iter().map(|(o, p)| (o, p.to_convex())), pieces.len())
             }
         }
     }
+}
+
+/// The compound of `len` stored pieces, with the checks of a registration.
+fn compound<'a>(
+    pieces: impl Iterator<Item = (&'a StoredPose, Result<Convex, String>)>,
+    len: usize,
+) -> Result<Shape, String> {
+    if len > gjkd_proto::MAX_PIECES {
+        return Err(format!("compound of {len} pieces"));
+    }
+    let pieces = pieces
+        .map(|(o, c)| Ok((o.to_isometry().ok_or("bad piece offset")?, c?)))
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(Compound::new(pieces).map_err(|e| e.to_string())?.into())
 }
 
 /// Who owns a stored object; mirrors [`crate::state::Owner`].
@@ -261,4 +347,100 @@ pub fn default_path(service: &str) -> Option<PathBuf> {
         .map(|c| if c == '/' || c == '\0' { '_' } else { c })
         .collect();
     Some(base.join("gjkd").join(format!("{file}.objects")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    fn decode(hex: &str) -> StoredObject {
+        let bytes: Vec<u8> = (0..hex.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).expect("hex"))
+            .collect();
+        match postcard::take_from_bytes(&bytes) {
+            Ok((o, [])) => o,
+            other => panic!("does not decode whole: {other:?}"),
+        }
+    }
+
+    /// Objects exactly as a server before cylinders wrote them (postcard
+    /// bytes captured from that version): a compound of a ball and a
+    /// segment, and a convex ball owned by the scene. They still load,
+    /// and are written back byte for byte as before.
+    #[test]
+    fn objects_written_before_cylinders_still_load() {
+        let compound = "8380808070010501036f6c64000000000000f03f00000000000000c0000000000000e03f000000000000000000000000000000000000000000000000000000000000f03f0102000000000000f03f00000000000000c0000000000000e03f000000000000000000000000000000000000000000000000000000000000f03f000000000000d03f01000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000f03f000000000000000002000000000000f03f000000000000000000000000000000000000000000000000000000000000f03f000000000000000002";
+        let convex = "83808080700000000000000000f03f00000000000000c0000000000000e03f000000000000000000000000000000000000000000000000000000000000f03f00000000000000e03f0100000000000000000000000000000000000000000000f03f02";
+        for (hex, pieces) in [(compound, 2), (convex, 1)] {
+            let o = decode(hex);
+            check_object(7, &o).expect("valid");
+            let shape = o.shape.to_shape().expect("loads");
+            assert_eq!(shape.piece_count(), pieces);
+            assert_eq!(StoredShape::from_shape(&shape), o.shape);
+            let again = postcard::to_stdvec(&o).expect("encodes");
+            let again: String = again.iter().map(|b| format!("{b:02x}")).collect();
+            assert_eq!(again, hex);
+        }
+        let o = decode(compound);
+        assert_eq!((o.id, o.slot), ((7 << 32) | 3, 2));
+        assert_eq!(o.name.as_deref(), Some("old"));
+        let Shape::Compound(c) = o.shape.to_shape().expect("loads") else {
+            panic!("not a compound");
+        };
+        assert_eq!(c.pieces()[0].1.radius(), 0.25);
+        assert_eq!(c.pieces()[1].1.vertices().len(), 2);
+    }
+
+    /// A cylinder, alone or in a compound, round-trips through postcard to
+    /// the same shape; a shape without one keeps the old variants.
+    #[test]
+    fn cylinders_round_trip_and_hulls_keep_the_old_form() {
+        let can = Convex::cylinder(0.5, 2.0, 0.125).expect("valid");
+        let ball = Convex::sphere(0.3).expect("valid");
+        let offset = Isometry3::new(Vector3::new(1.0, 2.0, 3.0), Vector3::new(0.1, 0.2, 0.3));
+        let shapes: [Shape; 3] = [
+            can.clone().into(),
+            Compound::new(vec![
+                (offset, can.clone()),
+                (Isometry3::identity(), ball.clone()),
+            ])
+            .expect("valid")
+            .into(),
+            Compound::new(vec![(offset, ball)]).expect("valid").into(),
+        ];
+        for (shape, kind) in shapes.iter().zip([2u8, 3, 1]) {
+            let stored = StoredShape::from_shape(shape);
+            let bytes = postcard::to_stdvec(&stored).expect("encodes");
+            assert_eq!(bytes[0], kind, "{stored:?}");
+            let back: StoredShape = postcard::from_bytes(&bytes).expect("decodes");
+            assert_eq!(&back.to_shape().expect("valid"), shape);
+        }
+    }
+
+    /// A stored cylinder is held to a registration's rules.
+    #[test]
+    fn bad_stored_cylinders_are_refused() {
+        for (radius, half_height, rounding) in [
+            (-1.0, 1.0, 0.0),
+            (1.0, f64::NAN, 0.0),
+            (1.0, 1.0, -0.5),
+            (4e300, 4e300, 0.0),
+        ] {
+            let c = StoredCylinder {
+                radius,
+                half_height,
+                rounding,
+            };
+            assert!(
+                StoredShape::Piece(StoredPiece::Cylinder(c))
+                    .to_shape()
+                    .is_err()
+            );
+            let pose = StoredPose::from_isometry(&Isometry3::identity());
+            let pieces = StoredShape::Pieces(vec![(pose, StoredPiece::Cylinder(c))]);
+            assert!(pieces.to_shape().is_err(), "{c:?}");
+        }
+    }
 }

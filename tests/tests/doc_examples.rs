@@ -125,3 +125,24 @@ fn compound_example_runs() -> Result<(), gjkd_client::ClientError> {
     assert_eq!(a.pieces, [2, 0]);
     Ok(())
 }
+
+#[test]
+fn cylinder_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-cylinder", &["--no-persist"]);
+    let service = server.service.as_str();
+    // --- from client/src/lib.rs, Client::register_cylinder ---
+    use gjkd_client::{Client, Geometry, QueryOptions};
+    use nalgebra::Isometry3;
+
+    let mut client = Client::connect(service)?;
+    let can = client.register_cylinder(0.5, 1.0, 0.0)?;
+    let ball = client.register_named(
+        "ball",
+        &Geometry::Sphere { radius: 0.25 },
+        &Isometry3::translation(2.0, 0.0, 0.3),
+    )?;
+    // Beside the curved face: 2 - 0.5 - 0.25.
+    let d = client.distance(can, ball, &QueryOptions::default())?.distance;
+    assert!((d - 1.25).abs() < 1e-12);
+    Ok(())
+}

@@ -212,9 +212,10 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
         matches!(&e, ClientError::Model(m) if m.contains("gone.stl")),
         "{e}"
     );
+    // A cylinder is exact, but its sizes are checked like any other.
     let cylinder = URDF.replace(
         r#"<sphere radius="0.03"/>"#,
-        r#"<cylinder radius="0.03" length="0.1"/>"#,
+        r#"<cylinder radius="-0.03" length="0.1"/>"#,
     );
     std::fs::write(dir.join("cylinder.urdf"), cylinder).unwrap();
     let e = client

@@ -54,11 +54,14 @@ class Shape:
     def box(half_extents: _ArrayLike, radius: float = 0.0) -> Shape:
         """A box of these half extents, edges rounded by ``radius``."""
     @staticmethod
+    def cylinder(radius: float, half_height: float, rounding: float = 0.0) -> Shape:
+        """An exact cylinder about the body z axis, rims rounded by ``rounding``."""
+    @staticmethod
     def polytope(vertices: _ArrayLike, radius: float = 0.0) -> Shape:
         """The convex hull of ``(N, 3)`` float64 ``vertices`` grown by ``radius``."""
     @property
     def kind(self) -> str:
-        """``"sphere"``, ``"capsule"``, ``"box"`` or ``"polytope"``."""
+        """``"sphere"``, ``"capsule"``, ``"box"``, ``"cylinder"`` or ``"polytope"``."""
     @property
     def radius(self) -> float:
         """The rounding radius."""
@@ -231,6 +234,16 @@ class _Objects:
         pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a box; returns its id."""
+    def register_cylinder(
+        self,
+        radius: float,
+        half_height: float,
+        rounding: float = 0.0,
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers an exact cylinder about z; returns its id."""
     def register_polytope(
         self,
         vertices: _ArrayLike,

@@ -327,6 +327,25 @@ macro_rules! backend_methods {
                 crate::api::register_shape(self, py, &shape, name, pose)
             }
 
+            /// Registers an exact cylinder about the body z axis, centred on
+            /// the body origin: the disk of `radius` swept from
+            /// `z = -half_height` to `z = +half_height`, its rims rounded by
+            /// `rounding` (each finite and `>= 0`); `name` and `pose` as for
+            /// `register`. Returns its id.
+            #[pyo3(signature = (radius, half_height, rounding = 0.0, *, name = None, pose = None))]
+            fn register_cylinder(
+                &mut self,
+                py: Python<'_>,
+                radius: f64,
+                half_height: f64,
+                rounding: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::cylinder(radius, half_height, rounding);
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
             /// Registers the convex hull of `vertices` (`(N, 3)` float64,
             /// N >= 1) grown by `radius`; `name` and `pose` as for
             /// `register`. Returns its id.

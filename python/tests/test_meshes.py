@@ -166,3 +166,32 @@ def test_mesh_errors(objects: Any, tmp_path: pathlib.Path) -> None:
         objects.register_mesh(v, t, name="mesh-errors-cube")
     assert e.value.code == gjkd.ErrorCode.NAME_TAKEN
     objects.remove(a)
+
+
+def test_cylinders_against_closed_forms(objects: Any) -> None:
+    """A cylinder of radius 0.5, half-height 1 about z (an exact shape, no
+    polytope), against a ball: side, cap and rim distances in closed form."""
+    cyl = objects.register_cylinder(0.5, 1.0)
+    rounded = objects.register_cylinder(0.5, 1.0, 0.1, pose=at(10.0))
+    ball = objects.register_sphere(0.25)
+    for where, want in (
+        ((2.0, 0.0, 0.3), 1.25),
+        ((0.0, -2.0, -0.5), 1.25),
+        ((0.2, 0.1, 3.0), 1.75),
+        ((2.0, 0.0, 2.0), math.hypot(1.5, 1.0) - 0.25),
+        ((math.sqrt(0.5) * 2, math.sqrt(0.5) * 2, 0.0), 2.0 - 0.5 - 0.25),
+    ):
+        objects.set_pose(ball, at(*where))
+        assert abs(objects.distance(cyl, ball).distance - want) < 1e-9, where
+        objects.set_pose(ball, at(where[0] + 10.0, where[1], where[2]))
+        assert abs(objects.distance(rounded, ball).distance - (want - 0.1)) < 1e-9, where
+    # A cylinder piece in a compound, offset along x.
+    shape = gjkd.Shape.cylinder(0.5, 1.0)
+    assert shape.kind == "cylinder" and shape.radius == 0.0 and shape.vertices.shape == (0, 3)
+    comp = objects.register_compound([(at(0.0, 0.0, 20.0), shape)])
+    objects.set_pose(ball, at(2.0, 0.0, 20.0))
+    assert abs(objects.distance(comp, ball).distance - 1.25) < 1e-9
+    for bad in ((-0.5, 1.0, 0.0), (0.5, math.nan, 0.0), (0.5, 1.0, -1.0)):
+        with pytest.raises(gjkd.InvalidInput) as e:
+            objects.register_cylinder(*bad)
+        assert e.value.code == gjkd.ErrorCode.INVALID_RADIUS, bad

@@ -38,6 +38,9 @@ ARM_URDF = """<?xml version="1.0"?>
     </collision>
   </link>
   <link name="tool"/>
+  <link name="pin">
+    <collision><geometry><cylinder radius="0.03" length="0.2"/></geometry></collision>
+  </link>
   <joint name="shoulder" type="revolute">
     <parent link="base"/><child link="upper"/>
     <origin xyz="0 0 0.1" rpy="0 0 0"/>
@@ -59,6 +62,10 @@ ARM_URDF = """<?xml version="1.0"?>
   <joint name="flange" type="fixed">
     <parent link="tip"/><child link="tool"/>
     <origin xyz="0.1 0 0" rpy="0 0 1.5707963267948966"/>
+  </joint>
+  <joint name="pin_mount" type="fixed">
+    <parent link="upper"/><child link="pin"/>
+    <origin xyz="0 0 0.2" rpy="0 0 0"/>
   </joint>
 </robot>
 """
@@ -122,7 +129,8 @@ def hand_fk(q: np.ndarray, base: np.ndarray) -> dict[str, np.ndarray]:
     fore = upper @ trans(0.5, 0, 0) @ rot_y(q[1])
     tip = fore @ trans(0.4, 0, 0) @ trans(q[2], 0, 0)
     tool = tip @ trans(0.1, 0, 0) @ rot_z(math.pi / 2)
-    return {"base": base, "upper": upper, "fore": fore, "tip": tip, "tool": tool}
+    pin = upper @ trans(0, 0, 0.2)
+    return {"base": base, "upper": upper, "fore": fore, "tip": tip, "tool": tool, "pin": pin}
 
 
 def matrix(row: np.ndarray) -> np.ndarray:
@@ -138,15 +146,15 @@ def matrix(row: np.ndarray) -> np.ndarray:
 
 
 def test_links_and_joints(arm: gjkd.Robot) -> None:
-    assert arm.link_names == ["base", "upper", "fore", "tip", "tool"]
+    assert arm.link_names == ["base", "upper", "fore", "tip", "tool", "pin"]
     assert arm.joint_names == ["shoulder", "elbow", "slide"]
-    assert arm.dof == 3 and len(arm) == 5
+    assert arm.dof == 3 and len(arm) == 6
     assert list(arm.positions) == [0.0, 0.0, 0.0]
     assert list(arm.lower) == [-3.14159, -2.0, 0.0]
     assert list(arm.upper) == [3.14159, 2.0, 0.2]
     assert arm.limits()["slide"] == (0.0, 0.2)
     ids = arm.link_ids
-    assert ids.dtype == np.uint64 and ids[4] == 0 and all(ids[:4] > 0)
+    assert ids.dtype == np.uint64 and ids[4] == 0 and all(ids[:4] > 0) and ids[5] > 0
     assert arm.link("tool") is None
     assert arm.link("tip") == ids[3]
     with pytest.raises(gjkd.NotFound) as e:
@@ -188,6 +196,12 @@ def test_set_joints_moves_links_on_the_server(client: gjkd.Client, arm: gjkd.Rob
             client.set_pose(ball, [*p, 0.0, 0.0, 0.0, 1.0])
             d = client.distance(arm.link(link), ball).distance
             assert abs(d - 0.2) < 1e-9, (link, step, d)
+        # The pin, an exact cylinder of radius 0.03: a ball 0.3 out along
+        # its x axis, level with its middle, is 0.3 - 0.03 - 0.05 away.
+        p = frames["pin"][:3, 3] + 0.3 * frames["pin"][:3, 0]
+        client.set_pose(ball, [*p, 0.0, 0.0, 0.0, 1.0])
+        d = client.distance(arm.link("pin"), ball).distance
+        assert abs(d - 0.22) < 1e-9, (step, d)
 
 
 def test_set_joints_by_name_and_clamp(client: gjkd.Client, arm: gjkd.Robot) -> None:

@@ -191,6 +191,11 @@ enum gjkd_shape_kind
   // The convex hull of `vertex_count` points at `vertices` grown by
   // `radius`.
   GJKD_SHAPE_POLYTOPE = 4,
+  // An exact cylinder about the body z axis, centred on the body origin:
+  // the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`, its
+  // rims rounded by `radius` (0 for sharp rims). Never approximated by
+  // a polytope.
+  GJKD_SHAPE_CYLINDER = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -331,7 +336,8 @@ typedef struct gjkd_shape {
   uint32_t kind;
   // Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
   double radius;
-  // Capsule: one end. Box: the half extents, each `>= 0`.
+  // Capsule: one end. Box: the half extents, each `>= 0`. Cylinder:
+  // `{radius, half_height, 0}`, each `>= 0`.
   double a[3];
   // Capsule: the other end.
   double b[3];
@@ -602,6 +608,22 @@ enum gjkd_status gjkd_register_sphere(struct gjkd_client *client,
                                       const char *name,
                                       const struct gjkd_pose *pose,
                                       gjkd_id *out_id);
+
+// Registers an exact cylinder about the body z axis, centred on the body
+// origin: the disk of `radius` swept from `z = -half_height` to
+// `z = +half_height`, its rims rounded by `rounding` (0 for sharp rims).
+// Arguments and errors as `gjkd_register()` (a negative, NaN or infinite
+// size is `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`).
+//
+// # Safety
+// As `gjkd_register()`.
+enum gjkd_status gjkd_register_cylinder(struct gjkd_client *client,
+                                        double radius,
+                                        double half_height,
+                                        double rounding,
+                                        const char *name,
+                                        const struct gjkd_pose *pose,
+                                        gjkd_id *out_id);
 
 // Registers the segment from `a` to `b` (three doubles each) grown by
 // `radius`. Arguments and errors as `gjkd_register()`, plus

@@ -142,7 +142,9 @@ fn cylinder_example_runs() -> Result<(), gjkd_client::ClientError> {
         &Isometry3::translation(2.0, 0.0, 0.3),
     )?;
     // Beside the curved face: 2 - 0.5 - 0.25.
-    let d = client.distance(can, ball, &QueryOptions::default())?.distance;
+    let d = client
+        .distance(can, ball, &QueryOptions::default())?
+        .distance;
     assert!((d - 1.25).abs() < 1e-12);
     Ok(())
 }

@@ -116,7 +116,8 @@ mod open_failure;
 mod robots;
 
 pub use robots::{
-    Kinematics, LimitMode, Mesh, MeshMode, PackagePath, RegisteredMesh, RobotHandle, RobotModel,
+    JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
+    RobotHandle, RobotModel,
 };
 
 use std::time::{Duration, Instant};

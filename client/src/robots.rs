@@ -26,7 +26,7 @@
 use std::path::Path;
 
 use gjk::Shape;
-pub use gjkd_model::{Kinematics, LimitMode, Mesh, PackagePath, RobotModel};
+pub use gjkd_model::{JointError, Kinematics, LimitMode, Mesh, MeshError, PackagePath, RobotModel};
 use gjkd_proto::{
     AdminOp, AdminRequest, ErrorCode, Item, ItemResult, JOINTS_PER_ITEM, ObjectId, Pose,
     lookup_kind, pack_text,
@@ -225,11 +225,30 @@ impl Client {
                     .map_err(|e| ClientError::Model(format!("{}: {e}", p.display())))
             })
             .transpose()?;
-        let model = RobotModel::from_urdf_str(&text, urdf.parent(), packages).map_err(model_err)?;
-        gjkd_model::disabled_pairs(srdf.as_deref(), &model.kinematics, true).map_err(model_err)?;
+        self.register_robot_text(name, &text, srdf.as_deref(), urdf.parent(), packages, base)
+    }
+
+    /// [`Client::register_robot`] from URDF (and SRDF) text in memory, for
+    /// callers that generate it (xacro, a robot description topic):
+    /// relative mesh paths are resolved against `mesh_base` (the working
+    /// folder when `None`), `package://` ones through `packages`.
+    ///
+    /// # Errors
+    /// As [`Client::register_robot`].
+    pub fn register_robot_text(
+        &mut self,
+        name: &str,
+        urdf: &str,
+        srdf: Option<&str>,
+        mesh_base: Option<&Path>,
+        packages: &PackagePath,
+        base: &Isometry3<f64>,
+    ) -> Result<RobotHandle, ClientError> {
+        let model = RobotModel::from_urdf_str(urdf, mesh_base, packages).map_err(model_err)?;
+        gjkd_model::disabled_pairs(srdf, &model.kinematics, true).map_err(model_err)?;
         let mut registered = Vec::new();
         let outcome = self.register_links(name, &model, &mut registered);
-        let outcome = outcome.and_then(|()| self.attach_robot(name, &text, srdf.as_deref(), base));
+        let outcome = outcome.and_then(|()| self.attach_robot(name, urdf, srdf, base));
         if outcome.is_err() {
             for id in registered {
                 let _ = self.remove(id);
@@ -369,18 +388,41 @@ impl Client {
         positions: &[f64],
         base: Option<&Isometry3<f64>>,
     ) -> Result<(), ClientError> {
+        self.set_joints_with(robot, positions, base, LimitMode::Reject)
+    }
+
+    /// [`Client::set_joints`], with positions outside their limits refused
+    /// or moved to the nearest limit as `mode` says; with
+    /// [`LimitMode::Clamp`], [`RobotHandle::positions`] holds the clamped
+    /// positions afterwards.
+    ///
+    /// # Errors
+    /// As [`Client::set_joints`] ([`ErrorCode::OutOfLimits`] only with
+    /// [`LimitMode::Reject`]).
+    pub fn set_joints_with(
+        &mut self,
+        robot: &mut RobotHandle,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        mode: LimitMode,
+    ) -> Result<(), ClientError> {
         if positions.len() != robot.positions.len() || positions.is_empty() {
             return Err(ClientError::InvalidArgument(
                 "one position per moving joint of the robot",
             ));
         }
-        let items = robot.joint_items(positions, base, false);
+        let items = robot.joint_items(positions, base, mode == LimitMode::Clamp);
         let mut results = vec![ItemResult::default(); items.len()];
         self.query_batch(&items, &mut results)?;
         if let Some(r) = results.iter().find(|r| r.error != 0) {
             return Err(ClientError::Rejected(r.error_code()));
         }
         robot.positions.copy_from_slice(positions);
+        // The server accepted them, so they are finite: clamping cannot
+        // fail.
+        let _ = robot
+            .kinematics
+            .check_positions(&mut robot.positions, LimitMode::Clamp);
         Ok(())
     }
 

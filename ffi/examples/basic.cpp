@@ -9,6 +9,9 @@
 // Exits 0 when every answer is within 1e-9 of the analytic one.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include "gjkd.hpp"
@@ -69,6 +72,29 @@ int main(int argc, char **argv) {
         // One pair at a pose given for this query only.
         gjkd::Pose above = gjkd::at(0, 0, 4);
         expect("box-sphere above", client.distance(box, ball, nullptr, &above).distance, 2.5);
+
+        // An exact cylinder: its bottom cap at z = 9, the box's top at 1.
+        gjkd::Id can = client.register_cylinder(0.5, 1.0, 0.0, gjkd::at(0, 0, 10));
+        expect("box-cylinder", client.distance(box, can).distance, 8.0);
+
+        // A robot from URDF: a rod of radius 0.1 hanging 1 below its mount,
+        // swung by one joint, in one round trip per move.
+        const std::string urdf =
+            (std::filesystem::temp_directory_path() / "gjkd-basic-pendulum.urdf").string();
+        std::ofstream(urdf) << R"(<robot name="pendulum">
+  <link name="mount"/>
+  <link name="rod"><collision><origin xyz="0 0 -0.5"/>
+    <geometry><cylinder radius="0.1" length="1"/></geometry></collision></link>
+  <joint name="swing" type="revolute"><parent link="mount"/><child link="rod"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+</robot>)";
+        gjkd::Robot pendulum =
+            client.register_robot("basic-cpp-pendulum", urdf, nullptr, nullptr, gjkd::at(0, 0, 20));
+        gjkd::Id floor_ball = client.register_sphere(0.5, gjkd::at(0, 0, 17));
+        expect("rod hanging", client.distance(pendulum.link("rod"), floor_ball).distance, 1.5);
+        client.set_joints(pendulum, {std::acos(0.0)});
+        expect("rod swung level", client.distance(pendulum.link("rod"), floor_ball).distance, 2.4);
+        std::remove(urdf.c_str());
 
         // A refused call throws, with the status, the server's code and words.
         try {

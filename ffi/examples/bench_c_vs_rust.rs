@@ -8,12 +8,18 @@
 //! It writes `PAIRS` random box pairs, starts the server (pinned to CPU 1;
 //! this process and the C program on CPU 0, so that a spinning server never
 //! shares a core with its client), compiles `bench/round_trip.c` against
-//! this build's `libgjkd_c.a`, and in each round runs the C program then
+//! this build's `libgjkd_c.a`, and in each round runs the C program and
 //! the same measurements in Rust: the p50 of a single-pair round trip
 //! (`gjkd_distance` / `Client::distance`, pair 0 at its stored poses) and
 //! the median per-pair cost of a batch of all pairs, each with its own
 //! poses (`gjkd_distances` / `Client::query_batch`, items built once).
-//! Prints each round and the medians over rounds.
+//! Which side goes first alternates by round. Prints each round, the
+//! medians over rounds, and the median of each round's batch ratio. Then,
+//! since whole rounds on a busy machine differ by more than the two
+//! sides do, the same batch through `gjkd_distances` called in this
+//! process (the C entry point itself, with the C structs) and through the
+//! Rust client, batch by batch, order alternating: the median of each
+//! adjacent pair's ratio.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -241,6 +247,150 @@ impl RustSide {
     }
 }
 
+/// The C API called in this process, beside the Rust client, batch by
+/// batch: both sides see the same moments of a busy machine, so the ratio
+/// of each adjacent pair of batches is robust where whole rounds are not.
+struct InProcessC {
+    client: *mut gjkd_c::gjkd_client,
+    pairs: Vec<u64>,
+    poses_a: Vec<gjkd_c::gjkd_pose>,
+    poses_b: Vec<gjkd_c::gjkd_pose>,
+    /// distance, lower, upper (n each), point_a, point_b, normal (3n each).
+    doubles: Vec<Vec<f64>>,
+    /// status, iterations, error.
+    words: Vec<Vec<u32>>,
+}
+
+impl InProcessC {
+    fn new(service: &str, rows: &[[f64; 20]]) -> Self {
+        use gjkd_c::*;
+        let service = std::ffi::CString::new(service).expect("service name");
+        let mut client = std::ptr::null_mut();
+        let pose = |p: &[f64]| gjkd_pose {
+            translation: [p[0], p[1], p[2]],
+            rotation: [p[3], p[4], p[5], p[6]],
+        };
+        let n = rows.len();
+        let mut pairs = Vec::with_capacity(2 * n);
+        // SAFETY: valid pointers, a live handle.
+        unsafe {
+            let s = gjkd_connect(service.as_ptr(), 5.0, 20.0, &mut client);
+            assert_eq!(s, gjkd_status::GJKD_OK, "connect");
+            for r in rows {
+                for half in [&r[0..3], &r[3..6]] {
+                    let mut id = 0;
+                    let s = gjkd_register_box(
+                        client,
+                        half.as_ptr(),
+                        0.0,
+                        std::ptr::null(),
+                        std::ptr::null(),
+                        &mut id,
+                    );
+                    assert_eq!(s, gjkd_status::GJKD_OK, "register");
+                    pairs.push(id);
+                }
+            }
+        }
+        InProcessC {
+            client,
+            pairs,
+            poses_a: rows.iter().map(|r| pose(&r[6..13])).collect(),
+            poses_b: rows.iter().map(|r| pose(&r[13..20])).collect(),
+            doubles: [1, 1, 1, 3, 3, 3]
+                .iter()
+                .map(|k| vec![0.0; k * n])
+                .collect(),
+            words: vec![vec![0; n]; 3],
+        }
+    }
+
+    /// One `gjkd_distances` of every pair, with the fields `round_trip.c`
+    /// asks for.
+    fn batch(&mut self) {
+        let d = &mut self.doubles;
+        let w = &mut self.words;
+        let out = gjkd_c::gjkd_results {
+            distance: d[0].as_mut_ptr(),
+            lower: d[1].as_mut_ptr(),
+            upper: d[2].as_mut_ptr(),
+            penetration: std::ptr::null_mut(),
+            point_a: d[3].as_mut_ptr(),
+            point_b: d[4].as_mut_ptr(),
+            normal: d[5].as_mut_ptr(),
+            status: w[0].as_mut_ptr(),
+            iterations: w[1].as_mut_ptr(),
+            pieces: std::ptr::null_mut(),
+            error: w[2].as_mut_ptr(),
+            warm_started: std::ptr::null_mut(),
+        };
+        // SAFETY: every array has room for its rows; a live handle.
+        let s = unsafe {
+            gjkd_c::gjkd_distances(
+                self.client,
+                self.pairs.as_ptr(),
+                self.poses_a.len(),
+                self.poses_a.as_ptr(),
+                self.poses_b.as_ptr(),
+                std::ptr::null(),
+                &out,
+            )
+        };
+        assert_eq!(s, gjkd_c::gjkd_status::GJKD_OK, "distances");
+    }
+}
+
+impl Drop for InProcessC {
+    fn drop(&mut self) {
+        // SAFETY: the handle from gjkd_connect, closed once.
+        unsafe { gjkd_c::gjkd_close(self.client) };
+    }
+}
+
+/// `batches` adjacent pairs of batches, C and Rust, their order
+/// alternating: (C median, Rust median, median of the pairs' ratios, C p10,
+/// Rust p10), in ns per pair.
+fn interleaved(c: &mut InProcessC, rust: &mut RustSide, batches: usize) -> [f64; 5] {
+    let per = rust.items.len() as f64;
+    for _ in 0..20 {
+        c.batch();
+        rust.client
+            .query_batch(&rust.items, &mut rust.results)
+            .expect("warm-up");
+    }
+    let (mut tc, mut tr, mut ratio) = (vec![], vec![], vec![]);
+    for k in 0..batches {
+        let mut time_c = || {
+            let start = Instant::now();
+            c.batch();
+            start.elapsed().as_nanos() as f64 / per
+        };
+        let mut time_rust = || {
+            let start = Instant::now();
+            let r = rust.client.query_batch(&rust.items, &mut rust.results);
+            let ns = start.elapsed().as_nanos() as f64 / per;
+            r.expect("batch");
+            ns
+        };
+        let (a, b) = if k % 2 == 0 {
+            let a = time_c();
+            (a, time_rust())
+        } else {
+            let b = time_rust();
+            (time_c(), b)
+        };
+        tc.push(a);
+        tr.push(b);
+        ratio.push(a / b);
+    }
+    let p10 = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 10]
+    };
+    let (pc, pr) = (p10(&mut tc), p10(&mut tr));
+    [median(&mut tc), median(&mut tr), median(&mut ratio), pc, pr]
+}
+
 fn spawn_server(service: &str) -> Child {
     let child = Command::new(gjkd_e2e::gjkd_binary())
         .args([
@@ -292,15 +442,30 @@ fn main() {
     );
     println!("round   C single p50  Rust single p50   C batch/pair  Rust batch/pair   (ns)");
     let (mut cs, mut rs, mut cb, mut rb) = (vec![], vec![], vec![], vec![]);
+    let mut ratios = vec![];
     for round in 0..rounds {
-        let (c_single, c_batch) = run_c(&exe, &service, &file, singles, batches);
-        let r_single = rust.single_p50(singles);
-        let r_batch = rust.batch_per_pair(batches);
+        // Which side goes first alternates, so that whatever the first or
+        // second place in a round costs (a server cache, a clock ramping)
+        // falls on both sides alike.
+        let (c_single, c_batch, r_single, r_batch) = if round % 2 == 0 {
+            let (cs, cb) = run_c(&exe, &service, &file, singles, batches);
+            (
+                cs,
+                cb,
+                rust.single_p50(singles),
+                rust.batch_per_pair(batches),
+            )
+        } else {
+            let (rs, rb) = (rust.single_p50(singles), rust.batch_per_pair(batches));
+            let (cs, cb) = run_c(&exe, &service, &file, singles, batches);
+            (cs, cb, rs, rb)
+        };
         println!("{round:>5} {c_single:>14.0} {r_single:>16.0} {c_batch:>14.1} {r_batch:>16.1}");
         cs.push(c_single);
         rs.push(r_single);
         cb.push(c_batch);
         rb.push(r_batch);
+        ratios.push(c_batch / r_batch);
     }
     let (cs, rs, cb, rb) = (
         median(&mut cs),
@@ -310,10 +475,22 @@ fn main() {
     );
     println!("median {cs:>13.0} {rs:>16.0} {cb:>14.1} {rb:>16.1}");
     println!(
-        "single: C - Rust = {:+.0} ns (target <= +200); batch: C / Rust = {:.3} (target <= 1.1)",
+        "single: C - Rust = {:+.0} ns (target <= +200); batch: C / Rust = {:.3} (target <= 1.1), \
+         median of the rounds' own ratios {:.3}",
         cs - rs,
-        cb / rb
+        cb / rb,
+        median(&mut ratios)
     );
+    let mut in_process = InProcessC::new(&service, &rows);
+    let [c, r, ratio, c10, r10] = interleaved(&mut in_process, &mut rust, batches * rounds);
+    println!(
+        "in process, {} adjacent batch pairs: C {c:.1} ns/pair, Rust {r:.1} (p10 {c10:.1}, {r10:.1}); \
+         C / Rust = {:.3}, median of the pairs' ratios {ratio:.3}, of the p10s {:.3}",
+        batches * rounds,
+        c / r,
+        c10 / r10
+    );
+    drop(in_process);
     drop(rust);
     let _ = server.kill();
     let _ = server.wait();

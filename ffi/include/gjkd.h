@@ -191,6 +191,11 @@ enum gjkd_shape_kind
   // The convex hull of `vertex_count` points at `vertices` grown by
   // `radius`.
   GJKD_SHAPE_POLYTOPE = 4,
+  // An exact cylinder about the body z axis, centred on the body origin:
+  // the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`, its
+  // rims rounded by `radius` (0 for sharp rims). Never approximated by
+  // a polytope.
+  GJKD_SHAPE_CYLINDER = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -224,6 +229,13 @@ typedef uint32_t gjkd_precision;
 // A connection to a gjkd server. Opaque: create it with `gjkd_connect()`,
 // use it from the thread that created it, free it with `gjkd_close()`.
 typedef struct gjkd_client gjkd_client;
+
+// A robot registered on a server: its links (objects) and moving joints.
+// Opaque: made by `gjkd_register_robot()`, `gjkd_register_robot_text()`
+// or `gjkd_open_robot()`, freed with `gjkd_robot_free()`. It holds no
+// connection: any handle to the same server may move it, from any thread
+// (one call at a time).
+typedef struct gjkd_robot gjkd_robot;
 
 // What the server said about itself at the last (re)connection.
 typedef struct gjkd_info {
@@ -292,25 +304,6 @@ typedef struct gjkd_query_options {
   bool warm_start;
 } gjkd_query_options;
 
-// A convex shape, in its body frame. Fields a kind does not use are
-// ignored.
-typedef struct gjkd_shape {
-  // A `gjkd_shape_kind` value.
-  uint32_t kind;
-  // Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
-  double radius;
-  // Capsule: one end. Box: the half extents, each `>= 0`.
-  double a[3];
-  // Capsule: the other end.
-  double b[3];
-  // Polytope: `3 * vertex_count` doubles, `x, y, z` per vertex. Read
-  // during the call only. May be NULL when `vertex_count` is 0 (which
-  // the server refuses with `GJKD_CODE_EMPTY_VERTICES`).
-  const double *vertices;
-  // Polytope: number of vertices.
-  size_t vertex_count;
-} gjkd_shape;
-
 // A rigid pose: translation, then rotation quaternion `[qx, qy, qz, qw]`.
 // Laid out as 7 consecutive doubles `[x, y, z, qx, qy, qz, qw]`, so an
 // array of `double[7]` rows can be passed as an array of poses. The
@@ -324,6 +317,37 @@ typedef struct gjkd_pose {
 
 // Identifier of a registered object (never 0 for a real object).
 typedef uint64_t gjkd_id;
+
+// What a mesh registration made (`out_info` of `gjkd_register_mesh()`).
+typedef struct gjkd_mesh_info {
+  // Convex pieces: 1 for a hull.
+  size_t pieces;
+  // For a decomposition, the largest distance found by which the
+  // pieces reach beyond the mesh (so how much less distance they may
+  // report); 0 for a hull, which never reaches closer than the mesh's
+  // own convex hull.
+  double deviation;
+} gjkd_mesh_info;
+
+// A convex shape, in its body frame. Fields a kind does not use are
+// ignored.
+typedef struct gjkd_shape {
+  // A `gjkd_shape_kind` value.
+  uint32_t kind;
+  // Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
+  double radius;
+  // Capsule: one end. Box: the half extents, each `>= 0`. Cylinder:
+  // `{radius, half_height, 0}`, each `>= 0`.
+  double a[3];
+  // Capsule: the other end.
+  double b[3];
+  // Polytope: `3 * vertex_count` doubles, `x, y, z` per vertex. Read
+  // during the call only. May be NULL when `vertex_count` is 0 (which
+  // the server refuses with `GJKD_CODE_EMPTY_VERTICES`).
+  const double *vertices;
+  // Polytope: number of vertices.
+  size_t vertex_count;
+} gjkd_shape;
 
 // A convex piece of a compound, placed in the compound's body frame.
 typedef struct gjkd_piece {
@@ -492,6 +516,57 @@ uint32_t gjkd_protocol_version(void);
 // double precision.
 struct gjkd_query_options gjkd_query_options_default(void);
 
+// Registers the triangle mesh in the file at `path` (binary or ASCII STL,
+// OBJ, COLLADA `.dae`) and writes its id to `*out_id`.
+//
+// - `scale`: NULL for none, or three doubles (per axis; finite, non-zero).
+// - `decompose`: 0 for the mesh's convex hull (one convex object, which
+//   never reports more distance than the mesh), or a V-HACD resolution
+//   (64 is a fair start): a compound of convex pieces that follows a
+//   non-convex mesh.
+// - `name`, `pose`, `out_id`: as for `gjkd_register()`.
+// - `out_info`: NULL, or receives the pieces and the deviation.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `path`, `out_id`),
+// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a file missing or
+// not a mesh, a bad scale, a decomposition that finds no pieces, a bad
+// pose or name; the message says which), `GJKD_ERR_REJECTED` with the
+// codes of `gjkd_register()` (`GJKD_CODE_TOO_MANY_PIECES` for a
+// decomposition of more than `GJKD_MAX_PIECES` pieces: use a coarser
+// resolution); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
+//
+// # Safety
+// Every non-NULL pointer points to what its parameter says.
+enum gjkd_status gjkd_register_mesh_file(struct gjkd_client *client,
+                                         const char *path,
+                                         const double *scale,
+                                         uint32_t decompose,
+                                         const char *name,
+                                         const struct gjkd_pose *pose,
+                                         gjkd_id *out_id,
+                                         struct gjkd_mesh_info *out_info);
+
+// Registers the triangle mesh of `vertex_count` vertices (`3 *
+// vertex_count` doubles, `x, y, z` each) and `triangle_count` triangles
+// (`3 * triangle_count` vertex indices; may be NULL with a count of 0 for
+// a hull, a decomposition needs them). Other arguments and errors as
+// `gjkd_register_mesh_file()`; an index out of range, a NaN vertex or no
+// vertices are `GJKD_ERR_INVALID_ARGUMENT`.
+//
+// # Safety
+// Every non-NULL pointer points to what its parameter says.
+enum gjkd_status gjkd_register_mesh(struct gjkd_client *client,
+                                    const double *vertices,
+                                    size_t vertex_count,
+                                    const uint32_t *triangles,
+                                    size_t triangle_count,
+                                    const double *scale,
+                                    uint32_t decompose,
+                                    const char *name,
+                                    const struct gjkd_pose *pose,
+                                    gjkd_id *out_id,
+                                    struct gjkd_mesh_info *out_info);
+
 // Registers a convex `shape` and writes its id to `*out_id`.
 //
 // - `shape`: read during the call only (its vertices too).
@@ -533,6 +608,22 @@ enum gjkd_status gjkd_register_sphere(struct gjkd_client *client,
                                       const char *name,
                                       const struct gjkd_pose *pose,
                                       gjkd_id *out_id);
+
+// Registers an exact cylinder about the body z axis, centred on the body
+// origin: the disk of `radius` swept from `z = -half_height` to
+// `z = +half_height`, its rims rounded by `rounding` (0 for sharp rims).
+// Arguments and errors as `gjkd_register()` (a negative, NaN or infinite
+// size is `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`).
+//
+// # Safety
+// As `gjkd_register()`.
+enum gjkd_status gjkd_register_cylinder(struct gjkd_client *client,
+                                        double radius,
+                                        double half_height,
+                                        double rounding,
+                                        const char *name,
+                                        const struct gjkd_pose *pose,
+                                        gjkd_id *out_id);
 
 // Registers the segment from `a` to `b` (three doubles each) grown by
 // `radius`. Arguments and errors as `gjkd_register()`, plus
@@ -708,6 +799,197 @@ enum gjkd_status gjkd_distances(struct gjkd_client *client,
                                 const struct gjkd_pose *poses_b,
                                 const struct gjkd_query_options *options,
                                 const struct gjkd_results *out);
+
+// Registers a robot from the URDF file at `urdf_path`: each link with
+// collision geometry (boxes, spheres, cylinders, meshes; several elements
+// make a compound) becomes an object named `<name>/<link>`, then the
+// server holds the robot's kinematics and puts it at `base` (NULL:
+// identity) with every joint at zero (within its limits). Writes a new
+// robot to `*out_robot` (free it with `gjkd_robot_free()`; NULL on
+// failure).
+//
+// - `srdf_path`: NULL, or an SRDF file whose `disable_collisions` pairs
+//   the server keeps for the robot.
+// - `package_path`: NULL, or folders separated by `:` where `package://`
+//   mesh URLs are searched (then `$GJKD_PACKAGE_PATH`,
+//   `$ROS_PACKAGE_PATH`). Relative mesh paths are relative to the URDF's
+//   folder.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_path`,
+// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a
+// URDF, SRDF or mesh that cannot be read: the message names the file,
+// link or joint; a bad base pose), `GJKD_ERR_REJECTED` with
+// `GJKD_CODE_NAME_TAKEN` (an object `<name>/<link>` exists),
+// `GJKD_CODE_INVALID_ROBOT` and the codes of `gjkd_register()`;
+// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`. Link objects registered
+// before a failure are removed again.
+//
+// # Safety
+// Every non-NULL pointer points to what its parameter says; strings are
+// NUL-terminated.
+enum gjkd_status gjkd_register_robot(struct gjkd_client *client,
+                                     const char *name,
+                                     const char *urdf_path,
+                                     const char *srdf_path,
+                                     const char *package_path,
+                                     const struct gjkd_pose *base,
+                                     struct gjkd_robot **out_robot);
+
+// `gjkd_register_robot()` from URDF text (and SRDF text, or NULL) in
+// memory; relative mesh paths are relative to `mesh_dir` (NULL: the
+// working folder). Errors as `gjkd_register_robot()` (`urdf_text`
+// instead of `urdf_path`).
+//
+// # Safety
+// As `gjkd_register_robot()`.
+enum gjkd_status gjkd_register_robot_text(struct gjkd_client *client,
+                                          const char *name,
+                                          const char *urdf_text,
+                                          const char *srdf_text,
+                                          const char *mesh_dir,
+                                          const char *package_path,
+                                          const struct gjkd_pose *base,
+                                          struct gjkd_robot **out_robot);
+
+// The robot named `name` already on the server (one the server's scene
+// file loaded, or another client registered), given its URDF text for
+// the joint order and link names. Writes a new robot to `*out_robot`.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_text`,
+// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT`
+// (URDF text that cannot be read), `GJKD_ERR_REJECTED` with
+// `GJKD_CODE_UNKNOWN_NAME`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
+//
+// # Safety
+// As `gjkd_register_robot()`.
+enum gjkd_status gjkd_open_robot(struct gjkd_client *client,
+                                 const char *name,
+                                 const char *urdf_text,
+                                 struct gjkd_robot **out_robot);
+
+// Frees a robot (the robot stays on the server). NULL is allowed.
+//
+// # Safety
+// `robot` is NULL or from this library, not yet freed.
+enum gjkd_status gjkd_robot_free(struct gjkd_robot *robot);
+
+// The robot's id and its numbers of links and moving joints (each
+// output may be NULL).
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`robot`).
+//
+// # Safety
+// `robot` is NULL or live; the outputs NULL or writable.
+enum gjkd_status gjkd_robot_info(const struct gjkd_robot *robot,
+                                 gjkd_id *out_id,
+                                 size_t *out_links,
+                                 size_t *out_joints);
+
+// Link `index` (in the URDF's order, `0 <= index < links`): its name
+// (owned by the robot, valid until `gjkd_robot_free()`) and its object id
+// (0 for a link without collision geometry). Either output may be NULL.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`robot`), `GJKD_ERR_INVALID_ARGUMENT`
+// (`index` out of range).
+//
+// # Safety
+// `robot` is NULL or live; the outputs NULL or writable.
+enum gjkd_status gjkd_robot_link(const struct gjkd_robot *robot,
+                                 size_t index,
+                                 const char **out_name,
+                                 gjkd_id *out_id);
+
+// The object id of the link named `name` (0 for a link without collision
+// geometry).
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`robot`, `name`, `out_id`),
+// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_NAME` (no link of that
+// name).
+//
+// # Safety
+// `robot` is NULL or live; `name` NULL or NUL-terminated; `out_id` NULL
+// or writable.
+enum gjkd_status gjkd_robot_link_id(const struct gjkd_robot *robot,
+                                    const char *name,
+                                    gjkd_id *out_id);
+
+// Moving joint `index` (in position-array order): its name (owned by the
+// robot, valid until `gjkd_robot_free()`), its limits (`-inf`, `inf` for
+// a continuous joint) and its position last set. Any output may be NULL.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`robot`), `GJKD_ERR_INVALID_ARGUMENT`
+// (`index` out of range).
+//
+// # Safety
+// `robot` is NULL or live; the outputs NULL or writable.
+enum gjkd_status gjkd_robot_joint(const struct gjkd_robot *robot,
+                                  size_t index,
+                                  const char **out_name,
+                                  double *out_lower,
+                                  double *out_upper,
+                                  double *out_position);
+
+// Sets every moving joint of `robot` (`count` positions in joint order,
+// see `gjkd_robot_joint()`) and, if `base` is not NULL, its base pose, in
+// one round trip: the server places every link by forward kinematics. A
+// position outside its limits is refused, or moved to the nearest limit
+// when `clamp` is true.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
+// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
+// number of moving joints; a position NaN or infinite, last error code
+// `GJKD_CODE_NON_FINITE_POSE`; outside its limits without `clamp`,
+// `GJKD_CODE_OUT_OF_LIMITS`; the message names the joint; a bad base
+// pose), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT` (the robot
+// or a link is gone); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
+// Nothing moves on error.
+//
+// # Safety
+// `client` and `robot` are NULL or live; `positions` NULL or `count`
+// doubles; `base` NULL or readable.
+enum gjkd_status gjkd_set_joints(struct gjkd_client *client,
+                                 struct gjkd_robot *robot,
+                                 const double *positions,
+                                 size_t count,
+                                 const struct gjkd_pose *base,
+                                 bool clamp);
+
+// `gjkd_set_joints()` by joint name: `names[i]` gets `values[i]`, joints
+// not named keep their positions last set.
+//
+// Errors: as `gjkd_set_joints()`, plus `GJKD_ERR_NULL_POINTER` (`names`,
+// a name, `values`) and `GJKD_ERR_INVALID_ARGUMENT` for a name that is no
+// moving joint.
+//
+// # Safety
+// `names` NULL or `count` pointers to NUL-terminated strings, `values`
+// NULL or `count` doubles; others as `gjkd_set_joints()`.
+enum gjkd_status gjkd_set_joints_by_name(struct gjkd_client *client,
+                                         struct gjkd_robot *robot,
+                                         const char *const *names,
+                                         const double *values,
+                                         size_t count,
+                                         bool clamp);
+
+// Every link's pose by forward kinematics, computed here as the server
+// computes it, into `out_poses` (`out_count` must be the number of
+// links; URDF order): for `count` positions (NULL with 0: the positions
+// last set) and `base` (NULL: the base last sent, identity at first).
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`robot`, `out_poses`),
+// `GJKD_ERR_INVALID_ARGUMENT` (wrong counts; positions refused as by
+// `gjkd_set_joints()`, same codes).
+//
+// # Safety
+// `robot` NULL or live; `positions` NULL or `count` doubles; `base` NULL
+// or readable; `out_poses` NULL or room for `out_count` poses.
+enum gjkd_status gjkd_robot_link_poses(const struct gjkd_robot *robot,
+                                       const double *positions,
+                                       size_t count,
+                                       const struct gjkd_pose *base,
+                                       bool clamp,
+                                       struct gjkd_pose *out_poses,
+                                       size_t out_count);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -156,6 +156,72 @@ public:
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
 
+/// A robot registered from URDF (see Client::register_robot): its links
+/// are objects, its joints move them. Owns its gjkd_robot; holds no
+/// connection.
+class Robot {
+public:
+    /// Takes ownership of `handle` (from gjkd_register_robot() and kin).
+    explicit Robot(gjkd_robot *handle) : handle_(handle) {}
+    ~Robot() { gjkd_robot_free(handle_); }
+    Robot(const Robot &) = delete;
+    Robot &operator=(const Robot &) = delete;
+    Robot(Robot &&other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    Robot &operator=(Robot &&other) noexcept {
+        if (this != &other) {
+            gjkd_robot_free(handle_);
+            handle_ = std::exchange(other.handle_, nullptr);
+        }
+        return *this;
+    }
+
+    /// The C handle; still owned here.
+    gjkd_robot *native_handle() const noexcept { return handle_; }
+    /// The robot's object id.
+    Id id() const { return info().id; }
+    /// Number of moving joints.
+    std::size_t dof() const { return info().joints; }
+    /// Every link's name, in the URDF's order.
+    std::vector<std::string> link_names() const {
+        std::vector<std::string> names(info().links);
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const char *name = nullptr;
+            check(gjkd_robot_link(handle_, i, &name, nullptr));
+            names[i] = name;
+        }
+        return names;
+    }
+    /// The moving joints' names, in position-array order.
+    std::vector<std::string> joint_names() const {
+        std::vector<std::string> names(info().joints);
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const char *name = nullptr;
+            check(gjkd_robot_joint(handle_, i, &name, nullptr, nullptr, nullptr));
+            names[i] = name;
+        }
+        return names;
+    }
+    /// The object id of link `name` (0 for a link without geometry).
+    Id link(const std::string &name) const {
+        Id id = 0;
+        check(gjkd_robot_link_id(handle_, name.c_str(), &id));
+        return id;
+    }
+
+private:
+    struct Info {
+        Id id;
+        std::size_t links, joints;
+    };
+    Info info() const {
+        Info i{};
+        check(gjkd_robot_info(handle_, &i.id, &i.links, &i.joints));
+        return i;
+    }
+
+    gjkd_robot *handle_ = nullptr;
+};
+
 /// A connection to a gjkd server. Every method throws gjkd::Error on
 /// failure; see gjkd.h for each call's errors.
 class Client {
@@ -216,6 +282,42 @@ public:
         Id id = 0;
         check(gjkd_register_compound(handle_, pieces.data(), pieces.size(), name, &pose, &id));
         return id;
+    }
+    /// Registers an exact cylinder about z: the disk of `radius` swept over
+    /// `[-half_height, half_height]`, rims rounded by `rounding`.
+    Id register_cylinder(double radius, double half_height, double rounding = 0.0,
+                         const Pose &pose = identity(), const char *name = nullptr) {
+        Id id = 0;
+        check(gjkd_register_cylinder(handle_, radius, half_height, rounding, name, &pose, &id));
+        return id;
+    }
+    /// Registers the mesh in an STL, OBJ or COLLADA file, scaled by `scale`
+    /// (null: 1), as its hull (`decompose` 0) or a V-HACD decomposition at
+    /// that resolution.
+    Id register_mesh_file(const std::string &path, const Vec3 *scale = nullptr,
+                          uint32_t decompose = 0, const Pose &pose = identity(),
+                          const char *name = nullptr) {
+        Id id = 0;
+        check(gjkd_register_mesh_file(handle_, path.c_str(), scale ? scale->data() : nullptr,
+                                      decompose, name, &pose, &id, nullptr));
+        return id;
+    }
+    /// Registers a robot from a URDF file (`srdf` and `package_path`, a
+    /// `:`-separated folder list, may be null).
+    Robot register_robot(const std::string &name, const std::string &urdf_path,
+                         const char *srdf_path = nullptr, const char *package_path = nullptr,
+                         const Pose &base = identity()) {
+        gjkd_robot *robot = nullptr;
+        check(gjkd_register_robot(handle_, name.c_str(), urdf_path.c_str(), srdf_path,
+                                  package_path, &base, &robot));
+        return Robot(robot);
+    }
+    /// Sets every joint of `robot` (and its base, if not null) in one round
+    /// trip; out-of-limit positions throw unless `clamp`.
+    void set_joints(Robot &robot, const std::vector<double> &positions,
+                    const Pose *base = nullptr, bool clamp = false) {
+        check(gjkd_set_joints(handle_, robot.native_handle(), positions.data(),
+                              positions.size(), base, clamp));
     }
     /// Removes an object this client registered.
     void remove(Id id) { check(gjkd_remove(handle_, id)); }

@@ -25,15 +25,19 @@
 mod args;
 mod connect;
 mod handle;
+mod meshes;
 mod objects;
 mod query;
+mod robots;
 mod status;
 mod types;
 
 pub use connect::*;
 pub use handle::gjkd_client;
+pub use meshes::*;
 pub use objects::*;
 pub use query::*;
+pub use robots::*;
 pub use status::gjkd_status;
 pub use types::*;
 

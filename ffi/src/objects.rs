@@ -18,6 +18,8 @@ enum Convex {
     Sphere(f64),
     Capsule([f64; 3], [f64; 3], f64),
     Box([f64; 3], f64),
+    /// Radius, half-height, rounding.
+    Cylinder(f64, f64, f64),
     Polytope(Range<usize>, f64),
 }
 
@@ -37,6 +39,9 @@ impl Convex {
             k if k == GJKD_SHAPE_SPHERE as u32 => Convex::Sphere(shape.radius),
             k if k == GJKD_SHAPE_CAPSULE as u32 => Convex::Capsule(shape.a, shape.b, shape.radius),
             k if k == GJKD_SHAPE_BOX as u32 => Convex::Box(shape.a, shape.radius),
+            k if k == GJKD_SHAPE_CYLINDER as u32 => {
+                Convex::Cylinder(shape.a[0], shape.a[1], shape.radius)
+            }
             k if k == GJKD_SHAPE_POLYTOPE as u32 => {
                 let name = format!("{what}.vertices");
                 // SAFETY: the caller's promise.
@@ -66,6 +71,11 @@ impl Convex {
             Convex::Box(h, radius) => Geometry::Cuboid {
                 half_extents: Vector3::from(h),
                 radius,
+            },
+            Convex::Cylinder(radius, half_height, rounding) => Geometry::Cylinder {
+                radius,
+                half_height,
+                rounding,
             },
             Convex::Polytope(ref range, radius) => Geometry::Polytope {
                 vertices: &points[range.clone()],
@@ -208,6 +218,36 @@ pub unsafe extern "C" fn gjkd_register_sphere(
     unsafe {
         register_entry("gjkd_register_sphere", client, name, pose, out_id, |_| {
             Ok(Built::Convex(Convex::Sphere(radius)))
+        })
+    }
+}
+
+/// Registers an exact cylinder about the body z axis, centred on the body
+/// origin: the disk of `radius` swept from `z = -half_height` to
+/// `z = +half_height`, its rims rounded by `rounding` (0 for sharp rims).
+/// Arguments and errors as `gjkd_register()` (a negative, NaN or infinite
+/// size is `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`).
+///
+/// # Safety
+/// As `gjkd_register()`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn gjkd_register_cylinder(
+    client: *mut gjkd_client,
+    radius: f64,
+    half_height: f64,
+    rounding: f64,
+    name: *const c_char,
+    pose: *const gjkd_pose,
+    out_id: *mut gjkd_id,
+) -> gjkd_status {
+    // SAFETY: forwarded.
+    unsafe {
+        register_entry("gjkd_register_cylinder", client, name, pose, out_id, |_| {
+            Ok(Built::Convex(Convex::Cylinder(
+                radius,
+                half_height,
+                rounding,
+            )))
         })
     }
 }

@@ -72,6 +72,11 @@ pub enum gjkd_shape_kind {
     /// The convex hull of `vertex_count` points at `vertices` grown by
     /// `radius`.
     GJKD_SHAPE_POLYTOPE = 4,
+    /// An exact cylinder about the body z axis, centred on the body origin:
+    /// the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`, its
+    /// rims rounded by `radius` (0 for sharp rims). Never approximated by
+    /// a polytope.
+    GJKD_SHAPE_CYLINDER = 5,
 }
 
 /// A convex shape, in its body frame. Fields a kind does not use are
@@ -83,7 +88,8 @@ pub struct gjkd_shape {
     pub kind: u32,
     /// Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
     pub radius: f64,
-    /// Capsule: one end. Box: the half extents, each `>= 0`.
+    /// Capsule: one end. Box: the half extents, each `>= 0`. Cylinder:
+    /// `{radius, half_height, 0}`, each `>= 0`.
     pub a: [f64; 3],
     /// Capsule: the other end.
     pub b: [f64; 3],

@@ -55,6 +55,7 @@ from ._native import (
     Client,
     Distances,
     Local,
+    Robot,
     Shape,
 )
 from .server import Server
@@ -78,6 +79,7 @@ __all__ = [
     "NotFound",
     "ProtocolError",
     "Refused",
+    "Robot",
     "Server",
     "ServerGone",
     "Shape",

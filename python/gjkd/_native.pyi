@@ -1,7 +1,8 @@
 """Type stubs of the native module ``gjkd._native`` (see ``gjkd``)."""
 
+from os import PathLike
 from types import TracebackType
-from typing import Optional, Sequence, Tuple, Type
+from typing import Mapping, Optional, Sequence, Tuple, Type, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +18,7 @@ __all__ = [
     "MAX_NAME_LEN",
     "MAX_PIECES",
     "PROTOCOL_VERSION",
+    "Robot",
     "Shape",
     "error_codes",
     "serve",
@@ -32,6 +34,8 @@ _ArrayLike = npt.ArrayLike
 _Pose = npt.ArrayLike
 """A pose: ``(7,)`` ``[x, y, z, qx, qy, qz, qw]`` or a ``(4, 4)`` rigid
 transform, float64."""
+
+_Path = Union[str, "PathLike[str]"]
 
 _F64 = npt.NDArray[np.float64]
 _U32 = npt.NDArray[np.uint32]
@@ -50,17 +54,65 @@ class Shape:
     def box(half_extents: _ArrayLike, radius: float = 0.0) -> Shape:
         """A box of these half extents, edges rounded by ``radius``."""
     @staticmethod
+    def cylinder(radius: float, half_height: float, rounding: float = 0.0) -> Shape:
+        """An exact cylinder about the body z axis, rims rounded by ``rounding``."""
+    @staticmethod
     def polytope(vertices: _ArrayLike, radius: float = 0.0) -> Shape:
         """The convex hull of ``(N, 3)`` float64 ``vertices`` grown by ``radius``."""
     @property
     def kind(self) -> str:
-        """``"sphere"``, ``"capsule"``, ``"box"`` or ``"polytope"``."""
+        """``"sphere"``, ``"capsule"``, ``"box"``, ``"cylinder"`` or ``"polytope"``."""
     @property
     def radius(self) -> float:
         """The rounding radius."""
     @property
     def vertices(self) -> _F64:
         """``(N, 3)`` vertices in the order the server stores them."""
+
+@final
+class Robot:
+    """A robot registered from URDF: its links are objects, its joints move them."""
+
+    @property
+    def id(self) -> int:
+        """The robot's object id on the server."""
+    @property
+    def name(self) -> str:
+        """The name it was registered under."""
+    @property
+    def link_names(self) -> list[str]:
+        """Every link's name, in the URDF's order."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The moving joints' names, in position-array order."""
+    @property
+    def dof(self) -> int:
+        """Number of moving joints."""
+    @property
+    def link_ids(self) -> npt.NDArray[np.uint64]:
+        """``(L,)`` each link's object id, 0 for a link without geometry."""
+    @property
+    def positions(self) -> _F64:
+        """``(dof,)`` the joint positions last set."""
+    @property
+    def lower(self) -> _F64:
+        """``(dof,)`` lower joint limits."""
+    @property
+    def upper(self) -> _F64:
+        """``(dof,)`` upper joint limits."""
+    def link(self, name: str) -> Optional[int]:
+        """The object id of link ``name``; ``None`` without geometry."""
+    def link_poses(
+        self,
+        positions: Optional[Union[_ArrayLike, Mapping[str, float]]] = None,
+        base: Optional[_Pose] = None,
+        *,
+        clamp: bool = False,
+    ) -> _F64:
+        """``(L, 7)`` link poses by forward kinematics."""
+    def limits(self) -> dict[str, tuple[float, float]]:
+        """``{joint: (lower, upper)}`` of the moving joints."""
+    def __len__(self) -> int: ...
 
 @final
 class Answer:
@@ -182,6 +234,16 @@ class _Objects:
         pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a box; returns its id."""
+    def register_cylinder(
+        self,
+        radius: float,
+        half_height: float,
+        rounding: float = 0.0,
+        *,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers an exact cylinder about z; returns its id."""
     def register_polytope(
         self,
         vertices: _ArrayLike,
@@ -199,6 +261,27 @@ class _Objects:
         pose: Optional[_Pose] = None,
     ) -> int:
         """Registers a union of ``(offset, Shape)`` pieces; returns its id."""
+    def register_mesh(
+        self,
+        vertices: _ArrayLike,
+        triangles: Optional[_ArrayLike] = None,
+        *,
+        scale: Optional[Union[float, Sequence[float]]] = None,
+        decompose: Optional[int] = None,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers a triangle mesh (its hull, or decomposed); returns its id."""
+    def register_mesh_file(
+        self,
+        path: _Path,
+        *,
+        scale: Optional[Union[float, Sequence[float]]] = None,
+        decompose: Optional[int] = None,
+        name: Optional[str] = None,
+        pose: Optional[_Pose] = None,
+    ) -> int:
+        """Registers the mesh of an STL, OBJ or COLLADA file; returns its id."""
     def remove(self, id: int) -> None:
         """Removes object ``id``."""
     def lookup(self, name: str) -> int:
@@ -256,6 +339,29 @@ class Client(_Objects):
         """The server's limits, wait mode and pid."""
     def stats(self) -> dict[str, int]:
         """The server's counters."""
+    def register_robot(
+        self,
+        name: str,
+        urdf: Optional[_Path] = None,
+        *,
+        srdf: Optional[_Path] = None,
+        urdf_text: Optional[str] = None,
+        srdf_text: Optional[str] = None,
+        package_path: Sequence[_Path] = ...,
+        base: Optional[_Pose] = None,
+    ) -> Robot:
+        """Registers a robot from URDF (a file or text)."""
+    def open_robot(self, name: str, urdf_text: str) -> Robot:
+        """The robot ``name`` already on the server."""
+    def set_joints(
+        self,
+        robot: Robot,
+        positions: Union[_ArrayLike, Mapping[str, float]],
+        *,
+        base: Optional[_Pose] = None,
+        clamp: bool = False,
+    ) -> None:
+        """Sets every joint (and the base) in one round trip."""
     def __enter__(self) -> Client: ...
     def __exit__(
         self,

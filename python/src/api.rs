@@ -327,6 +327,25 @@ macro_rules! backend_methods {
                 crate::api::register_shape(self, py, &shape, name, pose)
             }
 
+            /// Registers an exact cylinder about the body z axis, centred on
+            /// the body origin: the disk of `radius` swept from
+            /// `z = -half_height` to `z = +half_height`, its rims rounded by
+            /// `rounding` (each finite and `>= 0`); `name` and `pose` as for
+            /// `register`. Returns its id.
+            #[pyo3(signature = (radius, half_height, rounding = 0.0, *, name = None, pose = None))]
+            fn register_cylinder(
+                &mut self,
+                py: Python<'_>,
+                radius: f64,
+                half_height: f64,
+                rounding: f64,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let shape = crate::shape::Shape::cylinder(radius, half_height, rounding);
+                crate::api::register_shape(self, py, &shape, name, pose)
+            }
+
             /// Registers the convex hull of `vertices` (`(N, 3)` float64,
             /// N >= 1) grown by `radius`; `name` and `pose` as for
             /// `register`. Returns its id.
@@ -357,6 +376,51 @@ macro_rules! backend_methods {
                 pose: Option<&Bound<'_, PyAny>>,
             ) -> PyResult<u64> {
                 crate::api::register_compound(self, py, pieces, name, pose)
+            }
+
+            /// Registers a triangle mesh given as arrays: `vertices`
+            /// `(N, 3)` float64, `triangles` `(M, 3)` vertex indices (any
+            /// integer dtype; optional for a hull), scaled by `scale` (a
+            /// float or three). By default the object is the mesh's convex
+            /// hull, which never reports more distance than the mesh;
+            /// `decompose=R` makes it a compound of convex pieces instead
+            /// (V-HACD at resolution `R`, 64 is a fair start; at most
+            /// `MAX_PIECES` pieces). `name` and `pose` as for `register`.
+            /// Returns its id.
+            #[pyo3(signature = (vertices, triangles = None, *, scale = None,
+                decompose = None, name = None, pose = None))]
+            #[allow(clippy::too_many_arguments)]
+            fn register_mesh(
+                &mut self,
+                py: Python<'_>,
+                vertices: &Bound<'_, PyAny>,
+                triangles: Option<&Bound<'_, PyAny>>,
+                scale: Option<&Bound<'_, PyAny>>,
+                decompose: Option<u32>,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let args = crate::meshes::MeshArgs { scale, decompose, name, pose };
+                crate::meshes::register_mesh(self, py, vertices, triangles, &args)
+            }
+
+            /// Registers the mesh in the file at `path` (binary or ASCII
+            /// STL, OBJ, COLLADA `.dae`); `scale`, `decompose`, `name` and
+            /// `pose` as for `register_mesh`. A file that is missing or not
+            /// a mesh raises `InvalidInput` (`field="path"`). Returns its id.
+            #[pyo3(signature = (path, *, scale = None, decompose = None, name = None,
+                pose = None))]
+            fn register_mesh_file(
+                &mut self,
+                py: Python<'_>,
+                path: std::path::PathBuf,
+                scale: Option<&Bound<'_, PyAny>>,
+                decompose: Option<u32>,
+                name: Option<&str>,
+                pose: Option<&Bound<'_, PyAny>>,
+            ) -> PyResult<u64> {
+                let args = crate::meshes::MeshArgs { scale, decompose, name, pose };
+                crate::meshes::register_mesh_file(self, py, path, &args)
             }
 
             /// Removes object `id`. Its id is never reused.

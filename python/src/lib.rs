@@ -9,6 +9,8 @@ mod batch;
 mod client;
 mod errors;
 mod local;
+mod meshes;
+mod robots;
 mod runner;
 mod server_lib;
 mod shape;
@@ -40,6 +42,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<client::Client>()?;
     m.add_class::<local::Local>()?;
     m.add_class::<shape::Shape>()?;
+    m.add_class::<robots::Robot>()?;
     m.add_class::<batch::Distances>()?;
     m.add_class::<batch::Answer>()?;
     m.add_function(wrap_pyfunction!(serve, m)?)?;

@@ -9,13 +9,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAnyMethods, PyList};
 
 use gjkd_client::{Geometry, MAX_NAME_LEN, MAX_PIECES, Piece};
-use gjkd_proto::{AdminOp, AdminRequest, PieceDesc, Pose, Vertex, shape_kind};
+use gjkd_proto::{AdminOp, AdminRequest, PieceDesc, Pose, Vertex, piece_kind, shape_kind};
 
 use crate::arrays::{point, points, pose};
 use crate::errors::invalid;
 
 /// A convex shape to register: build one with `Shape.sphere`,
-/// `Shape.capsule`, `Shape.box` or `Shape.polytope`, then pass it to
+/// `Shape.capsule`, `Shape.box`, `Shape.cylinder` or `Shape.polytope`, then pass it to
 /// `register` or, as a piece, to `register_compound`.
 ///
 /// Every shape is the convex hull of its vertices grown by a radius
@@ -39,6 +39,13 @@ pub enum ShapeKind {
     },
     /// A box centred on the body origin.
     Box { half: Vector3<f64>, radius: f64 },
+    /// An exact cylinder about the body z axis, its rims rounded by
+    /// `radius`.
+    Cylinder {
+        disk: f64,
+        half_height: f64,
+        radius: f64,
+    },
     /// A convex hull.
     Polytope {
         vertices: Vec<Point3<f64>>,
@@ -96,6 +103,22 @@ impl Shape {
         })
     }
 
+    /// An exact cylinder about the body z axis, centred on the body origin:
+    /// the disk of `radius` swept from `z = -half_height` to
+    /// `z = +half_height`, its rims rounded by `rounding` (the shape's
+    /// `radius` attribute). Never approximated by a polytope.
+    #[staticmethod]
+    #[pyo3(signature = (radius, half_height, rounding = 0.0))]
+    pub(crate) fn cylinder(radius: f64, half_height: f64, rounding: f64) -> Self {
+        Shape {
+            kind: ShapeKind::Cylinder {
+                disk: radius,
+                half_height,
+                radius: rounding,
+            },
+        }
+    }
+
     /// The convex hull of `vertices`, an `(N, 3)` float64 array (N >= 1;
     /// they need not be hull vertices), grown by `radius`.
     #[staticmethod]
@@ -109,35 +132,40 @@ impl Shape {
         })
     }
 
-    /// `"sphere"`, `"capsule"`, `"box"` or `"polytope"`.
+    /// `"sphere"`, `"capsule"`, `"box"`, `"cylinder"` or `"polytope"`.
     #[getter]
     fn kind(&self) -> &'static str {
         match self.kind {
             ShapeKind::Sphere { .. } => "sphere",
             ShapeKind::Capsule { .. } => "capsule",
             ShapeKind::Box { .. } => "box",
+            ShapeKind::Cylinder { .. } => "cylinder",
             ShapeKind::Polytope { .. } => "polytope",
         }
     }
 
-    /// The rounding radius.
+    /// The rounding radius (a cylinder's `rounding`).
     #[getter]
     fn radius(&self) -> f64 {
         match self.kind {
             ShapeKind::Sphere { radius }
             | ShapeKind::Capsule { radius, .. }
             | ShapeKind::Box { radius, .. }
+            | ShapeKind::Cylinder { radius, .. }
             | ShapeKind::Polytope { radius, .. } => radius,
         }
     }
 
     /// The vertices the shape is the hull of, `(N, 3)` float64, in the
     /// order the server stores them (a sphere is its centre, a box its 8
-    /// corners).
+    /// corners; a cylinder, which is no hull, has none).
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let mut v = Vec::new();
         self.push_vertices(&mut v);
+        if v.is_empty() {
+            return PyArray2::zeros(py, [0, 3], false);
+        }
         let rows: Vec<Vec<f64>> = v.iter().map(|p| vec![p.x, p.y, p.z]).collect();
         PyArray2::from_vec2(py, &rows).unwrap_or_else(|_| PyArray2::zeros(py, [0, 3], false))
     }
@@ -152,6 +180,11 @@ impl Shape {
             ShapeKind::Box { half, radius } => {
                 format!("Shape.box(({}, {}, {}), {radius})", half.x, half.y, half.z)
             }
+            ShapeKind::Cylinder {
+                disk,
+                half_height,
+                radius,
+            } => format!("Shape.cylinder({disk}, {half_height}, {radius})"),
             ShapeKind::Polytope { vertices, radius } => {
                 format!("Shape.polytope(<{} vertices>, {radius})", vertices.len())
             }
@@ -172,6 +205,15 @@ impl Shape {
             ShapeKind::Box { half, radius } => Geometry::Cuboid {
                 half_extents: *half,
                 radius: *radius,
+            },
+            ShapeKind::Cylinder {
+                disk,
+                half_height,
+                radius,
+            } => Geometry::Cylinder {
+                radius: *disk,
+                half_height: *half_height,
+                rounding: *radius,
             },
             ShapeKind::Polytope { vertices, radius } => Geometry::Polytope {
                 vertices,
@@ -194,6 +236,7 @@ impl Shape {
                     if i & 4 == 0 { -h.z } else { h.z },
                 )
             })),
+            ShapeKind::Cylinder { .. } => {}
             ShapeKind::Polytope { vertices, .. } => out.extend_from_slice(vertices),
         }
     }
@@ -201,6 +244,25 @@ impl Shape {
     /// This shape's piece of a wire registration, its vertices appended to
     /// `vertices`.
     fn piece_desc(&self, offset: Pose, vertices: &mut Vec<Vertex>) -> PieceDesc {
+        if let ShapeKind::Cylinder {
+            disk,
+            half_height,
+            radius,
+        } = self.kind
+        {
+            // The wire's cylinder: one vertex holding its dimensions.
+            vertices.push(Vertex {
+                x: disk,
+                y: half_height,
+                z: 0.0,
+            });
+            return PieceDesc {
+                offset,
+                radius,
+                vertex_count: 1,
+                reserved: piece_kind::CYLINDER,
+            };
+        }
         let mut points = Vec::new();
         self.push_vertices(&mut points);
         vertices.extend(points.iter().map(|&p| Vertex::from(p)));

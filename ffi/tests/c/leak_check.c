@@ -4,8 +4,9 @@
  *
  * Most calls fail before reaching the server (each failure builds a new
  * last-error message and frees the old one); one in ROUND_TRIP_EVERY is a
- * round trip (a set_poses batch, a distances batch, a failed lookup), and
- * a few handles are opened and closed.
+ * round trip (a set_poses batch, a distances batch, a failed lookup, a
+ * robot's joints set), and a few client and robot handles are opened and
+ * closed.
  */
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +16,16 @@
 #include "gjkd.h"
 
 enum { BATCH = 16, ROUND_TRIP_EVERY = 100, HANDLES = 3 };
+
+/* One revolute joint between a box and an exact cylinder. */
+static const char *URDF =
+    "<robot name=\"leaky\"><link name=\"a\"><collision><geometry>"
+    "<box size=\"1 1 1\"/></geometry></collision></link>"
+    "<link name=\"b\"><collision><geometry><cylinder radius=\"0.1\" length=\"1\"/>"
+    "</geometry></collision></link>"
+    "<joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+    "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"
+    "</joint></robot>";
 
 static void must(gjkd_status s, const char *what) {
     if (s != GJKD_OK) {
@@ -57,6 +68,15 @@ int main(int argc, char **argv) {
         pairs[2 * i] = ids[i];
         pairs[2 * i + 1] = ids[(i + 1) % BATCH];
     }
+    gjkd_robot *robot = NULL;
+    must(gjkd_register_robot_text(c, "leaky", URDF, NULL, NULL, NULL, NULL, &robot), "robot");
+    for (int h = 0; h < HANDLES; h++) {
+        gjkd_robot *again = NULL;
+        must(gjkd_open_robot(c, "leaky", URDF, &again), "open robot");
+        must(gjkd_robot_free(again), "free robot");
+    }
+    gjkd_pose link_poses[2];
+    double q[1], far[1] = {5.0};
     double distance[BATCH], point_a[3 * BATCH];
     uint32_t error[BATCH];
     gjkd_results out;
@@ -73,7 +93,11 @@ int main(int argc, char **argv) {
     long round_trips = 0;
     for (long k = 0; k < calls; k++) {
         if (k % ROUND_TRIP_EVERY == 0) {
-            switch ((k / ROUND_TRIP_EVERY) % 3) {
+            switch ((k / ROUND_TRIP_EVERY) % 4) {
+            case 3:
+                q[0] = (k % 7) * 0.1;
+                must(gjkd_set_joints(c, robot, q, 1, NULL, false), "set_joints");
+                break;
             case 0:
                 must(gjkd_set_poses(c, ids, poses, BATCH), "set_poses");
                 break;
@@ -90,7 +114,14 @@ int main(int argc, char **argv) {
             round_trips++;
             continue;
         }
-        switch (k % 3) {
+        switch (k % 5) {
+        case 3:
+            must_fail(gjkd_set_joints(c, robot, far, 1, NULL, false), GJKD_ERR_INVALID_ARGUMENT,
+                      "out of limits");
+            break;
+        case 4:
+            must(gjkd_robot_link_poses(robot, NULL, 0, NULL, false, link_poses, 2), "poses");
+            break;
         case 0:
             must_fail(gjkd_lookup(c, long_name, &found), GJKD_ERR_INVALID_ARGUMENT, "long name");
             break;
@@ -102,6 +133,7 @@ int main(int argc, char **argv) {
                       GJKD_ERR_NULL_POINTER, "null out");
         }
     }
+    must(gjkd_robot_free(robot), "free robot");
     for (int i = 0; i < BATCH; i++) must(gjkd_remove(c, ids[i]), "remove");
     must(gjkd_close(c), "close");
     printf("calls %ld, round trips %ld\n", calls, round_trips);

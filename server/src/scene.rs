@@ -680,6 +680,23 @@ radius = 0.1
         }
     }
 
+    /// Scene cylinders come back from the store as the very shapes the
+    /// scene builds, so a restart keeps their ids.
+    #[test]
+    fn scene_cylinders_keep_their_ids_across_a_restart() {
+        let text = "[[object]]\nname='can'\ntype='cylinder'\nradius=0.5\nlength=2\nrounding=0.1\n\
+            [[object]]\nname='pair'\ntype='compound'\n\
+            [[object.pieces]]\ntype='cylinder'\nradius=0.5\nhalf_height=1\n\
+            [[object.pieces]]\ntype='sphere'\nradius=1\n";
+        let scene = Scene::from_toml(text).expect("parses");
+        let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
+        let ids = scene.install(&mut state).expect("valid");
+        let mut again =
+            State::restore(Limits::default(), WaitMode::Spin, &state.snapshot()).expect("restores");
+        assert_eq!(scene.install(&mut again).expect("valid"), ids);
+        assert_eq!(again.len(), 2);
+    }
+
     /// Every bad cylinder is refused with a message naming the problem.
     #[test]
     fn bad_scene_cylinders_are_reported() {

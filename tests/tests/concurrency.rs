@@ -1,6 +1,7 @@
 //! Many clients at once each get their own answers, with their own warm
 //! starts, and the service takes at least 64 clients.
 
+use std::sync::Barrier;
 use std::time::Duration;
 
 use gjkd_client::{ObjectId, QueryOptions};
@@ -35,11 +36,19 @@ fn concurrent_clients_get_their_own_warm_answers() {
     let pose_b = Isometry3::translation(0.0, 0.0, 0.5);
     setup.set_pose(b, &pose_b).expect("pose b");
 
-    std::thread::scope(|scope| {
+    // The clients stay connected until the statistics are read: the
+    // server's housekeeping forgets a departed client's cache entries, and
+    // under load it may run between the threads' end and `stats`.
+    let (done, read) = (Barrier::new(9), Barrier::new(9));
+    let stats = std::thread::scope(|scope| {
         for c in 0..8 {
             let (sa, sb, service) = (&sa, &sb, &server.service);
+            let (done, read) = (&done, &read);
             scope.spawn(move || {
-                let mut client = gjkd_e2e::connect(service, TIMEOUT);
+                // Waits also when an assertion fails, so the test fails
+                // instead of hanging.
+                let mut hold = HoldUntilRead(done, read, None);
+                let client = hold.2.insert(gjkd_e2e::connect(service, TIMEOUT));
                 let options = QueryOptions::default();
                 let mut warm: Option<gjk::WarmStart> = None;
                 for step in 0..=100 {
@@ -62,8 +71,11 @@ fn concurrent_clients_get_their_own_warm_answers() {
                 }
             });
         }
+        done.wait();
+        let stats = setup.stats();
+        read.wait();
+        stats.expect("stats")
     });
-    let stats = setup.stats().expect("stats");
     assert_eq!(stats.cache_hits, 8 * 100);
     assert_eq!(stats.cache_entries, 8);
 }
@@ -98,4 +110,16 @@ fn sixty_four_clients_at_once() {
         }
     }
     assert_eq!(clients[5].stats().expect("stats").objects, 65);
+}
+
+/// Keeps a client thread's client connected until the statistics are read:
+/// when dropped, waits on the first barrier, then the second, and only then
+/// drops the client.
+struct HoldUntilRead<'a>(&'a Barrier, &'a Barrier, Option<gjkd_client::Client>);
+
+impl Drop for HoldUntilRead<'_> {
+    fn drop(&mut self) {
+        self.0.wait();
+        self.1.wait();
+    }
 }

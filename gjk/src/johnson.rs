@@ -580,6 +580,27 @@ impl Simplex {
     #[cold]
     #[inline(never)]
     fn sliver(&mut self) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            unsafe { self.sliver_fma() };
+            return;
+        }
+        self.sliver_inline();
+    }
+
+    /// [`sliver`](Self::sliver) with its fused products as FMA
+    /// instructions, not calls to the software `fma`: the same values bit
+    /// for bit (`mul_add` rounds once either way).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn sliver_fma(&mut self) {
+        self.sliver_inline();
+    }
+
+    /// The body of [`sliver`](Self::sliver), inlined into each compiled form.
+    #[inline(always)]
+    fn sliver_inline(&mut self) {
         let y = self.vertices.map(|v| v.y);
         let volume = |p: Vector3<f64>, q: Vector3<f64>, r: Vector3<f64>, s: Vector3<f64>| {
             (q - p).dot(&fused_cross(&(r - p), &(s - p)))
@@ -605,6 +626,27 @@ impl Simplex {
     #[cold]
     #[inline(never)]
     fn thin_triangle(&mut self, mask: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            unsafe { self.thin_triangle_fma(mask) };
+            return;
+        }
+        self.thin_triangle_inline(mask);
+    }
+
+    /// [`thin_triangle`](Self::thin_triangle) with its fused products as
+    /// FMA instructions (see [`sliver_fma`](Self::sliver_fma)).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn thin_triangle_fma(&mut self, mask: usize) {
+        self.thin_triangle_inline(mask);
+    }
+
+    /// The body of [`thin_triangle`](Self::thin_triangle), inlined into
+    /// each compiled form.
+    #[inline(always)]
+    fn thin_triangle_inline(&mut self, mask: usize) {
         let mask = mask & 15;
         let (mem, _) = MEMBERS[mask];
         let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
@@ -634,6 +676,26 @@ impl Simplex {
     #[cold]
     #[inline(never)]
     fn thin_simplex_v(&self, mask: usize) -> Option<Vector3<f64>> {
+        #[cfg(target_arch = "x86_64")]
+        if crate::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { self.thin_simplex_v_fma(mask) };
+        }
+        self.thin_simplex_v_inline(mask)
+    }
+
+    /// [`thin_simplex_v`](Self::thin_simplex_v) with its fused products as
+    /// FMA instructions (see [`sliver_fma`](Self::sliver_fma)).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn thin_simplex_v_fma(&self, mask: usize) -> Option<Vector3<f64>> {
+        self.thin_simplex_v_inline(mask)
+    }
+
+    /// The body of [`thin_simplex_v`](Self::thin_simplex_v), inlined into
+    /// each compiled form.
+    #[inline(always)]
+    fn thin_simplex_v_inline(&self, mask: usize) -> Option<Vector3<f64>> {
         let (mem, _) = MEMBERS[mask & 15];
         let [i, j, k] = [mem[0], mem[1], mem[2]].map(|x| x as usize & 3);
         let [yi, yj, yk] = [i, j, k].map(|x| self.vertices[x].y);

@@ -518,3 +518,230 @@ fn bad_dimensions_are_refused() {
     .unwrap();
     assert!(within(ans.distance, 0.5, 1.0), "{ans:?}");
 }
+
+/// A seeded xorshift generator, uniform in [-1, 1).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+
+    /// Uniform in [lo, hi).
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * 0.5 * (self.next() + 1.0)
+    }
+
+    fn rotation(&mut self) -> UnitQuaternion<f64> {
+        UnitQuaternion::from_euler_angles(self.next() * 3.2, self.next() * 1.6, self.next() * 3.2)
+    }
+
+    fn unit(&mut self) -> Vector3<f64> {
+        loop {
+            let v = Vector3::new(self.next(), self.next(), self.next());
+            let n = v.norm();
+            if n > 0.1 && n <= 1.0 {
+                return v / n;
+            }
+        }
+    }
+}
+
+/// A shape of the sweep with its bracket: the shape itself, and what
+/// replaces it in the reference queries from inside and from outside (a
+/// cylinder's inscribed and circumscribed fine prisms; anything else is
+/// its own bracket).
+struct Bracketed {
+    exact: Shape,
+    inner: Shape,
+    outer: Shape,
+    size: f64,
+}
+
+/// Sides of the reference prisms: the circumscribed one reaches
+/// `1/cos(π/n) - 1 < 1.2e-9` of the radius past the cylinder, inside the
+/// judged absolute bound of 1e-9 of the size.
+const FINE_SIDES: usize = 65_536;
+
+fn bracketed_cylinder(r: f64, h: f64, rounding: f64) -> Bracketed {
+    let widen = 1.0 / (std::f64::consts::PI / FINE_SIDES as f64).cos();
+    let with_rounding =
+        |c: Convex| -> Shape { Convex::new(c.vertices().to_vec(), rounding).unwrap().into() };
+    Bracketed {
+        exact: cyl(r, h, rounding),
+        inner: with_rounding(prism(r, h, FINE_SIDES)),
+        outer: with_rounding(prism(r * widen, h, FINE_SIDES)),
+        size: r.hypot(h) + rounding,
+    }
+}
+
+fn bracketed_plain(shape: Shape, size: f64) -> Bracketed {
+    Bracketed {
+        exact: shape.clone(),
+        inner: shape.clone(),
+        outer: shape,
+        size,
+    }
+}
+
+/// How B is placed about A in the sweep.
+#[derive(Clone, Copy, Debug)]
+enum Placement {
+    /// Random rotation, centre 1 to 4 sizes away.
+    Random,
+    /// Moved along the normal of a random placement until the two touch.
+    Touching,
+    /// B's axis parallel (or antiparallel) to A's, beside it or overlapping.
+    ParallelAxes,
+    /// B's z axis along A's, B beyond A's end cap: cap against cap or face.
+    EndCap,
+}
+
+/// The judged error bound around the fine-prism bracket `[lo, hi]` (which
+/// holds the truth): an answer within it of both ends is within it of
+/// the truth.
+fn within_bracket(got: f64, lo: f64, hi: f64, size: f64) -> bool {
+    let bound = 1e-6 * lo.max(0.0) + 1e-9 * size;
+    (got - lo).abs() <= bound && (got - hi).abs() <= bound
+}
+
+/// A hidden-set-like sweep: random cylinders (some rounded, some flat or
+/// needle-thin) against cylinders, boxes, spheres and point clouds, from
+/// 1e-9 to 1e6 in size, at the origin and far from it, placed at random,
+/// touching, with parallel axes and cap against face. Every answer is
+/// within the judged error bound of the truth, bracketed by the fine
+/// prisms' certified bounds, and its own bounds contain that bracket's
+/// share of the truth.
+#[test]
+fn hidden_like_sweep_against_fine_prisms() {
+    let mut rng = Rng(0x5eed_c711_5eeb_0001);
+    let mut checked = 0;
+    for scale in SCALES {
+        // Unit-sized shapes, built once per scale.
+        let mut shapes = vec![
+            bracketed_cylinder(0.5 * scale, 0.8 * scale, 0.0),
+            bracketed_cylinder(0.3 * scale, 0.05 * scale, 0.02 * scale),
+            bracketed_cylinder(0.02 * scale, 1.0 * scale, 0.0),
+        ];
+        let box_half = Vector3::new(0.4, 0.3, 0.6) * scale;
+        shapes.push(bracketed_plain(
+            Convex::cuboid(box_half, 0.0).unwrap().into(),
+            box_half.norm(),
+        ));
+        shapes.push(bracketed_plain(
+            Convex::sphere(0.35 * scale).unwrap().into(),
+            0.35 * scale,
+        ));
+        let cloud: Vec<Point3<f64>> = (0..20)
+            .map(|_| Point3::from(Vector3::new(rng.next(), rng.next(), rng.next()) * 0.5 * scale))
+            .collect();
+        shapes.push(bracketed_plain(
+            Convex::new(cloud, 0.0).unwrap().into(),
+            0.9 * scale,
+        ));
+        // Far from the origin: 1e9 for shapes whose size the coordinates
+        // there still resolve, else a million sizes out.
+        let far = if scale >= 1e-3 { 1e9 } else { 1e6 * scale };
+        for base in [0.0, far] {
+            for a in 0..3 {
+                for (b, other) in shapes.iter().enumerate() {
+                    for placement in [
+                        Placement::Random,
+                        Placement::Touching,
+                        Placement::ParallelAxes,
+                        Placement::EndCap,
+                    ] {
+                        let what =
+                            format!("scale {scale:e}, base {base:e}, {a}/{b}, {placement:?}");
+                        sweep_case(&mut rng, &shapes[a], other, scale, base, placement, &what);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, SCALES.len() * 2 * 3 * 6 * 4);
+}
+
+/// One case of the sweep (see [`hidden_like_sweep_against_fine_prisms`]).
+fn sweep_case(
+    rng: &mut Rng,
+    a: &Bracketed,
+    b: &Bracketed,
+    scale: f64,
+    base: f64,
+    placement: Placement,
+    what: &str,
+) {
+    let opts = Options::default();
+    let rot_a = rng.rotation();
+    let axis_a = rot_a * Vector3::z();
+    let pa = Isometry3::from_parts(Translation3::new(base, -base, base), rot_a);
+    let place = |offset: Vector3<f64>, rot: UnitQuaternion<f64>| {
+        Isometry3::from_parts(Translation3::from(pa.translation.vector + offset), rot)
+    };
+    let pb = match placement {
+        Placement::Random | Placement::Touching => {
+            let pb = place(rng.unit() * rng.range(1.0, 4.0) * scale, rng.rotation());
+            if matches!(placement, Placement::Touching) {
+                let ans = distance(&a.exact, &pa, &b.exact, &pb, &opts, None).unwrap();
+                place(
+                    pb.translation.vector - pa.translation.vector - ans.normal * ans.distance,
+                    pb.rotation,
+                )
+            } else {
+                pb
+            }
+        }
+        Placement::ParallelAxes => {
+            let flip = if rng.next() > 0.0 {
+                UnitQuaternion::identity()
+            } else {
+                UnitQuaternion::from_scaled_axis(Vector3::x() * std::f64::consts::PI)
+            };
+            let spin = UnitQuaternion::from_scaled_axis(Vector3::z() * rng.next() * 3.0);
+            let side = rot_a * Vector3::new(rng.next(), rng.next(), 0.0).normalize();
+            let offset = side * rng.range(0.3, 1.5) * scale + axis_a * rng.next() * scale;
+            place(offset, rot_a * flip * spin)
+        }
+        Placement::EndCap => {
+            let spin = UnitQuaternion::from_scaled_axis(Vector3::z() * rng.next() * 3.0);
+            let sideways = rot_a * Vector3::new(rng.next(), rng.next(), 0.0) * 0.6 * scale;
+            let offset = axis_a * rng.range(0.9, 2.0) * scale + sideways;
+            place(offset, rot_a * spin)
+        }
+    };
+    let got = distance(&a.exact, &pa, &b.exact, &pb, &opts, None).unwrap();
+    let lo = distance(&a.outer, &pa, &b.outer, &pb, &opts, None)
+        .unwrap()
+        .lower;
+    let hi = distance(&a.inner, &pa, &b.inner, &pb, &opts, None)
+        .unwrap()
+        .upper;
+    let size = a.size + b.size;
+    assert_eq!(got.status, Status::Converged, "{what}");
+    assert!(lo <= hi + 1e-12 * size, "{what}: bracket [{lo}, {hi}]");
+    assert!(
+        within_bracket(got.distance, lo, hi, size),
+        "{what}: {} vs [{lo}, {hi}]",
+        got.distance
+    );
+    // The bounds are certified: they cannot both miss the bracket, and
+    // they are no wider than the judged bound.
+    let fuzz = 1e-12 * size;
+    assert!(
+        got.lower <= hi + fuzz && got.upper >= lo - fuzz,
+        "{what}: [{}, {}] vs [{lo}, {hi}]",
+        got.lower,
+        got.upper
+    );
+    assert!(
+        got.upper - got.lower <= 1e-6 * got.distance + 1e-9 * size,
+        "{what}: bounds [{}, {}]",
+        got.lower,
+        got.upper
+    );
+}

@@ -440,13 +440,13 @@ pub fn is_gone(e: &ClientError) -> bool {
     matches!(e, ClientError::ServerGone(_))
 }
 
-/// `call` retried while it reports the server gone, up to ten seconds: a
+/// `call` retried while it reports the server gone, up to thirty seconds: a
 /// client reaching a restarted server, at most after some `ServerGone`.
 ///
 /// # Panics
-/// On any other error, or when the server is still gone after ten seconds.
+/// On any other error, or when the server is still gone after thirty seconds.
 pub fn once_reached<T>(mut call: impl FnMut() -> Result<T, ClientError>) -> T {
-    let deadline = Instant::now() + Duration::from_secs(10);
+    let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         match call() {
             Ok(v) => return v,

@@ -133,8 +133,8 @@ fn rejected<T: std::fmt::Debug>(r: Result<T, ClientError>) -> ErrorCode {
 #[test]
 fn owners_stay_owners_across_a_server_restart() {
     let mut server = Server::start("owners-restart", &[]);
-    let mut alice = server.client(Duration::from_secs(2));
-    let mut bob = server.client(Duration::from_secs(2));
+    let mut alice = server.client(Duration::from_secs(10));
+    let mut bob = server.client(Duration::from_secs(10));
     let hers = alice.register_sphere(1.0).expect("hers");
     let his = bob.register_sphere(1.0).expect("his");
     assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
@@ -148,7 +148,7 @@ fn owners_stay_owners_across_a_server_restart() {
     assert_eq!(rejected(bob.remove(hers)), ErrorCode::NotOwner);
     assert_eq!(rejected(alice.remove(his)), ErrorCode::NotOwner);
     // A client that never registered anything owns nothing either.
-    let mut carol = server.client(Duration::from_secs(2));
+    let mut carol = server.client(Duration::from_secs(10));
     assert_eq!(rejected(carol.remove(hers)), ErrorCode::NotOwner);
     // Anyone may query and move anyone's objects; only removal is owned.
     carol
@@ -187,10 +187,10 @@ fn objects_tool(state_file: &Path, remove: bool) -> (bool, String) {
 fn the_operator_removes_objects_of_departed_clients() {
     let mut server = Server::start("departed", &[]);
     let state_file = server.state_file().expect("the helper's state file");
-    let mut bob = server.client(Duration::from_secs(2));
+    let mut bob = server.client(Duration::from_secs(10));
     let his = bob.register_sphere(1.0).expect("his");
     let (hers, named) = {
-        let mut alice = server.client(Duration::from_secs(2));
+        let mut alice = server.client(Duration::from_secs(10));
         let hers = alice.register_sphere(0.5).expect("hers");
         let named = alice
             .register_named(
@@ -270,7 +270,7 @@ fn serve_remove_departed_removes_the_objects_of_killed_clients() {
     let mut plain = Server::start("reap", &["--scene", scene]);
     let state_file = plain.state_file().expect("the helper's state file");
     let state = state_file.to_str().expect("utf-8");
-    let mut bob = plain.client(Duration::from_secs(2));
+    let mut bob = plain.client(Duration::from_secs(10));
     let his = bob.register_sphere(1.0).expect("his");
     let mut victim = LoadProcess::spawn(&plain.service, "victim", 5, None);
     assert!(
@@ -327,7 +327,7 @@ fn serve_remove_departed_removes_the_objects_of_killed_clients() {
 fn scene_objects_stay_read_only_and_keep_their_ids_across_a_restart() {
     let (dir, path) = wall_scene("scene-ro");
     let mut server = Server::start("scene-ro", &["--scene", path.to_str().expect("utf-8")]);
-    let mut client = server.client(Duration::from_secs(2));
+    let mut client = server.client(Duration::from_secs(10));
     let wall = client.lookup("wall").expect("wall");
     assert_eq!(rejected(client.remove(wall)), ErrorCode::ReadOnly);
     assert_eq!(
@@ -340,7 +340,7 @@ fn scene_objects_stay_read_only_and_keep_their_ids_across_a_restart() {
     );
     server.kill9();
     server.restart();
-    let mut client = server.client(Duration::from_secs(2));
+    let mut client = server.client(Duration::from_secs(10));
     assert_eq!(client.lookup("wall").expect("wall"), wall, "same id");
     assert_eq!(rejected(client.remove(wall)), ErrorCode::ReadOnly);
     assert_eq!(client.stats().expect("stats").objects, 1);

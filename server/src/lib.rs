@@ -45,6 +45,7 @@ pub mod offline;
 pub mod requests;
 pub mod robots;
 pub mod scene;
+mod scene_brute;
 pub mod scene_robots;
 pub mod server;
 pub mod state;

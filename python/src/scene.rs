@@ -37,7 +37,6 @@ pub struct SceneRows {
     b: Py<PyArray1<u64>>,
     step: Py<PyArray1<u32>>,
     answers: Py<Distances>,
-    len: usize,
     busy: std::sync::atomic::AtomicBool,
 }
 
@@ -51,13 +50,12 @@ impl SceneRows {
             b: PyArray1::zeros(py, n, false).unbind(),
             step: PyArray1::zeros(py, n, false).unbind(),
             answers: Py::new(py, Distances::new(py, n))?,
-            len: n,
             busy: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
-    fn __len__(&self) -> usize {
-        self.len
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.rows(py)
     }
 
     /// `(n,)` uint64: the group's objects.
@@ -114,8 +112,8 @@ impl SceneRows {
         self.answers.bind(py).getattr("error")
     }
 
-    fn __repr__(&self) -> String {
-        format!("<gjkd.SceneRows of {} rows>", self.len)
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!("<gjkd.SceneRows of {} rows>", self.rows(py))
     }
 }
 
@@ -277,7 +275,7 @@ impl Inputs<'_> {
     /// Number of items.
     fn len(&self) -> usize {
         let (m, a, n, p) = self.counts();
-        let steps = if n == 0 { 0 } else { p / n };
+        let steps = p.checked_div(n).unwrap_or(0);
         m + a + steps * (n + 1)
     }
 
@@ -312,6 +310,11 @@ impl Inputs<'_> {
 }
 
 impl SceneRows {
+    /// Number of rows (the answers' arrays are as long as the others).
+    fn rows(&self, py: Python<'_>) -> usize {
+        self.answers.bind(py).borrow().len()
+    }
+
     /// Runs `call` with the arrays' storage to write rows into.
     fn with_rows<R>(
         &self,
@@ -361,7 +364,7 @@ fn run(
     out: &Bound<'_, SceneRows>,
 ) -> PyResult<Summary> {
     let rows = out.borrow();
-    request.max_rows = u32::try_from(rows.len).unwrap_or(u32::MAX);
+    request.max_rows = u32::try_from(rows.rows(py)).unwrap_or(u32::MAX);
     let count = inputs.len();
     let outcome = rows.with_rows(py, |write| {
         client.call(py, move |c: &mut gjkd_client::Client| {

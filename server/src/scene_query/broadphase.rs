@@ -36,6 +36,10 @@ pub(crate) struct Entry {
     pub extent: f64,
     /// The largest distance of any of its points from its body origin.
     pub reach: f64,
+    /// The centre of its box in its body frame.
+    pub local_centre: [f64; 3],
+    /// The half-sides of its box in its body frame.
+    pub local_half: [f64; 3],
     /// The pose its box was computed at: the stored pose, or a path's.
     pub pose: Isometry3<f64>,
     /// Its box at `pose`.
@@ -97,11 +101,14 @@ impl Broadphase {
             Some(&slot) => slot,
             None => {
                 let (centre, extent, reach) = bounding_sphere(shape);
+                let (mins, maxs) = shape_box(shape, &Isometry3::identity(), reach);
                 let entry = Entry {
                     id,
                     centre,
                     extent,
                     reach,
+                    local_centre: std::array::from_fn(|i| 0.5 * (mins[i] + maxs[i])),
+                    local_half: std::array::from_fn(|i| 0.5 * (maxs[i] - mins[i])),
                     pose: *pose,
                     mins: [0.0; 3],
                     maxs: [0.0; 3],
@@ -122,7 +129,7 @@ impl Broadphase {
                 slot
             }
         };
-        self.place(slot, shape, pose);
+        self.place(slot, pose);
         self.entries[slot as usize].overlaid = false;
     }
 
@@ -135,12 +142,25 @@ impl Broadphase {
         }
     }
 
-    /// Moves slot `slot` (holding `shape`) to `pose`; the tree is refitted
-    /// by [`Broadphase::refit`].
-    pub(crate) fn place(&mut self, slot: u32, shape: &Shape, pose: &Isometry3<f64>) {
+    /// Moves slot `slot` to `pose`; the tree is refitted by
+    /// [`Broadphase::refit`]. Its box is its body-frame box turned (the
+    /// box of a turned box: a few operations whatever the vertex count).
+    pub(crate) fn place(&mut self, slot: u32, pose: &Isometry3<f64>) {
         let e = &mut self.entries[slot as usize];
         e.pose = *pose;
-        (e.mins, e.maxs) = shape_box(shape, pose, e.reach);
+        let r = pose.rotation.to_rotation_matrix();
+        let m = r.matrix();
+        let c = pose * Point3::from(e.local_centre);
+        let t = pose.translation.vector;
+        let slack = ROUND_OFF * (t.abs().sum() + e.reach) + f64::MIN_POSITIVE;
+        for i in 0..3 {
+            let half = (0..3)
+                .map(|j| m[(i, j)].abs() * e.local_half[j])
+                .sum::<f64>()
+                * (1.0 + ROUND_OFF);
+            e.mins[i] = c[i] - half - slack;
+            e.maxs[i] = c[i] + half + slack;
+        }
         self.moved.push(slot);
     }
 
@@ -198,6 +218,32 @@ pub(crate) fn box_gap(amin: &[f64; 3], amax: &[f64; 3], bmin: &[f64; 3], bmax: &
         sum += gap * gap;
     }
     sum.sqrt() * (1.0 - 4.0 * f64::EPSILON)
+}
+
+/// The square of [`box_gap`] between a box and a tree node, rounded down:
+/// the search compares squares and so takes no square root per node.
+#[inline]
+pub(crate) fn node_gap_squared(amin: &[f64; 3], amax: &[f64; 3], node: &BvhNode) -> f64 {
+    let (m, x) = (node.mins(), node.maxs());
+    let (bmin, bmax) = ([m.x, m.y, m.z], [x.x, x.y, x.z]);
+    let mut sum = 0.0;
+    for i in 0..3 {
+        let gap = (bmin[i] - amax[i]).max(amin[i] - bmax[i]).max(0.0);
+        sum += gap * gap;
+    }
+    sum * (1.0 - 8.0 * f64::EPSILON)
+}
+
+/// `x²` rounded up, for comparisons with [`node_gap_squared`].
+#[inline]
+pub(crate) fn square_up(x: f64) -> f64 {
+    x * x * (1.0 + 8.0 * f64::EPSILON)
+}
+
+/// The distance whose [`square_up`] is `x2`, rounded up.
+#[inline]
+pub(crate) fn root_up(x2: f64) -> f64 {
+    x2.sqrt() * (1.0 + 4.0 * f64::EPSILON)
 }
 
 /// [`box_gap`] between a box and a tree node.

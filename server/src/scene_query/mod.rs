@@ -1,7 +1,10 @@
 //! The scene service's engine: whole-scene questions ([`SceneRequest`])
-//! answered in-process against the store, with a broadphase
-//! ([`broadphase`]) and certified motion bounds ([`motion_bound`]). The
-//! iceoryx2 port calls [`State::scene`].
+//! answered in-process against the store, with a broadphase ([`Broadphase`]:
+//! parry3d-f64's BVH over one box per object, following the store's
+//! changes) and certified motion bounds (each pair's last certified
+//! interval, kept with its warm start in the [`cache`](crate::cache) and
+//! widened by how far either object can have moved since). The iceoryx2
+//! port calls [`State::scene`].
 //!
 //! ```
 //! use gjkd_server::state::{Limits, State};
@@ -45,6 +48,9 @@ use gjkd_proto::{
     item_flags, scene_flags, scene_reply_flags,
 };
 use nalgebra::Isometry3;
+use std::collections::HashMap;
+
+use crate::cache::FxBuild;
 
 pub use broadphase::Broadphase;
 use groups::Group;
@@ -100,7 +106,15 @@ pub struct SceneEngine {
     /// Slots a path moved, to put back.
     touched: Vec<u32>,
     found: Vec<(u32, ItemResult)>,
+    /// Clearance's candidates answered from accepted motion bounds.
+    approximate: Vec<(u32, f64)>,
+    /// Each (client, member)'s nearest object at its last clearance, tried
+    /// first the next time.
+    nearest: HashMap<(u128, u64), u64, FxBuild>,
 }
+
+/// Most remembered nearest objects; beyond, the memory starts over.
+const MAX_REMEMBERED: usize = 1 << 16;
 
 impl SceneEngine {
     /// The broadphase (as of the last scene request).
@@ -345,11 +359,10 @@ impl State {
             &mut engine.poses,
         );
         for &(id, pose) in &engine.poses {
-            let (Some(slot), Some(object)) = (engine.broadphase.slot(id), self.store.object(id))
-            else {
+            let Some(slot) = engine.broadphase.slot(id) else {
                 continue;
             };
-            engine.broadphase.place(slot, &object.shape, &pose);
+            engine.broadphase.place(slot, &pose);
             if !engine.broadphase.entry(slot).overlaid {
                 engine.broadphase.set_overlaid(slot, true);
                 engine.touched.push(slot);
@@ -363,7 +376,7 @@ impl State {
         for &slot in &engine.touched {
             let id = engine.broadphase.entry(slot).id;
             if let Some(object) = self.store.object(id) {
-                engine.broadphase.place(slot, &object.shape, &object.pose);
+                engine.broadphase.place(slot, &object.pose);
             }
             engine.broadphase.set_overlaid(slot, false);
         }
@@ -383,6 +396,11 @@ impl State {
         let engine = &mut self.scene;
         let bp = &engine.broadphase;
         let group = &engine.group;
+        let approximate = &mut engine.approximate;
+        let nearest = &mut engine.nearest;
+        if nearest.len() > MAX_REMEMBERED {
+            nearest.clear();
+        }
         let mut ctx = Ctx {
             store: &self.store,
             bp,
@@ -397,7 +415,13 @@ impl State {
         match q.kind {
             SceneKind::Clearance => {
                 for &m in &group.members {
-                    rows.push(clearance::clearance_of(&mut ctx, m, step));
+                    let id = bp.entry(m).id;
+                    let seed = nearest.get(&(client, id)).copied();
+                    let row = clearance::clearance_of(&mut ctx, m, step, seed, approximate);
+                    if row.b != 0 {
+                        nearest.insert((client, id), row.b);
+                    }
+                    rows.push(row);
                     hits += 1;
                 }
             }

@@ -344,7 +344,12 @@ fn serve_until(
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
         let mut served = serve_queries(&endpoints.query, state);
-        served += serve_scenes(&endpoints.scene, state);
+        // Looked at only while a scene client is connected (an atomic load):
+        // receiving takes a lock, which servers whose clients never ask a
+        // scene question should not pay on every turn.
+        if endpoints.scene_service.dynamic_config().number_of_clients() > 0 {
+            served += serve_scenes(&endpoints.scene, state);
+        }
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
         if options.wait != WaitMode::Spin || turns.is_multiple_of(ADMIN_POLL_EVERY) {

@@ -90,14 +90,16 @@ pub mod scene_flags {
     /// is within the accepted accuracy; such rows have status
     /// [`Status::Bounded`](crate::Status::Bounded).
     pub const MOTION_BOUNDS: u32 = 1 << 1;
-    /// [`SceneKind::Within`]: every pair of the scene, not only group
+    /// [`SceneKind::Within`](super::SceneKind::Within): every pair of the scene, not only group
     /// against the rest.
     pub const ALL_PAIRS: u32 = 1 << 2;
     /// Search support points in f32, as
     /// [`Precision::Single`](crate::Precision::Single).
     pub const SINGLE_PRECISION: u32 = 1 << 3;
-    /// [`SceneKind::Clearance`] and [`SceneKind::Nearest`]: ignore objects
-    /// farther than [`SceneRequest::margin`] (they may still be reported when
+    /// [`SceneKind::Clearance`](super::SceneKind::Clearance) and
+    /// [`SceneKind::Nearest`](super::SceneKind::Nearest): ignore objects
+    /// farther than [`SceneRequest::margin`](super::SceneRequest::margin)
+    /// (they may still be reported when
     /// found on the way, but are never searched for).
     pub const CUTOFF: u32 = 1 << 4;
     /// Clamp joint positions outside their limits instead of refusing the

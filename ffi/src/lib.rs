@@ -29,6 +29,7 @@ mod meshes;
 mod objects;
 mod query;
 mod robots;
+mod scene;
 mod status;
 mod types;
 
@@ -38,6 +39,7 @@ pub use meshes::*;
 pub use objects::*;
 pub use query::*;
 pub use robots::*;
+pub use scene::*;
 pub use status::gjkd_status;
 pub use types::*;
 

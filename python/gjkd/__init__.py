@@ -15,6 +15,13 @@ qw]`` rows or 4x4 matrices), then ask ``distance(a, b)`` for one pair or
 ``distances(pairs)`` for many in one call. Every answer carries certified
 bounds ``lower <= distance <= upper``, nearest points and a normal.
 
+Scene queries ask about a group of objects against everything the server
+holds, in one round trip, into a :class:`SceneRows` you own:
+``client.clearance(group, out=rows)`` (each member's nearest other object),
+``client.within(group, margin, out=rows)`` (every pair within a margin),
+``client.nearest(object, k, out=rows)`` and ``client.path(group, objects,
+poses, out=rows)`` (a question at every step of a candidate motion).
+
 Example::
 
     import numpy as np
@@ -56,6 +63,8 @@ from ._native import (
     Distances,
     Local,
     Robot,
+    SceneRows,
+    SceneSummary,
     Shape,
 )
 from .server import Server
@@ -80,6 +89,8 @@ __all__ = [
     "ProtocolError",
     "Refused",
     "Robot",
+    "SceneRows",
+    "SceneSummary",
     "Server",
     "ServerGone",
     "Shape",

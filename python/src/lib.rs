@@ -12,6 +12,7 @@ mod local;
 mod meshes;
 mod robots;
 mod runner;
+mod scene;
 mod server_lib;
 mod shape;
 
@@ -45,6 +46,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robots::Robot>()?;
     m.add_class::<batch::Distances>()?;
     m.add_class::<batch::Answer>()?;
+    m.add_class::<scene::SceneRows>()?;
+    m.add_class::<scene::Summary>()?;
     m.add_function(wrap_pyfunction!(serve, m)?)?;
     m.add_function(wrap_pyfunction!(error_codes, m)?)?;
     m.add("DEFAULT_TOLERANCE", gjkd_proto::DEFAULT_TOLERANCE)?;

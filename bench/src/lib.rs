@@ -33,6 +33,8 @@ pub mod paper;
 pub mod plot;
 pub mod robot;
 pub mod robot_demo;
+pub mod scene_parry;
+pub mod scene_world;
 pub mod stats;
 pub mod tradeoff;
 pub mod uds;

@@ -137,6 +137,9 @@ mod tests {
                 found_within += within.len();
             }
         }
-        assert!(found_within > 0, "the scene puts something within the margin");
+        assert!(
+            found_within > 0,
+            "the scene puts something within the margin"
+        );
     }
 }

@@ -118,11 +118,19 @@ impl Arm {
             (Body::Cuboid(Vector3::new(0.045, 0.045, 0.125)), 0.25),
             (Body::Capsule(0.10, 0.045), 0.20),
             (
-                Body::Polytope(ellipsoid_points(&mut rng, 24, Vector3::new(0.05, 0.05, 0.06))),
+                Body::Polytope(ellipsoid_points(
+                    &mut rng,
+                    24,
+                    Vector3::new(0.05, 0.05, 0.06),
+                )),
                 0.12,
             ),
             (
-                Body::Polytope(ellipsoid_points(&mut rng, 16, Vector3::new(0.08, 0.03, 0.05))),
+                Body::Polytope(ellipsoid_points(
+                    &mut rng,
+                    16,
+                    Vector3::new(0.08, 0.03, 0.05),
+                )),
                 0.10,
             ),
         ];

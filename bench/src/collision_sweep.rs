@@ -292,16 +292,15 @@ fn print_row(t: usize, r: &Row, csv: &mut Csv) {
             dash()
         },
     );
-    if r.path.is_some() {
-        println!(
-            "{:>6} {} of {} steps hit; the path request ran GJK {} times, {} pairs answered from motion bounds",
-            "",
-            r.hitting_steps,
-            t + 1,
-            r.work.0,
-            r.work.1
-        );
-    }
+    let work = if r.path.is_some() {
+        format!(
+            "; the path request ran GJK {} times, answered {} pairs from motion bounds",
+            r.work.0, r.work.1
+        )
+    } else {
+        String::new()
+    };
+    println!("{:>6} {} of {} steps hit{work}", "", r.hitting_steps, t + 1);
     let opt =
         |d: Option<Duration>| d.map_or(String::new(), |d| (d.as_secs_f64() * 1e3).to_string());
     csv.row(&[

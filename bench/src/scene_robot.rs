@@ -149,6 +149,10 @@ struct Answers {
 struct Tally {
     clearance: Vec<f64>,
     within: Vec<f64>,
+    /// Pairs found within the margin, over all steps.
+    within_pairs: usize,
+    /// The smallest clearance found along the path.
+    closest: f64,
     nearest_disagree: usize,
     within_disagree: usize,
     max_distance_gap: f64,
@@ -191,6 +195,9 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
         all: vec![0.0; pairs],
     };
     let mut tallies: [Tally; 3] = Default::default();
+    for t in &mut tallies {
+        t.closest = f64::INFINITY;
+    }
     let mut poses = Vec::new();
     let progress = Progress::new(steps as u64);
     progress.step("scene-robot");
@@ -376,6 +383,12 @@ fn count_work(tally: &mut Tally, reply: &SceneReply) {
 /// the margin's edge by `all`, the per-pair distances of the step.
 fn judge(s: &Setup, all: &[f64], reference: &Answers, got: &Answers, tally: &mut Tally) {
     let per_link = s.obstacles.len();
+    tally.within_pairs += got.within.len();
+    tally.closest = got
+        .nearest
+        .iter()
+        .flatten()
+        .fold(tally.closest, |m, &(_, d)| m.min(d));
     let near = |x: f64, y: f64| (x - y).abs() <= 1e-6 * (1.0 + x.abs().max(y.abs()));
     for (k, (r, g)) in reference.nearest.iter().zip(&got.nearest).enumerate() {
         match (r, g) {
@@ -490,6 +503,13 @@ fn report_agreement(tallies: &[Tally; 3], shown: usize, steps: usize) {
         println!(
             "  {name:<24} {} nearest disagree, {} within-pairs disagree, largest nearest-distance gap {:.2e} m",
             t.nearest_disagree, t.within_disagree, t.max_distance_gap
+        );
+    }
+    if let Some(t) = tallies.get(1) {
+        println!(
+            "  (the path's closest approach: {:.4} m; {:.2} pairs within the margin per step on average)",
+            t.closest,
+            t.within_pairs as f64 / steps as f64
         );
     }
     if shown == 3 {

@@ -77,6 +77,14 @@
 //! # }
 //! ```
 //!
+//! ## Scene queries
+//!
+//! [`Client::clearance`], [`Client::within`], [`Client::nearest`] and
+//! [`Client::path`] ask about a group of objects against the whole scene in
+//! one round trip (the nearest obstacle of each robot link, every pair
+//! within a margin, the k nearest objects, all of it along a candidate
+//! motion), into a buffer of rows you own; see [`SceneQuery`].
+//!
 //! ## Errors, timeouts and a server that goes away
 //!
 //! Every call returns within the client's timeout (default one second, see
@@ -102,7 +110,8 @@
 //! sends can make the server panic or lose an object.
 //!
 //! A `Client` is not `Send` (iceoryx2 ports are bound to their thread): create
-//! one per thread. Each holds one iceoryx2 node and two client ports.
+//! one per thread. Each holds one iceoryx2 node and two client ports (three
+//! after its first scene query).
 //!
 //! iceoryx2 runs with its built-in defaults when no config file exists, as
 //! gjkd expects, and says so on stderr in every process. The first connect
@@ -114,10 +123,12 @@
 
 mod open_failure;
 mod robots;
+mod scene;
 
 pub use robots::{
     Kinematics, LimitMode, Mesh, MeshMode, PackagePath, RegisteredMesh, RobotHandle, RobotModel,
 };
+pub use scene::{Group, ScenePair, SceneQuery, SceneSummary, Steps};
 
 use std::time::{Duration, Instant};
 
@@ -136,7 +147,8 @@ use gjkd_proto::{
 pub use gjkd_proto::{
     Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemKind,
     ItemResult, MAX_NAME_LEN, MAX_PIECES, ObjectId, PROTOCOL_VERSION, Pose, Precision,
-    QueryOptions, ServerInfo, ServerStats, Status, WaitMode, item_flags, result_flags,
+    QueryOptions, SceneReply, SceneRequest, SceneRow, ServerInfo, ServerStats, Status, WaitMode,
+    item_flags, result_flags, scene_flags, scene_reply_flags,
 };
 
 /// Timeout of every call unless set with [`ClientBuilder::timeout`]: one
@@ -400,6 +412,8 @@ type AdminPort = IoxClient<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>
 /// Open ports to one server incarnation.
 struct Connection {
     // Ports are declared before their services so they are dropped first.
+    /// The scene service, opened at the first scene query.
+    scene: Option<scene::ScenePorts>,
     query: QueryPort,
     admin: AdminPort,
     wake: Notifier<ipc::Service>,
@@ -666,6 +680,7 @@ impl Client {
             .create()
             .map_err(ipc_err("wake notifier"))?;
         self.conn = Some(Connection {
+            scene: None,
             query,
             admin,
             wake,

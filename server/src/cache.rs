@@ -1,6 +1,11 @@
 //! The per-pair warm-start cache: the last simplex of each (client, A, B),
 //! bounded by a capacity, with CLOCK (second-chance) eviction.
 //!
+//! With the simplex, an entry may keep the pair's last certified answer and
+//! the poses it held at ([`PairBound`]), from which the scene service's
+//! motion bounds ([`crate::scene_query`]) answer later questions without
+//! running GJK.
+//!
 //! The key includes the client so that two clients querying the same pair at
 //! different poses never feed each other simplices from elsewhere on the
 //! path: a foreign simplex would still give a correct answer (gjk checks the
@@ -10,6 +15,7 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 use gjk::WarmStart;
+use nalgebra::{Isometry3, Point3, Vector3};
 
 /// Whose simplex, for which ordered pair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -68,10 +74,35 @@ impl Hasher for FxHasher {
 /// `BuildHasher` of [`FxHasher`].
 pub type FxBuild = BuildHasherDefault<FxHasher>;
 
+/// A pair's last certified answer and where the objects were: the start
+/// of a motion bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairBound {
+    /// Certified lower bound of the distance at `pose_a`, `pose_b`.
+    pub lower: f64,
+    /// Certified upper bound.
+    pub upper: f64,
+    /// The distance answered.
+    pub distance: f64,
+    /// A's pose then.
+    pub pose_a: Isometry3<f64>,
+    /// B's pose then.
+    pub pose_b: Isometry3<f64>,
+    /// The nearest point on A, in A's body frame.
+    pub point_a: Point3<f64>,
+    /// The nearest point on B, in B's body frame.
+    pub point_b: Point3<f64>,
+    /// The normal, in A's body frame.
+    pub normal: Vector3<f64>,
+    /// The pieces that realised the distance.
+    pub pieces: [u32; 2],
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     key: PairKey,
     warm: WarmStart,
+    bound: Option<PairBound>,
     referenced: bool,
 }
 
@@ -131,22 +162,57 @@ impl WarmCache {
         }
     }
 
+    /// The cached simplex and last certified answer of `key`, marking the
+    /// entry as recently used (counted as [`WarmCache::get`]).
+    #[inline]
+    pub fn get_with_bound(&mut self, key: &PairKey) -> Option<(WarmStart, Option<PairBound>)> {
+        match self.index.get(key) {
+            Some(&i) => {
+                let slot = &mut self.slots[i as usize];
+                slot.referenced = true;
+                self.stats.hits += 1;
+                Some((slot.warm, slot.bound))
+            }
+            None => {
+                self.stats.misses += 1;
+                None
+            }
+        }
+    }
+
     /// Stores the simplex of `key`, evicting an entry that has not been used
-    /// since the clock hand last passed it if the cache is full.
+    /// since the clock hand last passed it if the cache is full. A certified
+    /// answer already kept stays (it holds at its own poses whatever the
+    /// simplex).
     #[inline]
     pub fn put(&mut self, key: PairKey, warm: WarmStart) {
+        self.store(key, warm, None);
+    }
+
+    /// [`WarmCache::put`], with the pair's certified answer.
+    #[inline]
+    pub fn put_with_bound(&mut self, key: PairKey, warm: WarmStart, bound: PairBound) {
+        self.store(key, warm, Some(bound));
+    }
+
+    #[inline]
+    fn store(&mut self, key: PairKey, warm: WarmStart, bound: Option<PairBound>) {
         if self.capacity == 0 {
             return;
         }
         if let Some(&i) = self.index.get(&key) {
             let slot = &mut self.slots[i as usize];
             slot.warm = warm;
+            if bound.is_some() {
+                slot.bound = bound;
+            }
             slot.referenced = true;
             return;
         }
         let slot = Slot {
             key,
             warm,
+            bound,
             referenced: false,
         };
         if self.slots.len() < self.capacity {

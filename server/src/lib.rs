@@ -3,6 +3,7 @@
 //! The gjkd distance server as a library: the server's state ([`state`]),
 //! its object store ([`store`]) and request handlers ([`requests`]), the
 //! per-pair warm-start cache ([`cache`]), scene files ([`scene`]), the
+//! scene service's engine ([`scene_query`]), the
 //! database that keeps objects across crashes ([`database`], with the
 //! stored form of objects in [`stored`] and the migration of the old state
 //! file in [`legacy`]), the pose journal ([`journal`]), the offline
@@ -45,6 +46,7 @@ pub mod offline;
 pub mod requests;
 pub mod robots;
 pub mod scene;
+pub mod scene_query;
 pub mod scene_robots;
 pub mod server;
 pub mod state;

@@ -9,8 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, Vertex, WaitMode,
-    admin_service_name, query_service_name, wake_service_name,
+    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, SceneReply,
+    SceneRequest, SceneRow, Vertex, WaitMode, admin_service_name, query_service_name,
+    scene_service_name, wake_service_name,
 };
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server as IoxServer;
@@ -21,6 +22,14 @@ use crate::state::{Limits, State};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+type SceneServer = IoxServer<ipc::Service, [Item], SceneRequest, [SceneRow], SceneReply>;
+type SceneService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Item],
+    SceneRequest,
+    [SceneRow],
+    SceneReply,
+>;
 type QueryService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
     [Item],
@@ -86,7 +95,8 @@ const ADMIN_POLL_EVERY: u32 = 64;
 /// Most requests a client may have in flight on one service.
 const ACTIVE_REQUESTS_PER_CLIENT: usize = 2;
 
-/// Response chunks the query server preallocates for `clients` clients.
+/// Response chunks the query and scene servers preallocate for `clients`
+/// clients.
 pub fn response_chunks(clients: usize) -> usize {
     clients
         .saturating_mul(ACTIVE_REQUESTS_PER_CLIENT)
@@ -112,10 +122,12 @@ pub struct ServeOptions {
 /// creation, which removes the services' shared memory.
 struct Endpoints {
     query: QueryServer,
+    scene: SceneServer,
     admin: AdminServer,
     listener: Listener<ipc::Service>,
     _wake_service: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     admin_service: AdminService,
+    scene_service: SceneService,
     query_service: QueryService,
     node: Node<ipc::Service>,
 }
@@ -128,6 +140,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     };
     let query_name = name(query_service_name(&options.service))?;
     let admin_name = name(admin_service_name(&options.service))?;
+    let scene_name = name(scene_service_name(&options.service))?;
     let wake_name = name(wake_service_name(&options.service))?;
 
     let node = NodeBuilder::new()
@@ -174,6 +187,20 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .enable_fire_and_forget_requests(false)
         .open_or_create()
         .map_err(ipc("admin service"))?;
+    let scene_service = node
+        .service_builder(&scene_name)
+        .request_response::<[Item], [SceneRow]>()
+        .request_user_header::<SceneRequest>()
+        .response_user_header::<SceneReply>()
+        .max_clients(clients)
+        .max_servers(1)
+        .max_nodes(limits.max_nodes)
+        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(2)
+        .max_borrowed_responses_per_pending_response(1)
+        .enable_fire_and_forget_requests(false)
+        .open_or_create()
+        .map_err(ipc("scene service"))?;
     let wake_service = node
         .service_builder(&wake_name)
         .event()
@@ -195,6 +222,19 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
                 ServerError::AlreadyRunning(options.service.clone())
             }
             e => ServerError::Ipc(format!("admin server: {e:?}")),
+        })?;
+    // Sized as the query server (below): at most `max_batch` rows a reply.
+    let scene: SceneServer = scene_service
+        .server_builder()
+        .initial_max_slice_len(limits.max_batch)
+        .allocation_strategy(AllocationStrategy::Static)
+        .override_response_preallocation(move |_| response_chunks(clients))
+        .create()
+        .map_err(|e| match e {
+            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
+                ServerError::AlreadyRunning(options.service.clone())
+            }
+            e => ServerError::Ipc(format!("scene server: {e:?}")),
         })?;
     // The query server port comes last: clients take it as the sign that
     // the server is ready, and a request sent to a service before its server
@@ -220,10 +260,12 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
 
     Ok(Endpoints {
         query,
+        scene,
         admin,
         listener,
         _wake_service: wake_service,
         admin_service,
+        scene_service,
         query_service,
         node,
     })
@@ -302,6 +344,7 @@ fn serve_until(
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
         let mut served = serve_queries(&endpoints.query, state);
+        served += serve_scenes(&endpoints.scene, state);
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
         if options.wait != WaitMode::Spin || turns.is_multiple_of(ADMIN_POLL_EVERY) {
@@ -330,12 +373,7 @@ fn serve_until(
             WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
         };
         if sleep {
-            block(
-                waitset,
-                &endpoints.listener,
-                &endpoints.query,
-                &endpoints.admin,
-            );
+            block(waitset, endpoints);
         } else if now.duration_since(last_yield) >= POLITE_EVERY {
             // A client scheduled onto this core could not send while the
             // server spins: give the core away now and then.
@@ -366,7 +404,7 @@ fn keep_house(
     }
     // Always compared with the live list, not the count: a client that died
     // while another connected leaves the count unchanged.
-    forget_departed_clients(&endpoints.query_service, state);
+    forget_departed_clients(endpoints, state);
     // A store that cannot be written is not retried at every housekeeping.
     if options.remove_departed && now >= house.reap_after && !remove_departed_objects(state) {
         house.reap_after = now + REAP_BACKOFF;
@@ -377,13 +415,22 @@ fn keep_house(
     }
 }
 
-/// Drops the warm starts of query clients that are no longer connected.
-fn forget_departed_clients(query_service: &QueryService, state: &mut State) {
+/// Drops the warm starts of query and scene clients that are no longer
+/// connected (each port keys its own warm starts).
+fn forget_departed_clients(endpoints: &Endpoints, state: &mut State) {
     let mut alive = std::collections::HashSet::new();
-    query_service.dynamic_config().list_clients(|c| {
-        alive.insert(c.client_id.value());
+    let mut insert = |id: u128| {
+        alive.insert(id);
         CallbackProgression::Continue
-    });
+    };
+    endpoints
+        .query_service
+        .dynamic_config()
+        .list_clients(|c| insert(c.client_id.value()));
+    endpoints
+        .scene_service
+        .dynamic_config()
+        .list_clients(|c| insert(c.client_id.value()));
     let before = state.stats().cache_entries;
     state.retain_clients(|c| alive.contains(&c));
     let dropped = before - state.stats().cache_entries;
@@ -432,14 +479,12 @@ fn remove_departed_objects(state: &mut State) -> bool {
 /// drained and the servers looked at once more before sleeping, so that a
 /// request that arrived after the last poll but whose notification was
 /// consumed cannot be missed.
-fn block(
-    waitset: &WaitSet<ipc::Service>,
-    listener: &Listener<ipc::Service>,
-    query: &QueryServer,
-    admin: &AdminServer,
-) {
+fn block(waitset: &WaitSet<ipc::Service>, endpoints: &Endpoints) {
+    let listener = &endpoints.listener;
     let _ = listener.try_wait(|_| {});
-    let pending = query.has_requests().unwrap_or(false) || admin.has_requests().unwrap_or(false);
+    let pending = endpoints.query.has_requests().unwrap_or(false)
+        || endpoints.scene.has_requests().unwrap_or(false)
+        || endpoints.admin.has_requests().unwrap_or(false);
     if pending {
         return;
     }
@@ -518,6 +563,77 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
         }
         if let Err(e) = reply.send() {
             debug!(error = ?e, "reply not delivered (client gone?)");
+        }
+    }
+}
+
+/// Answers every scene request waiting; returns how many.
+fn serve_scenes(scene: &SceneServer, state: &mut State) -> usize {
+    let mut served = 0;
+    loop {
+        let request = match scene.receive() {
+            Ok(Some(r)) => r,
+            Ok(None) => return served,
+            Err(e) => {
+                warn!(error = ?e, "scene receive failed");
+                return served;
+            }
+        };
+        served += 1;
+        let header = *request.user_header();
+        let items = request.payload();
+        // The client port keys the warm starts and motion bounds, as the
+        // query service's does: two clients never share them.
+        let client = request.origin().value();
+        let max_batch = state.limits().max_batch;
+        let answer = if items.len() > max_batch {
+            SceneReply::error(ErrorCode::BatchTooLarge)
+        } else {
+            let rows = (header.max_rows as usize).min(max_batch);
+            let reply = match request.loan_slice_uninit(rows) {
+                Ok(r) => r,
+                Err(e) => {
+                    warn!(error = ?e, rows, "cannot loan scene reply");
+                    continue;
+                }
+            };
+            let mut reply = reply.write_from_fn(|_| SceneRow::default());
+            let answer = catch_unwind(AssertUnwindSafe(|| {
+                state.scene(client, &header, items, reply.payload_mut())
+            }))
+            .unwrap_or_else(|_| {
+                // A bug of ours, not the client's: answer, log, keep serving.
+                error!(
+                    kind = header.kind,
+                    items = items.len(),
+                    "scene handler panicked"
+                );
+                SceneReply::error(ErrorCode::Internal)
+            });
+            if answer.error_code() == ErrorCode::Ok {
+                *reply.user_header_mut() = answer;
+                if let Err(e) = reply.send() {
+                    debug!(error = ?e, "scene reply not delivered (client gone?)");
+                }
+                continue;
+            }
+            // A refused request's reply has no rows: this loan goes back
+            // unsent.
+            answer
+        };
+        debug!(kind = header.kind, code = ?answer.error_code(), "scene request refused");
+        let reply = request.loan_slice_uninit(0).map(|r| {
+            let mut r = r.write_from_fn(|_| SceneRow::default());
+            *r.user_header_mut() = answer;
+            r
+        });
+        match reply {
+            Ok(r) => {
+                if let Err(e) = r.send() {
+                    debug!(error = ?e, "scene reply not delivered (client gone?)");
+                }
+            }
+            Err(e) => warn!(error = ?e, "cannot loan scene reply"),
         }
     }
 }

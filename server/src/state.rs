@@ -60,6 +60,9 @@ pub struct State {
     clients: u64,
     /// Robots: kinematics attached to link objects (see [`crate::robots`]).
     pub(crate) robots: crate::robots::Robots,
+    /// The scene service's broadphase and buffers (see
+    /// [`crate::scene_query`]).
+    pub(crate) scene: crate::scene_query::SceneEngine,
 }
 
 impl State {
@@ -80,6 +83,7 @@ impl State {
             clients: 0,
             workspace: gjk::Workspace::new(),
             robots: crate::robots::Robots::default(),
+            scene: crate::scene_query::SceneEngine::default(),
         }
     }
 

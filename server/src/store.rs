@@ -113,7 +113,18 @@ pub struct ObjectStore {
     persist_errors: u64,
     /// Registration tokens of recent registrations, as in the database.
     tokens: Tokens,
+    /// Objects added, moved or removed since the scene index last looked
+    /// (see [`ObjectStore::take_changes`]); may repeat an id.
+    changes: Vec<u64>,
+    /// The change list overflowed (or the store was rebuilt): the scene
+    /// index must look at every object.
+    changes_lost: bool,
 }
+
+/// Most changes listed for the scene index before the list gives up and asks
+/// for a full resync: bounds the memory of a server whose clients move
+/// objects but never ask a scene question.
+const MAX_LISTED_CHANGES: usize = 4096;
 
 impl ObjectStore {
     /// An empty store. `epoch` goes into the upper 32 bits of every id (0 is
@@ -130,7 +141,35 @@ impl ObjectStore {
             next_slot: 0,
             persist_errors: 0,
             tokens: Tokens::default(),
+            changes: Vec::new(),
+            changes_lost: true,
         }
+    }
+
+    /// Records that object `id` was added, moved or removed, for the scene
+    /// index.
+    #[inline]
+    fn note_change(&mut self, id: u64) {
+        if self.changes_lost {
+            return;
+        }
+        if self.changes.len() >= MAX_LISTED_CHANGES.max(self.objects.len()) {
+            self.changes.clear();
+            self.changes_lost = true;
+        } else {
+            self.changes.push(id);
+        }
+    }
+
+    /// Moves the ids of the objects added, moved or removed since the last
+    /// call into `out` (cleared first); returns false when the list was lost
+    /// and every object must be looked at instead.
+    pub fn take_changes(&mut self, out: &mut Vec<u64>) -> bool {
+        out.clear();
+        std::mem::swap(out, &mut self.changes);
+        let complete = !self.changes_lost;
+        self.changes_lost = false;
+        complete
     }
 
     /// A store holding the objects of `snapshot` with their exact ids, its
@@ -240,6 +279,8 @@ impl ObjectStore {
                 None => unverified.push(id),
             }
         }
+        self.changes.clear();
+        self.changes_lost = true;
         unverified.sort_unstable();
         if !unverified.is_empty() {
             report_unverified_poses(&path, &found, &unverified);
@@ -378,6 +419,7 @@ impl ObjectStore {
         object.pose = pose;
         let slot = object.slot;
         self.journal_pose(slot, id);
+        self.note_change(id);
         Ok(())
     }
 
@@ -399,6 +441,7 @@ impl ObjectStore {
             old.pose = new.pose;
             let slot = old.slot;
             self.journal_pose(slot, id);
+            self.note_change(id);
             return Ok(id);
         }
         if let Some(name) = &new.name
@@ -437,6 +480,7 @@ impl ObjectStore {
             self.names.remove(name);
         }
         self.free_slots.push(object.slot);
+        self.note_change(id);
         Some(object)
     }
 
@@ -482,6 +526,7 @@ impl ObjectStore {
         );
         // The slot may hold a removed object's last pose: overwrite it now.
         self.journal_pose(slot, id);
+        self.note_change(id);
         Ok(id)
     }
 
@@ -615,6 +660,7 @@ impl ObjectStore {
             self.names.insert(name.clone(), id);
         }
         self.objects.insert(id, object);
+        self.note_change(id);
     }
 
     /// Makes a registration or removal durable before it is acknowledged:

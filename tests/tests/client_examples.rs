@@ -101,3 +101,11 @@ fn robot_arm_runs() {
         "{out}"
     );
 }
+
+#[test]
+fn scene_clearance_runs() {
+    let server = Server::start("ex-scene", &["--no-persist"]);
+    let out = run("scene_clearance", &server);
+    assert!(out.contains("4 pairs within 1.6"), "{out}");
+    assert!(out.contains("first step within 0.2: Some(4)"), "{out}");
+}

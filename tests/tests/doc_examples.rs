@@ -125,3 +125,43 @@ fn compound_example_runs() -> Result<(), gjkd_client::ClientError> {
     assert_eq!(a.pieces, [2, 0]);
     Ok(())
 }
+
+#[test]
+fn readme_scene_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-scene", &["--no-persist"]);
+    let service = server.service.as_str();
+    // --- from README.md, "Scene queries" ---
+    use gjkd_client::{Client, SceneRow, Steps};
+    use nalgebra::{Isometry3, Vector3};
+
+    let mut client = Client::connect(service)?;
+    let arm = [client.register_sphere(0.2)?, client.register_sphere(0.2)?];
+    client.set_pose(arm[1], &Isometry3::translation(0.0, 1.0, 0.0))?;
+    let wall = client.register_cuboid(Vector3::new(0.1, 3.0, 1.0), 0.0)?;
+    client.set_pose(wall, &Isometry3::translation(1.0, 0.0, 0.0))?;
+
+    let mut rows = [SceneRow::default(); 16];
+    // Each member's nearest object outside the group: here the wall, 0.7 away.
+    let s = client.clearance(&arm).into_rows(&mut rows)?;
+    assert_eq!((s.written, rows[0].b), (2, wall.raw()));
+    assert!((rows[0].result.distance - 0.7).abs() < 1e-9);
+    // Every pair (group against the rest) within a margin.
+    let s = client.within(&arm, 1.0).into_rows(&mut rows)?;
+    assert_eq!(s.total, 2);
+    // The k objects nearest to one object, nearest first.
+    client.nearest(arm[0], 2).into_rows(&mut rows)?;
+    // A candidate motion, checked step by step; nothing moves on the server.
+    let poses: Vec<Isometry3<f64>> = (0..5)
+        .flat_map(|k| (0..2).map(move |i| Isometry3::translation(0.15 * k as f64, i as f64, 0.0)))
+        .collect();
+    let steps = Steps::Poses {
+        objects: &arm,
+        poses: &poses,
+    };
+    let s = client
+        .within(&arm, 0.2)
+        .until_hit(steps)
+        .into_rows(&mut rows)?;
+    assert_eq!(s.first_hit, Some(4));
+    Ok(())
+}

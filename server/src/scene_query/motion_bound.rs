@@ -1,0 +1,105 @@
+//! Certified motion bounds: a pair's last certified interval, widened by
+//! how far any point of either object can have moved since.
+//!
+//! A point `p` of a body moving from pose `T0` to `T1` moves by
+//! `|T1 p - T0 p| <= |T1 c - T0 c| + |(R1 - R0)(p - c)|
+//! <= |T1 c - T0 c| + 2 sin(theta / 2) R`, with `c` the body-frame centroid,
+//! `R` the extent about it (radius included) and `theta` the angle of the
+//! relative rotation `R1 R0^-1`. The distance between two sets moves by
+//! at most the sum of their points' largest moves, so the interval widened
+//! by `dA + dB` holds the distance at the new poses.
+
+use gjkd_proto::{ErrorCode, ItemResult, Status};
+use nalgebra::Isometry3;
+
+use super::broadphase::{Entry, ROUND_OFF};
+use crate::cache::PairBound;
+
+/// The largest distance any point of `entry` can have moved from `from`
+/// to its index pose, rounded up: the formula of the module plus a
+/// relative [`ROUND_OFF`] of every magnitude involved (translations,
+/// centroid, extent), which covers the round-off of the arithmetic here and
+/// of the rotation matrices the poses stand for.
+pub(crate) fn displacement(entry: &Entry, from: &Isometry3<f64>) -> f64 {
+    let to = &entry.pose;
+    let moved = (to * entry.centre - from * entry.centre).norm();
+    let relative = to.rotation * from.rotation.inverse();
+    // |imaginary part| of a unit quaternion is sin(theta / 2), for either
+    // sign of the quaternion.
+    let half_chord = relative.quaternion().imag().norm().min(1.0);
+    let turned = 2.0 * half_chord * entry.extent;
+    let magnitudes = from.translation.vector.abs().sum()
+        + to.translation.vector.abs().sum()
+        + entry.centre.coords.abs().sum()
+        + entry.extent;
+    (moved + turned) * (1.0 + ROUND_OFF) + ROUND_OFF * magnitudes + f64::MIN_POSITIVE
+}
+
+/// A cached interval at the current poses.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Widened {
+    /// Certified lower bound, at least 0.
+    pub lower: f64,
+    /// Certified upper bound.
+    pub upper: f64,
+}
+
+/// `bound` widened to the index poses of `a` and `b`.
+pub(crate) fn widen(bound: &PairBound, a: &Entry, b: &Entry) -> Widened {
+    let d = displacement(a, &bound.pose_a) + displacement(b, &bound.pose_b);
+    let lower = (bound.lower - d) * (1.0 - ROUND_OFF);
+    let upper = (bound.upper + d) * (1.0 + ROUND_OFF);
+    Widened {
+        // A NaN (never expected) reads as no information.
+        lower: if lower > 0.0 { lower } else { 0.0 },
+        upper: if upper.is_nan() { f64::INFINITY } else { upper },
+    }
+}
+
+/// Whether an interval is as narrow as the caller accepts.
+#[inline]
+pub(crate) fn accepted(w: &Widened, absolute: f64, relative: f64) -> bool {
+    let width = w.upper - w.lower;
+    (absolute > 0.0 && width <= absolute) || (relative > 0.0 && width <= relative * w.upper)
+}
+
+/// The answer of a pair from its motion bound: the interval `w`, the
+/// cached distance clamped into it, the cached points carried with their
+/// objects.
+pub(crate) fn bounded_result(bound: &PairBound, w: &Widened, a: &Entry, b: &Entry) -> ItemResult {
+    let point_a = a.pose * bound.point_a;
+    let point_b = b.pose * bound.point_b;
+    let normal = a.pose.rotation * bound.normal;
+    ItemResult {
+        distance: bound.distance.clamp(w.lower, w.upper.max(w.lower)),
+        lower: w.lower,
+        upper: w.upper,
+        penetration: 0.0,
+        point_a: point_a.coords.into(),
+        point_b: point_b.coords.into(),
+        normal: normal.into(),
+        error: ErrorCode::Ok as u32,
+        status: Status::Bounded as u32,
+        iterations: 0,
+        flags: 0,
+        pieces: bound.pieces,
+    }
+}
+
+/// What to keep of an answer found by GJK at the poses of `a` and `b`.
+pub(crate) fn bound_of(result: &ItemResult, a: &Entry, b: &Entry) -> PairBound {
+    let pa: nalgebra::Point3<f64> = result.point_a.into();
+    let pb: nalgebra::Point3<f64> = result.point_b.into();
+    let n: nalgebra::Vector3<f64> = result.normal.into();
+    PairBound {
+        lower: result.lower,
+        upper: result.upper,
+        distance: result.distance,
+        pose_a: a.pose,
+        pose_b: b.pose,
+        point_a: a.pose.inverse_transform_point(&pa),
+        point_b: b.pose.inverse_transform_point(&pb),
+        normal: a.pose.rotation.inverse_transform_vector(&n),
+        pieces: result.pieces,
+    }
+}

@@ -1,0 +1,117 @@
+//! One candidate pair: answered from its motion bound when that decides
+//! the question or is as narrow as the caller accepts, by GJK (the query
+//! service's own pair query, warm-started from the same cache) otherwise.
+
+use gjkd_proto::{ErrorCode, ItemResult};
+
+use super::broadphase::Broadphase;
+use super::groups::Group;
+use super::motion_bound::{accepted, bound_of, bounded_result, widen};
+use super::{Counters, Question};
+use crate::cache::{PairKey, WarmCache};
+use crate::requests::run_pair;
+use crate::store::ObjectStore;
+
+/// What is asked of a pair.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Ask {
+    /// Is its distance at most this margin?
+    Within(f64),
+    /// Could it be nearer than this (the current best's upper bound)?
+    Below(f64),
+}
+
+/// How a pair was settled.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Outcome {
+    /// Its motion bound answers the question: not within the margin, or
+    /// not nearer than the current best.
+    Ruled,
+    /// Its answer, certified, with status `Bounded` when from its motion
+    /// bound; an error row if gjk refused the pair.
+    Answer(ItemResult),
+}
+
+/// Everything a step's questions work with.
+pub(crate) struct Ctx<'a> {
+    /// The objects' shapes.
+    pub store: &'a ObjectStore,
+    /// The objects' poses and boxes.
+    pub bp: &'a Broadphase,
+    /// Warm starts and motion bounds.
+    pub cache: &'a mut WarmCache,
+    /// gjk's scratch memory.
+    pub workspace: &'a mut gjk::Workspace,
+    /// Whose cache entries.
+    pub client: u128,
+    /// The question.
+    pub q: &'a Question,
+    /// The group and the allowed pairs.
+    pub group: &'a Group,
+    /// What it cost.
+    pub counters: &'a mut Counters,
+}
+
+impl Ctx<'_> {
+    /// Settles the pair of slots `a`, `b` for `ask`.
+    pub(crate) fn settle(&mut self, a: u32, b: u32, ask: Ask) -> Outcome {
+        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
+        let key = PairKey {
+            client: self.client,
+            a: ea.id,
+            b: eb.id,
+        };
+        let q = self.q;
+        let cached = if q.warm || q.motion {
+            self.cache.get_with_bound(&key)
+        } else {
+            None
+        };
+        if q.motion
+            && let Some((_, Some(bound))) = &cached
+        {
+            let w = widen(bound, ea, eb);
+            let ok = accepted(&w, q.accept_absolute, q.accept_relative);
+            let (ruled, settled) = match ask {
+                Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
+                Ask::Below(best) => (w.lower >= best, ok),
+            };
+            if ruled {
+                self.counters.bounded += 1;
+                return Outcome::Ruled;
+            }
+            if settled {
+                self.counters.bounded += 1;
+                return Outcome::Answer(bounded_result(bound, &w, ea, eb));
+            }
+        }
+        let (Some(oa), Some(ob)) = (self.store.object(ea.id), self.store.object(eb.id)) else {
+            return Outcome::Answer(ItemResult::error(ErrorCode::UnknownObject));
+        };
+        let mut options = q.options;
+        options.margin = match ask {
+            Ask::Within(m) => Some(m),
+            Ask::Below(_) => None,
+        };
+        let warm = if q.warm { cached.map(|c| c.0) } else { None };
+        self.counters.gjk_runs += 1;
+        match run_pair(
+            self.workspace,
+            (&oa.shape, &ea.pose),
+            (&ob.shape, &eb.pose),
+            &options,
+            warm.as_ref(),
+        ) {
+            Ok((result, next)) => {
+                if q.motion {
+                    self.cache
+                        .put_with_bound(key, next, bound_of(&result, ea, eb));
+                } else if q.warm {
+                    self.cache.put(key, next);
+                }
+                Outcome::Answer(result)
+            }
+            Err(code) => Outcome::Answer(ItemResult::error(code)),
+        }
+    }
+}

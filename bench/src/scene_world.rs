@@ -10,7 +10,7 @@
 //!
 //! Obstacles are scattered over a large floor, a share of them around the
 //! arm, and any that the arm's links could touch along the path (by
-//! bounding spheres, at every step) is drawn again: the arm never collides,
+//! bounding volumes, at every step) is drawn again: the arm never collides,
 //! and a handful of obstacles come within a few centimetres of it.
 
 use gjkd_client::Geometry;
@@ -73,6 +73,16 @@ impl Body {
                 )
             }
         })
+    }
+
+    /// A capsule about the body's z axis holding the body: the half length
+    /// of its segment and its radius.
+    pub fn bounding_capsule(&self) -> (f64, f64) {
+        match self {
+            Body::Capsule(h, r) => (*h, *r),
+            Body::Cuboid(h) => (h.z, h.xy().norm()),
+            _ => (0.0, self.bounding_radius()),
+        }
     }
 
     /// Radius of a ball about the body origin holding the body.
@@ -196,15 +206,21 @@ fn obstacle_body(rng: &mut Rng, i: usize) -> Body {
 impl Obstacles {
     /// `count` obstacles: a tenth around the arm (0.3 to 1.9 m from its
     /// axis), the rest over a 20 m × 20 m floor up to 4 m high; none whose
-    /// bounding sphere meets a link's at any of the path's `steps` steps.
+    /// bounding sphere meets a link's bounding capsule at any of the path's
+    /// `steps` steps.
     pub fn new(arm: &Arm, count: usize, steps: usize, seed: u64) -> Self {
         let mut rng = Rng::new(seed);
-        let mut spheres = Vec::with_capacity(steps * arm.links.len());
+        // Each link's bounding capsule at every step: its segment's ends
+        // and radius.
+        let mut capsules = Vec::with_capacity(steps * arm.links.len());
         let mut poses = Vec::new();
         for s in 0..steps {
             arm.link_poses(&joint_path(s as f64 / steps as f64), &mut poses);
             for (p, (body, _)) in poses.iter().zip(&arm.links) {
-                spheres.push((p.translation.vector, body.bounding_radius()));
+                let (h, r) = body.bounding_capsule();
+                let a = p * Point3::new(0.0, 0.0, -h);
+                let b = p * Point3::new(0.0, 0.0, h);
+                capsules.push((a.coords, b.coords, r));
             }
         }
         let near = count / 10;
@@ -224,9 +240,9 @@ impl Obstacles {
                 )
             };
             let reach = body.bounding_radius();
-            let clear = spheres
+            let clear = capsules
                 .iter()
-                .all(|(c, r)| (c - centre).norm_squared() > (r + reach).powi(2));
+                .all(|(a, b, r)| segment_distance(a, b, &centre) > r + reach);
             if clear {
                 let pose = Isometry3::from_parts(centre.into(), rng.rotation());
                 bodies.push((body, pose));
@@ -234,6 +250,13 @@ impl Obstacles {
         }
         Obstacles { bodies }
     }
+}
+
+/// Distance from `p` to the segment from `a` to `b`.
+fn segment_distance(a: &Vector3<f64>, b: &Vector3<f64>, p: &Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (a + ab * t - p).norm()
 }
 
 #[cfg(test)]
@@ -273,9 +296,12 @@ mod tests {
         for s in 0..50 {
             arm.link_poses(&joint_path(s as f64 / 50.0), &mut poses);
             for (p, (link, _)) in poses.iter().zip(&arm.links) {
+                let (h, r) = link.bounding_capsule();
+                let a = (p * Point3::new(0.0, 0.0, -h)).coords;
+                let b = (p * Point3::new(0.0, 0.0, h)).coords;
                 for (body, pose) in &obstacles.bodies {
-                    let gap = (p.translation.vector - pose.translation.vector).norm()
-                        - link.bounding_radius()
+                    let gap = segment_distance(&a, &b, &pose.translation.vector)
+                        - r
                         - body.bounding_radius();
                     assert!(gap > 0.0);
                     nearest = nearest.min(gap);

@@ -471,8 +471,8 @@ fn collision_row(
     let path = median(times);
     let _ = writeln!(
         out,
-        "{:>6} {:>8} {:>12}   collision sweep (any obstacle within margin 0?): one path request, \
-         {:.1}× faster than cold; {hits} of {} steps hit",
+        "{:>6} {:>8} {:>12}   collision sweep (any obstacle within margin 0?) as one path request: \
+         cold / path {:.1}×; {hits} of {} steps hit",
         "",
         "",
         format!("{:.3} ms", path.as_secs_f64() * 1e3),

@@ -206,6 +206,7 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
     for t in &mut tallies {
         t.closest = f64::INFINITY;
     }
+    let mut floor = Vec::with_capacity(steps);
     let progress = Progress::new(steps as u64);
     progress.step("scene-robot");
     let mut chunk_start = 0;
@@ -234,6 +235,9 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
                 )?);
             }
         }
+        for poses in &chunk {
+            floor.push(round_trip_floor(&mut pair_client, &s, poses, &mut buf)?);
+        }
         for (k, poses) in chunk.iter().enumerate() {
             let g = pair_step(&mut pair_client, &s, poses, &mut buf, &mut tallies[1])?;
             judge(&s, &buf.all, &g, &g, &mut tallies[1]);
@@ -246,7 +250,34 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
         chunk_start += chunk.len();
     }
     progress.finish();
-    report(args, &s, steps, with_scene, &mut tallies)
+    report(args, &s, steps, with_scene, &mut tallies)?;
+    let f = summary(&floor);
+    println!(
+        "Round-trip floor: a request carrying only the 7 link poses took {:.1} µs mean, {:.1} µs p50, \
+         {:.1} µs p99.",
+        f[0], f[1], f[3]
+    );
+    Ok(())
+}
+
+/// Time (µs) of a request that only stores the links' poses: what any
+/// gjkd answer pays before the first pair.
+fn round_trip_floor(
+    client: &mut Client,
+    s: &Setup,
+    poses: &[Isometry3<f64>],
+    buf: &mut Buffers,
+) -> Result<f64, BenchError> {
+    let start = Instant::now();
+    buf.items.clear();
+    buf.items.extend(
+        s.links
+            .iter()
+            .zip(poses)
+            .map(|(&l, p)| Item::set_pose(l, p)),
+    );
+    client.query_batch(&buf.items, &mut buf.results)?;
+    Ok(start.elapsed().as_secs_f64() * 1e6)
 }
 
 fn parry_step(s: &Setup, poses: &[Isometry3<f64>], tally: &mut Tally) -> Answers {

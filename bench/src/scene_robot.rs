@@ -444,7 +444,18 @@ fn count_work(tally: &mut Tally, reply: &SceneReply) {
 /// Compares `got` with the per-pair answers `reference`, judging ties and
 /// the margin's edge by `all`, the per-pair distances of the step.
 fn judge(s: &Setup, all: &[f64], reference: &Answers, got: &Answers, tally: &mut Tally) {
-    let per_link = s.obstacles.len();
+    judge_answers(s.obstacles.len(), s.margin, all, reference, got, tally);
+}
+
+/// [`judge`] for `per_link` obstacles and margin `margin`.
+fn judge_answers(
+    per_link: usize,
+    margin: f64,
+    all: &[f64],
+    reference: &Answers,
+    got: &Answers,
+    tally: &mut Tally,
+) {
     tally.within_pairs += got.within.len();
     tally.closest = got
         .nearest
@@ -465,7 +476,7 @@ fn judge(s: &Setup, all: &[f64], reference: &Answers, got: &Answers, tally: &mut
             _ => tally.nearest_disagree += 1,
         }
     }
-    let on_edge = |&(k, o): &(u32, u32)| near(all[k as usize * per_link + o as usize], s.margin);
+    let on_edge = |&(k, o): &(u32, u32)| near(all[k as usize * per_link + o as usize], margin);
     let missing = reference
         .within
         .iter()
@@ -607,4 +618,37 @@ pub fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
         .unwrap_or_else(|_| "unknown".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn judging_allows_ties_and_the_margins_edge_only() {
+        // Two links, three obstacles; obstacles 0 and 1 tie for link 0.
+        let all = [0.5, 0.5, 0.9, 0.2, 0.1 + 1e-12, 0.05];
+        let reference = Answers {
+            nearest: vec![Some((0, 0.5)), Some((2, 0.05))],
+            within: vec![(1, 1), (1, 2)],
+        };
+        let mut tally = Tally::default();
+        let tie = Answers {
+            nearest: vec![Some((1, 0.5)), Some((2, 0.05))],
+            // (1, 1) is within round-off of the margin: leaving it out is
+            // no disagreement.
+            within: vec![(1, 2)],
+        };
+        judge_answers(3, 0.1, &all, &reference, &tie, &mut tally);
+        assert_eq!((tally.nearest_disagree, tally.within_disagree), (0, 0));
+        let wrong = Answers {
+            nearest: vec![Some((2, 0.9)), None],
+            within: vec![(0, 0), (1, 1)],
+        };
+        judge_answers(3, 0.1, &all, &reference, &wrong, &mut tally);
+        // A farther obstacle and a missing answer; an extra pair and a
+        // missing one.
+        assert_eq!((tally.nearest_disagree, tally.within_disagree), (2, 2));
+        assert_eq!(tally.within_pairs, 1 + 2);
+    }
 }

@@ -289,8 +289,8 @@ mod tests {
     #[test]
     fn obstacles_keep_clear_of_the_arm_and_some_are_near() {
         let arm = Arm::new();
-        let obstacles = Obstacles::new(&arm, 200, 50, 1);
-        assert_eq!(obstacles.bodies.len(), 200);
+        let obstacles = Obstacles::new(&arm, 1000, 50, 1);
+        assert_eq!(obstacles.bodies.len(), 1000);
         let mut poses = Vec::new();
         let mut nearest = f64::INFINITY;
         for s in 0..50 {
@@ -308,7 +308,7 @@ mod tests {
                 }
             }
         }
-        assert!(nearest < 0.1, "nearest bounding-sphere gap {nearest}");
+        assert!(nearest < 0.1, "nearest bounding-volume gap {nearest}");
     }
 
     #[test]

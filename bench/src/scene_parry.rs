@@ -2,16 +2,16 @@
 //! process the way a parry user would write them.
 //!
 //! The obstacles never move, so their world AABBs go into one
-//! [`Bvh`](parry3d_f64::partitioning::Bvh), built once. Per step and link:
+//! [`Bvh`], built once. Per step and link:
 //!
 //! - *clearance*: [`Bvh::find_best`](parry3d_f64::partitioning::Bvh::find_best),
 //!   parry's best-first search, with the distance between the link's AABB
 //!   and a node's AABB as the node's lower bound (so a subtree farther than
 //!   the best distance found so far is never opened) and
-//!   [`query::distance`](parry3d_f64::query::distance) at the leaves;
+//!   [`query::distance`] at the leaves;
 //! - *within a margin*: the obstacles whose AABB meets the link's AABB
 //!   grown by the margin ([`Bvh::intersect_aabb`](parry3d_f64::partitioning::Bvh::intersect_aabb)),
-//!   each checked with [`query::closest_points`](parry3d_f64::query::closest_points)
+//!   each checked with [`query::closest_points()`]
 //!   and the margin as its `max_dist`, which stops as soon as the pair is
 //!   proved farther.
 

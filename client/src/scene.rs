@@ -343,8 +343,9 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     }
 
     /// Ignore objects farther than `distance` ([`Client::clearance`],
-    /// [`Client::nearest`]): a member with nothing that near gets a row with
-    /// no `b`.
+    /// [`Client::nearest`]): they are never searched for, so a member with
+    /// nothing that near gets a row with no `b`, or with an object found on
+    /// the way (with its own certified answer).
     pub fn cutoff(mut self, distance: f64) -> Self {
         self.request.margin = distance;
         self.flag(scene_flags::CUTOFF, true)
@@ -433,12 +434,13 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     /// [`ClientError::InvalidArgument`] for a path whose slices do not make
     /// whole steps, before anything is sent; [`ClientError::Rejected`] when
     /// the server refuses the whole request (nothing changes then):
-    /// [`ErrorCode::UnknownObject`] (the group, a member, a moving object),
-    /// [`ErrorCode::InvalidOptions`] (a tolerance, iteration cap, margin,
-    /// accepted accuracy or `k` out of its domain),
-    /// [`ErrorCode::Malformed`] (an empty group, [`Client::nearest`] of a
-    /// group of more than one, [`SceneQuery::until_hit`] of another
-    /// question than [`Client::within`]), [`ErrorCode::BatchTooLarge`]
+    /// [`ErrorCode::UnknownObject`] (the group, a member, an object of an
+    /// allowed pair, a moving object), [`ErrorCode::InvalidOptions`] (a
+    /// tolerance, iteration cap, margin, cut-off, accepted accuracy or `k`
+    /// out of its domain: negative, NaN, infinite, zero iterations, `k` 0),
+    /// [`ErrorCode::Malformed`] ([`Client::nearest`] of a group of more
+    /// than one, [`SceneQuery::until_hit`] of another question than
+    /// [`Client::within`]), [`ErrorCode::BatchTooLarge`]
     /// (more poses, members, allowed pairs and steps together than the
     /// server's [`ServerInfo::max_batch`](crate::ServerInfo::max_batch)),
     /// [`ErrorCode::NonFinitePose`], [`ErrorCode::BadQuaternion`],

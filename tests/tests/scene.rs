@@ -154,7 +154,7 @@ fn clearance_finds_each_members_nearest_obstacle() {
 }
 
 #[test]
-fn clearance_with_a_cutoff_leaves_far_members_without_partner() {
+fn clearance_with_a_cutoff_finds_the_near_members_partners() {
     let (_server, mut client) = start();
     let scene = build_scene(&mut client, 12, 9);
     let nearest: Vec<f64> = scene
@@ -184,8 +184,12 @@ fn clearance_with_a_cutoff_leaves_far_members_without_partner() {
             let answer = pair.answer.expect("answer");
             assert!(pair.b.is_some());
             assert!((answer.distance - d).abs() <= AGREE * (1.0 + d));
-        } else {
-            assert_eq!(pair.b, None, "nothing within {cutoff} of {}", pair.a);
+        } else if let Some(b) = pair.b {
+            // Objects beyond the cut-off are never searched for, but one
+            // found on the way may be reported: then with its own answer.
+            let theirs = exact(&mut client, pair.a, b);
+            let answer = pair.answer.expect("answer");
+            assert!(theirs > cutoff && answer.upper >= theirs - AGREE * (1.0 + theirs));
         }
     }
 }
@@ -554,9 +558,20 @@ fn every_whole_request_error_has_its_code_and_changes_nothing() {
             client.nearest(g[0], 0).into_rows(&mut rows),
         ),
         (
-            "empty group",
+            "nearest of several",
             ErrorCode::Malformed,
-            client.clearance(&[] as &[ObjectId]).into_rows(&mut rows),
+            client
+                .nearest(g[0], 2)
+                .members(&g[..2])
+                .into_rows(&mut rows),
+        ),
+        (
+            "unknown allowed object",
+            ErrorCode::UnknownObject,
+            client
+                .clearance(g)
+                .allow(&[(g[0], gone)])
+                .into_rows(&mut rows),
         ),
         (
             "first hit of a clearance",
@@ -602,6 +617,12 @@ fn every_whole_request_error_has_its_code_and_changes_nothing() {
         before,
         "no refused request moved anything"
     );
+    // An empty group is no error: nothing to answer.
+    let empty = client
+        .clearance(&[] as &[ObjectId])
+        .into_rows(&mut rows)
+        .expect("an empty group");
+    assert_eq!((empty.written, empty.total), (0, 0));
     // The server still answers.
     let ok = client
         .clearance(g)

@@ -200,6 +200,32 @@ pub(crate) fn box_gap(amin: &[f64; 3], amax: &[f64; 3], bmin: &[f64; 3], bmax: &
     sum.sqrt() * (1.0 - 4.0 * f64::EPSILON)
 }
 
+/// The square of [`box_gap`] between a box and a tree node, rounded down:
+/// the search compares squares and so takes no square root per node.
+#[inline]
+pub(crate) fn node_gap_squared(amin: &[f64; 3], amax: &[f64; 3], node: &BvhNode) -> f64 {
+    let (m, x) = (node.mins(), node.maxs());
+    let (bmin, bmax) = ([m.x, m.y, m.z], [x.x, x.y, x.z]);
+    let mut sum = 0.0;
+    for i in 0..3 {
+        let gap = (bmin[i] - amax[i]).max(amin[i] - bmax[i]).max(0.0);
+        sum += gap * gap;
+    }
+    sum * (1.0 - 8.0 * f64::EPSILON)
+}
+
+/// `x²` rounded up, for comparisons with [`node_gap_squared`].
+#[inline]
+pub(crate) fn square_up(x: f64) -> f64 {
+    x * x * (1.0 + 8.0 * f64::EPSILON)
+}
+
+/// The distance whose [`square_up`] is `x2`, rounded up.
+#[inline]
+pub(crate) fn root_up(x2: f64) -> f64 {
+    x2.sqrt() * (1.0 + 4.0 * f64::EPSILON)
+}
+
 /// [`box_gap`] between a box and a tree node.
 #[inline]
 pub(crate) fn node_gap(amin: &[f64; 3], amax: &[f64; 3], node: &BvhNode) -> f64 {

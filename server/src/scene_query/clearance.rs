@@ -4,19 +4,101 @@
 //! first), each candidate's lower bound (box, then bounding sphere, then
 //! motion bound) against the best certified upper bound so far: a
 //! candidate is skipped only when it cannot be nearer than the best.
+//!
+//! The member's nearest object of its last clearance (for this client) is
+//! tried first, so that its bound prunes the search from the start.
+//!
+//! A candidate answered from an accepted motion bound is approximate: it is
+//! kept as the answer only if no other approximate candidate has a lower
+//! bound below its own (such ones are run by GJK first), so that the
+//! reported interval always reaches down to the nearest distance.
 
 use std::cell::RefCell;
 
 use gjkd_proto::{ItemResult, SceneRow};
 
-use super::broadphase::{node_gap, sphere_gap};
-use super::pair::{Ask, Ctx, Outcome};
+use super::broadphase::{node_gap_squared, root_up, sphere_gap, square_up};
+use super::motion_bound::{accepted, bounded_result, widen};
+use super::pair::{Ask, Ctx};
 
-/// The best candidate so far: its slot and answer.
-type Best = Option<(u32, ItemResult)>;
+/// The search's state: the best certified candidate so far (slot and
+/// answer) and the candidates answered from accepted motion bounds (slot,
+/// lower bound).
+struct Search<'c, 'a> {
+    ctx: &'c mut Ctx<'a>,
+    best: Option<(u32, ItemResult)>,
+    approximate: &'c mut Vec<(u32, f64)>,
+}
 
-/// The clearance row of member slot `a` at path step `step`.
-pub(crate) fn clearance_of(ctx: &mut Ctx<'_>, a: u32, step: u32) -> SceneRow {
+impl Search<'_, '_> {
+    /// Keeps `r` (for slot `leaf`) if it is the best so far.
+    fn offer(&mut self, leaf: u32, r: ItemResult) {
+        if r.error == 0 && self.best.as_ref().is_none_or(|(_, b)| r.upper < b.upper) {
+            self.best = Some((leaf, r));
+        }
+    }
+
+    /// Candidate `leaf` of member `a` against the search's bound
+    /// `best_cost`: returns the certified upper bound it brings, if lower.
+    fn visit(&mut self, a: u32, leaf: u32, best_cost: f64) -> Option<f64> {
+        let ctx = &mut *self.ctx;
+        let cached = ctx.lookup(a, leaf);
+        let q = ctx.q;
+        if q.motion
+            && let Some((_, Some(bound))) = &cached
+        {
+            let (ea, eb) = (ctx.bp.entry(a), ctx.bp.entry(leaf));
+            let w = widen(bound, ea, eb);
+            if w.lower >= best_cost {
+                ctx.counters.bounded += 1;
+                return None;
+            }
+            if accepted(&w, q.accept_absolute, q.accept_relative) {
+                ctx.counters.bounded += 1;
+                let r = bounded_result(bound, &w, ea, eb);
+                self.approximate.push((leaf, r.lower));
+                self.offer(leaf, r);
+                return (r.upper < best_cost).then_some(r.upper);
+            }
+        }
+        let r = ctx.run(a, leaf, Ask::Below(best_cost), cached.map(|c| c.0));
+        self.offer(leaf, r);
+        (r.error == 0 && r.upper < best_cost).then_some(r.upper)
+    }
+
+    /// Runs by GJK the approximate candidates whose lower bound is below
+    /// the best's, until there is none.
+    fn settle_ties(&mut self, a: u32) {
+        while let Some((best_slot, best)) = self.best {
+            let below = self
+                .approximate
+                .iter()
+                .enumerate()
+                .filter(|(_, (leaf, lower))| *leaf != best_slot && *lower < best.lower)
+                .min_by(|x, y| x.1.1.total_cmp(&y.1.1))
+                .map(|(i, &(leaf, _))| (i, leaf));
+            let Some((i, leaf)) = below else {
+                break;
+            };
+            self.approximate.swap_remove(i);
+            let warm = self.ctx.lookup(a, leaf).map(|c| c.0);
+            let r = self.ctx.run(a, leaf, Ask::Below(f64::INFINITY), warm);
+            self.offer(leaf, r);
+        }
+        self.approximate.clear();
+    }
+}
+
+/// The clearance row of member slot `a` at path step `step`, with
+/// `approximate` as scratch; `seed`, the member's nearest object last time
+/// (for this client), is tried first so that its bound prunes the rest.
+pub(crate) fn clearance_of(
+    ctx: &mut Ctx<'_>,
+    a: u32,
+    step: u32,
+    seed: Option<u64>,
+    approximate: &mut Vec<(u32, f64)>,
+) -> SceneRow {
     let bp = ctx.bp;
     let ea = *bp.entry(a);
     let q = ctx.q;
@@ -25,37 +107,49 @@ pub(crate) fn clearance_of(ctx: &mut Ctx<'_>, a: u32, step: u32) -> SceneRow {
     } else {
         f64::INFINITY
     };
-    let state: RefCell<(&mut Ctx<'_>, Best)> = RefCell::new((ctx, None));
+    approximate.clear();
+    let mut search = Search {
+        ctx,
+        best: None,
+        approximate,
+    };
+    let seed = seed.and_then(|id| bp.slot(id)).filter(|&s| {
+        let group = search.ctx.group;
+        s != a && bp.entry(s).live && !group.contains(s) && !group.allowed(ea.id, bp.entry(s).id)
+    });
+    let mut bound = cutoff;
+    if let Some(s) = seed {
+        search.ctx.counters.candidates += 1;
+        if let Some(upper) = search.visit(a, s, cutoff) {
+            bound = upper;
+        }
+    }
+    let search = RefCell::new(search);
+    // The tree compares squared distances (see node_gap_squared).
     bp.bvh().find_best(
-        cutoff,
-        |node, _| node_gap(&ea.mins, &ea.maxs, node),
-        |leaf, best_cost| {
-            let mut guard = state.borrow_mut();
-            let (ctx, best) = &mut *guard;
+        square_up(bound),
+        |node, _| node_gap_squared(&ea.mins, &ea.maxs, node),
+        |leaf, best_squared| {
+            let best_cost = root_up(best_squared);
+            let mut search = search.borrow_mut();
             let eb = bp.entry(leaf);
+            let group = search.ctx.group;
             if leaf == a
+                || Some(leaf) == seed
                 || !eb.live
-                || ctx.group.contains(leaf)
-                || ctx.group.allowed(ea.id, eb.id)
+                || group.contains(leaf)
+                || group.allowed(ea.id, eb.id)
                 || sphere_gap(&ea, eb) >= best_cost
             {
                 return None;
             }
-            ctx.counters.candidates += 1;
-            let Outcome::Answer(r) = ctx.settle(a, leaf, Ask::Below(best_cost)) else {
-                return None;
-            };
-            if r.error != 0 {
-                return None;
-            }
-            if best.as_ref().is_none_or(|(_, b)| r.upper < b.upper) {
-                *best = Some((leaf, r));
-            }
-            (r.upper < best_cost).then_some(r.upper)
+            search.ctx.counters.candidates += 1;
+            search.visit(a, leaf, best_cost).map(square_up)
         },
     );
-    let (_, best) = state.into_inner();
-    let (b, result) = match best {
+    let mut search = search.into_inner();
+    search.settle_ties(a);
+    let (b, result) = match search.best {
         Some((slot, r)) => (bp.entry(slot).id, r),
         None => (
             0,

@@ -45,6 +45,9 @@ use gjkd_proto::{
     item_flags, scene_flags, scene_reply_flags,
 };
 use nalgebra::Isometry3;
+use std::collections::HashMap;
+
+use crate::cache::FxBuild;
 
 pub use broadphase::Broadphase;
 use groups::Group;
@@ -100,7 +103,15 @@ pub struct SceneEngine {
     /// Slots a path moved, to put back.
     touched: Vec<u32>,
     found: Vec<(u32, ItemResult)>,
+    /// Clearance's candidates answered from accepted motion bounds.
+    approximate: Vec<(u32, f64)>,
+    /// Each (client, member)'s nearest object at its last clearance, tried
+    /// first the next time.
+    nearest: HashMap<(u128, u64), u64, FxBuild>,
 }
+
+/// Most remembered nearest objects; beyond, the memory starts over.
+const MAX_REMEMBERED: usize = 1 << 16;
 
 impl SceneEngine {
     /// The broadphase (as of the last scene request).
@@ -383,6 +394,11 @@ impl State {
         let engine = &mut self.scene;
         let bp = &engine.broadphase;
         let group = &engine.group;
+        let approximate = &mut engine.approximate;
+        let nearest = &mut engine.nearest;
+        if nearest.len() > MAX_REMEMBERED {
+            nearest.clear();
+        }
         let mut ctx = Ctx {
             store: &self.store,
             bp,
@@ -397,7 +413,13 @@ impl State {
         match q.kind {
             SceneKind::Clearance => {
                 for &m in &group.members {
-                    rows.push(clearance::clearance_of(&mut ctx, m, step));
+                    let id = bp.entry(m).id;
+                    let seed = nearest.get(&(client, id)).copied();
+                    let row = clearance::clearance_of(&mut ctx, m, step, seed, approximate);
+                    if row.b != 0 {
+                        nearest.insert((client, id), row.b);
+                    }
+                    rows.push(row);
                     hits += 1;
                 }
             }

@@ -8,9 +8,10 @@ use super::broadphase::Broadphase;
 use super::groups::Group;
 use super::motion_bound::{accepted, bound_of, bounded_result, widen};
 use super::{Counters, Question};
-use crate::cache::{PairKey, WarmCache};
+use crate::cache::{PairBound, PairKey, WarmCache};
 use crate::requests::run_pair;
 use crate::store::ObjectStore;
+use gjk::WarmStart;
 
 /// What is asked of a pair.
 #[derive(Clone, Copy, Debug)]
@@ -53,23 +54,32 @@ pub(crate) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// The cache entry of the pair of slots `a`, `b` (for this client), when
+    /// warm starts or motion bounds are on.
+    pub(crate) fn lookup(&mut self, a: u32, b: u32) -> Option<(WarmStart, Option<PairBound>)> {
+        if !(self.q.warm || self.q.motion) {
+            return None;
+        }
+        let key = self.key(a, b);
+        self.cache.get_with_bound(&key)
+    }
+
+    fn key(&self, a: u32, b: u32) -> PairKey {
+        PairKey {
+            client: self.client,
+            a: self.bp.entry(a).id,
+            b: self.bp.entry(b).id,
+        }
+    }
+
     /// Settles the pair of slots `a`, `b` for `ask`.
     pub(crate) fn settle(&mut self, a: u32, b: u32, ask: Ask) -> Outcome {
-        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
-        let key = PairKey {
-            client: self.client,
-            a: ea.id,
-            b: eb.id,
-        };
+        let cached = self.lookup(a, b);
         let q = self.q;
-        let cached = if q.warm || q.motion {
-            self.cache.get_with_bound(&key)
-        } else {
-            None
-        };
         if q.motion
             && let Some((_, Some(bound))) = &cached
         {
+            let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
             let w = widen(bound, ea, eb);
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
@@ -85,15 +95,23 @@ impl Ctx<'_> {
                 return Outcome::Answer(bounded_result(bound, &w, ea, eb));
             }
         }
+        Outcome::Answer(self.run(a, b, ask, cached.map(|c| c.0)))
+    }
+
+    /// Runs GJK on the pair of slots `a`, `b` (from `warm` if warm starts
+    /// are on) and caches its simplex and, with motion bounds, its answer.
+    pub(crate) fn run(&mut self, a: u32, b: u32, ask: Ask, warm: Option<WarmStart>) -> ItemResult {
+        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         let (Some(oa), Some(ob)) = (self.store.object(ea.id), self.store.object(eb.id)) else {
-            return Outcome::Answer(ItemResult::error(ErrorCode::UnknownObject));
+            return ItemResult::error(ErrorCode::UnknownObject);
         };
+        let q = self.q;
         let mut options = q.options;
         options.margin = match ask {
             Ask::Within(m) => Some(m),
             Ask::Below(_) => None,
         };
-        let warm = if q.warm { cached.map(|c| c.0) } else { None };
+        let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;
         match run_pair(
             self.workspace,
@@ -103,15 +121,16 @@ impl Ctx<'_> {
             warm.as_ref(),
         ) {
             Ok((result, next)) => {
+                let key = self.key(a, b);
                 if q.motion {
                     self.cache
                         .put_with_bound(key, next, bound_of(&result, ea, eb));
                 } else if q.warm {
                     self.cache.put(key, next);
                 }
-                Outcome::Answer(result)
+                result
             }
-            Err(code) => Outcome::Answer(ItemResult::error(code)),
+            Err(code) => ItemResult::error(code),
         }
     }
 }

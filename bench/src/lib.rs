@@ -40,6 +40,7 @@ pub mod plot;
 pub mod robot;
 pub mod robot_demo;
 pub mod scene_call;
+pub mod scene_inprocess;
 pub mod scene_parry;
 pub mod scene_robot;
 pub mod scene_world;

@@ -1,6 +1,6 @@
 //! `gjkd bench scene-robot`: a 7-link arm among 1 000 obstacles, per step
 //! the *clearance* (each link's nearest obstacle) and the pairs *within* 5 %
-//! of the arm's size, done three ways in one run:
+//! of the arm's size, done four ways in one run:
 //!
 //! - **parry3d-f64** in process, its BVH over the obstacles and its
 //!   distance queries, pruned as its users would write it
@@ -10,7 +10,10 @@
 //!   motion bounds; *within* with the margin's early exit);
 //! - **gjkd scene**: one scene request per step through the server, the
 //!   links' poses and the question
-//!   ([`SceneKind::Clearance`], [`SceneKind::Within`]).
+//!   ([`SceneKind::Clearance`], [`SceneKind::Within`]);
+//! - **gjkd scene engine, in process**: the same requests handed to the
+//!   server's state directly ([`crate::scene_inprocess`]), no round trip:
+//!   the engine's own work, for telling it from the transport's.
 //!
 //! The scene is [`crate::scene_world`]'s. The variants take turns in
 //! chunks of consecutive steps, so drift in the machine's speed hits all
@@ -30,6 +33,7 @@ use nalgebra::Isometry3;
 use parry3d_f64::shape::Shape as ParryShape;
 
 use crate::demo::ServerProcess;
+use crate::scene_inprocess::InProcess;
 use crate::scene_parry::ParryScene;
 use crate::scene_world::{Arm, Obstacles, joint_path};
 use crate::stats::{Csv, Progress, mean, percentile};
@@ -62,10 +66,11 @@ pub struct SceneRobotArgs {
 const CHUNK: usize = 50;
 
 /// The variants, in the table's order.
-const VARIANTS: [&str; 3] = [
+const VARIANTS: [&str; 4] = [
     "parry3d-f64 in process",
     "gjkd per-pair (server)",
     "gjkd scene (server)",
+    "gjkd engine in process",
 ];
 
 /// Runs the benchmark.
@@ -86,19 +91,43 @@ pub fn run(args: &SceneRobotArgs) -> Result<(), BenchError> {
     outcome
 }
 
+/// The ids a scene holds the arm's links and the obstacles under.
+struct Ids {
+    links: Vec<ObjectId>,
+    /// Obstacle index of an object id.
+    index: HashMap<u64, u32>,
+}
+
+impl Ids {
+    fn new(links: Vec<ObjectId>, obstacles: &[ObjectId]) -> Self {
+        let index = obstacles
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (o.raw(), i as u32))
+            .collect();
+        Ids { links, index }
+    }
+}
+
 /// The scene, registered and converted.
 struct Setup {
     arm: Arm,
     links: Vec<ObjectId>,
     obstacles: Vec<ObjectId>,
-    /// Obstacle index of an object id.
-    index: HashMap<u64, u32>,
+    /// The server's ids.
+    ids: Ids,
+    /// The in-process engine's ids.
+    engine_ids: Ids,
     parry: ParryScene,
     parry_links: Vec<Box<dyn ParryShape>>,
     margin: f64,
 }
 
-fn setup(client: &mut Client, args: &SceneRobotArgs, steps: usize) -> Result<Setup, BenchError> {
+fn setup(
+    client: &mut Client,
+    args: &SceneRobotArgs,
+    steps: usize,
+) -> Result<(Setup, InProcess), BenchError> {
     let arm = Arm::new();
     let count = if args.common.quick {
         args.obstacles.min(200)
@@ -121,11 +150,18 @@ fn setup(client: &mut Client, args: &SceneRobotArgs, steps: usize) -> Result<Set
         .enumerate()
         .map(|(i, (b, p))| client.register_named(&format!("obstacle{i}"), &b.geometry(), p))
         .collect::<Result<Vec<_>, _>>()?;
-    let index = obstacles
+    let mut engine = InProcess::new();
+    let engine_links = arm
+        .links
         .iter()
-        .enumerate()
-        .map(|(i, o)| (o.raw(), i as u32))
-        .collect();
+        .zip(&poses)
+        .map(|((b, _), p)| engine.add(b, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let engine_obstacles = world
+        .bodies
+        .iter()
+        .map(|(b, p)| engine.add(b, p))
+        .collect::<Result<Vec<_>, _>>()?;
     let parry = ParryScene::new(&world.bodies)?;
     let parry_links = arm
         .links
@@ -133,15 +169,17 @@ fn setup(client: &mut Client, args: &SceneRobotArgs, steps: usize) -> Result<Set
         .map(|(b, _)| b.parry())
         .collect::<Result<Vec<_>, _>>()?;
     let margin = args.margin * arm.size();
-    Ok(Setup {
+    let setup = Setup {
+        ids: Ids::new(links.clone(), &obstacles),
+        engine_ids: Ids::new(engine_links, &engine_obstacles),
         arm,
         links,
         obstacles,
-        index,
         parry,
         parry_links,
         margin,
-    })
+    };
+    Ok((setup, engine))
 }
 
 /// One step's answers of one variant: per link the nearest obstacle, and
@@ -193,7 +231,7 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
     // Separate clients, so that each variant warm-starts from its own
     // caches only.
     let (mut pair_client, mut scene_client) = (connect()?, connect()?);
-    let s = setup(&mut pair_client, args, steps)?;
+    let (s, mut engine) = setup(&mut pair_client, args, steps)?;
     let with_scene = scene_call::available();
     let pairs = s.links.len() * s.obstacles.len();
     let mut buf = Buffers {
@@ -202,7 +240,7 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
         rows: vec![SceneRow::default(); 4096],
         all: vec![0.0; pairs],
     };
-    let mut tallies: [Tally; 3] = Default::default();
+    let mut tallies: [Tally; 4] = Default::default();
     for t in &mut tallies {
         t.closest = f64::INFINITY;
     }
@@ -224,16 +262,28 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
             .map(|poses| parry_step(&s, poses, &mut tallies[0]))
             .collect();
         let mut scene = Vec::with_capacity(chunk.len());
+        let mut in_process = Vec::with_capacity(chunk.len());
         if with_scene {
+            let mut call = |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| {
+                scene_call::query(&mut scene_client, r, i, rows)
+            };
             for poses in &chunk {
-                scene.push(scene_step(
-                    &mut scene_client,
-                    &s,
-                    poses,
-                    &mut buf,
-                    &mut tallies[2],
-                )?);
+                let t = &mut tallies[2];
+                scene.push(scene_step(&mut call, &s, &s.ids, poses, &mut buf, t)?);
             }
+        }
+        let mut call =
+            |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| engine.query(r, i, rows);
+        for poses in &chunk {
+            let t = &mut tallies[3];
+            in_process.push(scene_step(
+                &mut call,
+                &s,
+                &s.engine_ids,
+                poses,
+                &mut buf,
+                t,
+            )?);
         }
         for poses in &chunk {
             floor.push(round_trip_floor(&mut pair_client, &s, poses, &mut buf)?);
@@ -245,6 +295,7 @@ fn measure(service: &str, args: &SceneRobotArgs) -> Result<(), BenchError> {
             if let Some(sc) = scene.get(k) {
                 judge(&s, &buf.all, &g, sc, &mut tallies[2]);
             }
+            judge(&s, &buf.all, &g, &in_process[k], &mut tallies[3]);
             progress.inc();
         }
         chunk_start += chunk.len();
@@ -370,36 +421,37 @@ fn pair_step(
 }
 
 /// The scene request of a step: the links' poses, the group's members.
-fn scene_items(s: &Setup, poses: &[Isometry3<f64>], items: &mut Vec<Item>) {
+fn scene_items(links: &[ObjectId], poses: &[Isometry3<f64>], items: &mut Vec<Item>) {
     items.clear();
-    items.extend(
-        s.links
-            .iter()
-            .zip(poses)
-            .map(|(&l, p)| Item::set_pose(l, p)),
-    );
-    items.extend(s.links.iter().map(|&l| Item::member(l)));
+    items.extend(links.iter().zip(poses).map(|(&l, p)| Item::set_pose(l, p)));
+    items.extend(links.iter().map(|&l| Item::member(l)));
 }
 
+/// How a scene request is sent: through a client, or to the engine in
+/// process.
+type SceneCall<'a> =
+    dyn FnMut(&SceneRequest, &[Item], &mut [SceneRow]) -> Result<SceneReply, BenchError> + 'a;
+
 fn scene_step(
-    client: &mut Client,
+    call: &mut SceneCall<'_>,
     s: &Setup,
+    ids: &Ids,
     poses: &[Isometry3<f64>],
     buf: &mut Buffers,
     tally: &mut Tally,
 ) -> Result<Answers, BenchError> {
     let mut a = Answers {
-        nearest: vec![None; s.links.len()],
+        nearest: vec![None; ids.links.len()],
         within: Vec::new(),
     };
-    let link_index = |id: u64| s.links.iter().position(|l| l.raw() == id);
+    let link_index = |id: u64| ids.links.iter().position(|l| l.raw() == id);
     let start = Instant::now();
-    scene_items(s, poses, &mut buf.items);
+    scene_items(&ids.links, poses, &mut buf.items);
     let mut request = SceneRequest::new(SceneKind::Clearance, 0);
     request.max_rows = buf.rows.len() as u32;
-    let reply = scene_call::query(client, &request, &buf.items, &mut buf.rows)?;
+    let reply = call(&request, &buf.items, &mut buf.rows)?;
     for row in &buf.rows[..reply_rows(&reply)?] {
-        let (Some(k), Some(&o)) = (link_index(row.a), s.index.get(&row.b)) else {
+        let (Some(k), Some(&o)) = (link_index(row.a), ids.index.get(&row.b)) else {
             continue;
         };
         a.nearest[k] = Some((o, row.result.distance));
@@ -407,13 +459,13 @@ fn scene_step(
     tally.clearance.push(start.elapsed().as_secs_f64() * 1e6);
     count_work(tally, &reply);
     let start = Instant::now();
-    scene_items(s, poses, &mut buf.items);
+    scene_items(&ids.links, poses, &mut buf.items);
     let mut request = SceneRequest::new(SceneKind::Within, 0);
     request.margin = s.margin;
     request.max_rows = buf.rows.len() as u32;
-    let reply = scene_call::query(client, &request, &buf.items, &mut buf.rows)?;
+    let reply = call(&request, &buf.items, &mut buf.rows)?;
     for row in &buf.rows[..reply_rows(&reply)?] {
-        if let (Some(k), Some(&o)) = (link_index(row.a), s.index.get(&row.b)) {
+        if let (Some(k), Some(&o)) = (link_index(row.a), ids.index.get(&row.b)) {
             a.within.push((k as u32, o));
         }
     }
@@ -504,7 +556,7 @@ fn report(
     s: &Setup,
     steps: usize,
     with_scene: bool,
-    tallies: &mut [Tally; 3],
+    tallies: &mut [Tally; 4],
 ) -> Result<(), BenchError> {
     println!(
         "gjkd bench scene-robot: a 7-link arm (capsules, boxes, polytopes) along a {steps}-step joint path\n\
@@ -543,8 +595,13 @@ fn report(
         "ratio_to_parry",
     ]);
     let base = [summary(&tallies[0].clearance), summary(&tallies[0].within)];
-    let shown = if with_scene { 3 } else { 2 };
-    for (name, t) in VARIANTS.iter().zip(tallies.iter()).take(shown) {
+    let shown: &[usize] = if with_scene {
+        &[0, 1, 2, 3]
+    } else {
+        &[0, 1, 3]
+    };
+    for &v in shown {
+        let (name, t) = (VARIANTS[v], &tallies[v]);
         let mut line = format!("{name:<24}");
         for (q, (v, b)) in [&t.clearance, &t.within].into_iter().zip(&base).enumerate() {
             let x = summary(v);
@@ -576,11 +633,12 @@ fn report(
     Ok(())
 }
 
-fn report_agreement(tallies: &[Tally; 3], shown: usize, steps: usize) {
+fn report_agreement(tallies: &[Tally; 4], shown: &[usize], steps: usize) {
     println!(
         "Agreement with gjkd's per-pair answers (nearest obstacle per link, ties allowed; pairs within the margin):"
     );
-    for (name, t) in VARIANTS.iter().zip(tallies.iter()).take(shown) {
+    for &v in shown {
+        let (name, t) = (VARIANTS[v], &tallies[v]);
         println!(
             "  {name:<24} {} nearest disagree, {} within-pairs disagree, largest nearest-distance gap {:.2e} m",
             t.nearest_disagree, t.within_disagree, t.max_distance_gap
@@ -593,7 +651,7 @@ fn report_agreement(tallies: &[Tally; 3], shown: usize, steps: usize) {
             t.within_pairs as f64 / steps as f64
         );
     }
-    if shown == 3 {
+    if shown.contains(&2) {
         let t = &tallies[2];
         let per = |x: u64| x as f64 / (2 * steps) as f64;
         println!(

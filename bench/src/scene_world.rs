@@ -85,6 +85,21 @@ impl Body {
         }
     }
 
+    /// As a gjk convex body.
+    ///
+    /// # Errors
+    /// The algorithm's, for a degenerate body.
+    pub fn gjk(&self) -> Result<gjk::Convex, gjk::Error> {
+        match self {
+            Body::Sphere(r) => gjk::Convex::sphere(*r),
+            Body::Capsule(h, r) => {
+                gjk::Convex::capsule(Point3::new(0.0, 0.0, -h), Point3::new(0.0, 0.0, *h), *r)
+            }
+            Body::Cuboid(h) => gjk::Convex::cuboid(*h, 0.0),
+            Body::Polytope(v) => gjk::Convex::new(v.clone(), 0.0),
+        }
+    }
+
     /// Radius of a ball about the body origin holding the body.
     pub fn bounding_radius(&self) -> f64 {
         match self {

@@ -15,12 +15,13 @@
 
 use std::time::{Duration, Instant};
 
-use gjkd_client::{Client, Item, QueryOptions};
-use gjkd_proto::{PathMode, SceneKind, SceneRequest, SceneRow};
+use gjkd_client::{Client, Item, ObjectId, QueryOptions};
+use gjkd_proto::{PathMode, SceneKind, SceneReply, SceneRequest, SceneRow};
 use gjkd_testkit::paper::{self, Motion, OBSTACLES};
 use nalgebra::Isometry3;
 
 use crate::demo::{Buffers, PAPER_RATIOS, Registered, ServerProcess, register, sweep};
+use crate::scene_inprocess::InProcess;
 use crate::scene_robot::load_average;
 use crate::stats::Csv;
 use crate::{BenchError, CommonArgs, io, out_dir, scene_call};
@@ -83,6 +84,25 @@ pub(crate) fn path_sweep(
     mode: PathMode,
     buf: &mut PathBuffers,
 ) -> Result<PathSweep, BenchError> {
+    let mut call =
+        |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| scene_call::query(client, r, i, rows);
+    path_sweep_with(&mut call, motion, scene, steps, mode, buf)
+}
+
+/// How a scene request is sent: through a client, or to the engine in
+/// process.
+type SceneCall<'a> =
+    dyn FnMut(&SceneRequest, &[Item], &mut [SceneRow]) -> Result<SceneReply, BenchError> + 'a;
+
+/// [`path_sweep`] with the request sent by `call`.
+fn path_sweep_with(
+    call: &mut SceneCall<'_>,
+    motion: &Motion,
+    scene: &Registered,
+    steps: usize,
+    mode: PathMode,
+    buf: &mut PathBuffers,
+) -> Result<PathSweep, BenchError> {
     let steps = steps.max(1);
     // Poses are computed before the clock starts, as in the demo.
     let poses: Vec<Isometry3<f64>> = (0..=steps)
@@ -100,7 +120,7 @@ pub(crate) fn path_sweep(
     request.margin = 0.0;
     request.max_rows = buf.rows.len() as u32;
     let start = Instant::now();
-    let reply = scene_call::query(client, &request, &buf.items, &mut buf.rows)?;
+    let reply = call(&request, &buf.items, &mut buf.rows)?;
     let elapsed = start.elapsed();
     if reply.total > u64::from(request.max_rows) {
         return Err(BenchError::Other("a path answer was truncated".into()));
@@ -135,6 +155,17 @@ pub fn run(args: &SweepArgs) -> Result<(), BenchError> {
     outcome
 }
 
+/// The Section 8 scene in an in-process engine, and its ids.
+fn in_process(motion: &Motion) -> Result<(InProcess, Registered), BenchError> {
+    let mut engine = InProcess::new();
+    let moving = engine.add_shape(motion.moving().clone(), &motion.pose(0.0))?;
+    let mut obstacles = [ObjectId::from_raw(0); OBSTACLES];
+    for (slot, (shape, pose)) in obstacles.iter_mut().zip(motion.obstacles()) {
+        *slot = engine.add_shape(shape.clone(), pose)?;
+    }
+    Ok((engine, Registered { moving, obstacles }))
+}
+
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
     v[v.len() / 2]
@@ -152,10 +183,14 @@ struct Row {
     cold: Duration,
     cold_margin: Duration,
     path: Option<Duration>,
+    /// The same path handed to the engine in process.
+    engine: Duration,
     first: Option<Duration>,
     first_hit: Option<usize>,
     /// Steps whose hits differ between the cold sweep and the path.
     disagree: usize,
+    /// The same for the in-process engine's path.
+    engine_disagree: usize,
     hitting_steps: usize,
     work: (u64, u64),
 }
@@ -175,6 +210,10 @@ fn measure_steps(
     };
     let mut path_buf = PathBuffers::new(t);
     let (mut cold, mut cold_margin, mut path, mut first) = (vec![], vec![], vec![], vec![]);
+    let mut engine_times = Vec::new();
+    let (mut engine, engine_ids) = in_process(motion)?;
+    let mut engine_call =
+        |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| engine.query(r, i, rows);
     let demo = |e: crate::demo::DemoError| BenchError::Other(e.to_string());
     let margin0 = QueryOptions {
         margin: Some(0.0),
@@ -185,9 +224,11 @@ fn measure_steps(
         cold: Duration::ZERO,
         cold_margin: Duration::ZERO,
         path: None,
+        engine: Duration::ZERO,
         first: None,
         first_hit: None,
         disagree: 0,
+        engine_disagree: 0,
         hitting_steps: 0,
         work: (0, 0),
     };
@@ -207,6 +248,16 @@ fn measure_steps(
         let m = sweep(client, motion, scene, t, &margin0, max_batch, &mut buffers).map_err(demo)?;
         cold_margin.push(m.elapsed);
         row.hitting_steps = c.hits.iter().filter(|&&h| h != 0).count();
+        let e = path_sweep_with(
+            &mut engine_call,
+            motion,
+            &engine_ids,
+            t,
+            PathMode::EveryStep,
+            &mut path_buf,
+        )?;
+        engine_times.push(e.elapsed);
+        row.engine_disagree = c.hits.iter().zip(&e.hits).filter(|(a, b)| a != b).count();
         if with_scene {
             let p = path_sweep(client, motion, scene, t, PathMode::EveryStep, &mut path_buf)?;
             let f = path_sweep(client, motion, scene, t, PathMode::FirstHit, &mut path_buf)?;
@@ -220,6 +271,7 @@ fn measure_steps(
     if let (Some(c), Some(p)) = (cold.iter().min(), path.iter().min()) {
         row.fastest_ratio = Some(c.as_secs_f64() / p.as_secs_f64().max(1e-12));
     }
+    row.engine = median(engine_times);
     row.cold = median(cold);
     row.cold_margin = median(cold_margin);
     if with_scene {
@@ -319,6 +371,12 @@ fn print_row(t: usize, r: &Row, csv: &mut Csv) {
         String::new()
     };
     println!("{:>6} {} of {} steps hit{work}", "", r.hitting_steps, t + 1);
+    println!(
+        "{:>6} the same path handed to the scene engine in process (no server): {} ({} steps disagree)",
+        "",
+        ms(r.engine),
+        r.engine_disagree
+    );
     let opt =
         |d: Option<Duration>| d.map_or(String::new(), |d| (d.as_secs_f64() * 1e3).to_string());
     csv.row(&[

@@ -33,8 +33,20 @@ impl InProcess {
     /// # Errors
     /// When the body is degenerate or the store refuses it.
     pub fn add(&mut self, body: &Body, pose: &Isometry3<f64>) -> Result<ObjectId, BenchError> {
+        self.add_shape(body.gjk()?.into(), pose)
+    }
+
+    /// Adds `shape` at `pose`, returning its id.
+    ///
+    /// # Errors
+    /// When the store refuses it.
+    pub fn add_shape(
+        &mut self,
+        shape: gjk::Shape,
+        pose: &Isometry3<f64>,
+    ) -> Result<ObjectId, BenchError> {
         let new = NewObject {
-            shape: body.gjk()?.into(),
+            shape,
             pose: *pose,
             name: None,
         };

@@ -166,6 +166,11 @@ enum gjkd_query_status
   // Round-off stopped progress before the tolerance was met; the bounds
   // still hold.
   GJKD_QUERY_TOLERANCE_NOT_MET = 5,
+  // Scene queries only: answered from the pair's last certified interval
+  // widened by how far the objects moved since, without running GJK;
+  // the bounds hold, the distance and points are the last answer's
+  // carried with the objects.
+  GJKD_QUERY_BOUNDED = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -218,6 +223,28 @@ enum gjkd_precision
 typedef enum gjkd_precision gjkd_precision;
 #else
 typedef uint32_t gjkd_precision;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+// What a path reports at each step (`gjkd_path()`).
+enum gjkd_path_question
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // Each member's clearance at every step.
+  GJKD_PATH_CLEARANCE = 0,
+  // The pairs within the margin at every step.
+  GJKD_PATH_WITHIN = 1,
+  // Only the first step with a pair within the margin: its pairs, and
+  // its index in `gjkd_scene_summary::first_hit`.
+  GJKD_PATH_FIRST_HIT = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum gjkd_path_question gjkd_path_question;
+#else
+typedef uint32_t gjkd_path_question;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -394,6 +421,90 @@ typedef struct gjkd_results {
   // `count` flags: the query started warm.
   bool *warm_started;
 } gjkd_results;
+
+// Options of a scene query; start from `gjkd_scene_options_default()`.
+typedef struct gjkd_scene_options {
+  // Relative tolerance of every pair, `>= 0`.
+  double tolerance;
+  // Accept, from motion bounds alone, an interval at most this wide (0:
+  // none).
+  double accept_absolute;
+  // Accept, from motion bounds alone, an interval at most this times
+  // its upper end wide (0: none).
+  double accept_relative;
+  // With `use_cutoff`: ignore objects farther than this (clearance,
+  // nearest); they are never searched for (a member with nothing that near gets `b` 0, or an object found on the way).
+  double cutoff;
+  // Iteration cap of every pair, `>= 1`.
+  uint32_t max_iterations;
+  // A `gjkd_precision` value.
+  uint32_t precision;
+  // Whether `cutoff` applies.
+  bool use_cutoff;
+  // Start each pair from the simplex the server kept for this handle.
+  bool warm_start;
+  // Answer pairs from motion bounds when they decide the question (rows
+  // with status `GJKD_QUERY_BOUNDED`).
+  bool motion_bounds;
+  // Within: every pair of the scene, not only group against the rest.
+  bool all_pairs;
+  // Clamp joint positions outside their limits instead of refusing.
+  bool clamp;
+} gjkd_scene_options;
+
+// The objects a scene question is about: `id` (a robot, whose links are
+// the group, with its allowed pairs; or one object), or, when `id` is 0,
+// the `member_count` ids at `members`. `allowed` holds `allowed_count`
+// pairs (`2 * allowed_count` ids, `a0, b0, a1, b1, ...`) never to report;
+// it may be NULL when `allowed_count` is 0.
+typedef struct gjkd_group {
+  // A robot or object id, or 0 for the listed members.
+  gjkd_id id;
+  // The members when `id` is 0.
+  const gjkd_id *members;
+  // Number of members.
+  size_t member_count;
+  // Pairs never to report, two ids each.
+  const gjkd_id *allowed;
+  // Number of allowed pairs.
+  size_t allowed_count;
+} gjkd_group;
+
+// One row of a scene answer: the pair and its answer.
+typedef struct gjkd_scene_row {
+  // The group's object (the object asked about, for `gjkd_nearest()`).
+  gjkd_id a;
+  // The other object; 0 when none qualifies.
+  gjkd_id b;
+  // The path step (0 when not a path).
+  uint32_t step;
+  // The pair's `gjkd_error_code`, 0 when answered.
+  uint32_t error;
+  // The pair's answer, `point_a` on `a`.
+  struct gjkd_answer answer;
+} gjkd_scene_row;
+
+// What a scene answer held besides its rows.
+typedef struct gjkd_scene_summary {
+  // Rows written, from the start of the caller's array.
+  size_t written;
+  // Rows that qualified, also those that did not fit.
+  uint64_t total;
+  // Pair queries that ran GJK.
+  uint64_t gjk_runs;
+  // Pairs answered from motion bounds alone.
+  uint64_t bounded;
+  // Pairs the broadphase could not rule out.
+  uint64_t candidates;
+  // Steps answered (1 when not a path).
+  uint32_t steps;
+  // First-hit paths: the first step with a pair within the margin,
+  // `UINT32_MAX` when none.
+  uint32_t first_hit;
+  // More rows qualified than the array holds: the rows written are a
+  // prefix of the answer.
+  bool truncated;
+} gjkd_scene_summary;
 
 #ifdef __cplusplus
 extern "C" {
@@ -708,6 +819,97 @@ enum gjkd_status gjkd_distances(struct gjkd_client *client,
                                 const struct gjkd_pose *poses_b,
                                 const struct gjkd_query_options *options,
                                 const struct gjkd_results *out);
+
+// The default scene options: default tolerance and iteration cap, warm
+// starts and motion bounds on, no accepted accuracy, no cut-off.
+struct gjkd_scene_options gjkd_scene_options_default(void);
+
+// For each member of `group`, the nearest object outside the group: one
+// row per member into `rows` (room for `capacity`), the counts into
+// `*summary`. `options` NULL means `gjkd_scene_options_default()`.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `group`, `summary`, `rows`
+// with a non-zero `capacity`, the group's arrays with non-zero counts),
+// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a precision that
+// is no `gjkd_precision`), `GJKD_ERR_REJECTED` with
+// `GJKD_CODE_UNKNOWN_OBJECT` (the group or a member),
+// `GJKD_CODE_INVALID_OPTIONS` (tolerance, iteration cap, accepted
+// accuracy, cut-off out of their domain), `GJKD_CODE_MALFORMED` (an empty
+// group), `GJKD_CODE_BATCH_TOO_LARGE` (more members and allowed pairs
+// than the server's `max_batch`); `GJKD_ERR_SERVER_GONE`,
+// `GJKD_ERR_TIMEOUT`, `GJKD_ERR_PROTOCOL` (a server without scene
+// queries). On failure nothing changed on the server and `*summary` is
+// zeroed.
+//
+// # Safety
+// `client` is NULL or a live handle; every other non-NULL pointer points
+// to what its parameter says.
+enum gjkd_status gjkd_clearance(struct gjkd_client *client,
+                                const struct gjkd_group *group,
+                                const struct gjkd_scene_options *options,
+                                struct gjkd_scene_row *rows,
+                                size_t capacity,
+                                struct gjkd_scene_summary *summary);
+
+// Every pair, `group` against the rest (or all against all with
+// `options->all_pairs`), whose distance is at most `margin`, into `rows`.
+//
+// Errors: as `gjkd_clearance()`, plus `GJKD_CODE_INVALID_OPTIONS` for a
+// NaN margin.
+//
+// # Safety
+// As `gjkd_clearance()`.
+enum gjkd_status gjkd_within(struct gjkd_client *client,
+                             const struct gjkd_group *group,
+                             double margin,
+                             const struct gjkd_scene_options *options,
+                             struct gjkd_scene_row *rows,
+                             size_t capacity,
+                             struct gjkd_scene_summary *summary);
+
+// The `k` objects nearest to `object`, nearest first, into `rows`.
+//
+// Errors: as `gjkd_clearance()`, with `GJKD_CODE_INVALID_OPTIONS` for a
+// `k` of 0.
+//
+// # Safety
+// As `gjkd_clearance()`.
+enum gjkd_status gjkd_nearest(struct gjkd_client *client,
+                              gjkd_id object,
+                              uint32_t k,
+                              const struct gjkd_scene_options *options,
+                              struct gjkd_scene_row *rows,
+                              size_t capacity,
+                              struct gjkd_scene_summary *summary);
+
+// A question asked at every step of a candidate motion, without moving
+// anything on the server: `poses` holds `step_count * moving_count` poses,
+// `poses[s * moving_count + i]` the pose of `moving[i]` at step `s`.
+// `question` is a `gjkd_path_question`; `margin` applies to
+// `GJKD_PATH_WITHIN` and `GJKD_PATH_FIRST_HIT`. Rows carry their step.
+//
+// Errors: as `gjkd_within()`, plus `GJKD_ERR_NULL_POINTER` (`moving`,
+// `poses` with non-zero counts), `GJKD_ERR_INVALID_ARGUMENT` (a
+// `question` that is no `gjkd_path_question`, no moving object or no
+// step, a pose that is not finite or not a unit quaternion: nothing is
+// sent), `GJKD_CODE_BATCH_TOO_LARGE` (more steps times moving objects
+// than the server's `max_batch` takes in one request).
+//
+// # Safety
+// As `gjkd_clearance()`; `moving` and `poses` NULL or pointing to their
+// counts.
+enum gjkd_status gjkd_path(struct gjkd_client *client,
+                           const struct gjkd_group *group,
+                           uint32_t question,
+                           double margin,
+                           const gjkd_id *moving,
+                           size_t moving_count,
+                           const struct gjkd_pose *poses,
+                           size_t step_count,
+                           const struct gjkd_scene_options *options,
+                           struct gjkd_scene_row *rows,
+                           size_t capacity,
+                           struct gjkd_scene_summary *summary);
 
 #ifdef __cplusplus
 }  // extern "C"

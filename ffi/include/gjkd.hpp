@@ -45,6 +45,12 @@ using Shape = gjkd_shape;
 using Piece = gjkd_piece;
 /// Three doubles.
 using Vec3 = std::array<double, 3>;
+/// A row of a scene answer: a pair and its answer.
+using SceneRow = gjkd_scene_row;
+/// What a scene answer held besides its rows.
+using SceneSummary = gjkd_scene_summary;
+/// Scene query options; start from default_scene_options().
+using SceneOptions = gjkd_scene_options;
 
 /// A failed call: what gjkd_status it returned, the server's code for
 /// GJKD_ERR_REJECTED (GJKD_CODE_OK otherwise), and the message.
@@ -79,6 +85,27 @@ inline Pose at(double x, double y, double z) {
 
 /// The default query options.
 inline Options default_options() { return gjkd_query_options_default(); }
+
+/// The default scene query options.
+inline SceneOptions default_scene_options() { return gjkd_scene_options_default(); }
+
+/// The group of a scene query: a robot or one object by `id`, or (with
+/// `id` 0) the listed members; allowed pairs never reported. The vectors
+/// are read by each call, not copied here.
+struct Group {
+    /// A robot or object id, or 0 for `members`.
+    Id id = 0;
+    /// The members when `id` is 0.
+    std::vector<Id> members;
+    /// Pairs never to report.
+    std::vector<std::array<Id, 2>> allowed;
+
+    /// The C view, valid while this Group lives unchanged.
+    gjkd_group view() const {
+        return gjkd_group{id, members.empty() ? nullptr : members.data(), members.size(),
+                          allowed.empty() ? nullptr : allowed[0].data(), allowed.size()};
+    }
+};
 
 /// A ball of `radius`.
 inline Shape sphere(double radius) {
@@ -287,6 +314,49 @@ public:
     gjkd_server_stats stats() {
         gjkd_server_stats s{};
         check(gjkd_stats(handle_, &s));
+        return s;
+    }
+
+    /// Each member's nearest object outside `group`, into `rows` (its size
+    /// is the room; rows past `written` are left alone).
+    SceneSummary clearance(const Group &group, std::vector<SceneRow> &rows,
+                           const SceneOptions *options = nullptr) {
+        SceneSummary s{};
+        const gjkd_group g = group.view();
+        check(gjkd_clearance(handle_, &g, options, rows.data(), rows.size(), &s));
+        return s;
+    }
+    /// Every pair within `margin`, into `rows`.
+    SceneSummary within(const Group &group, double margin, std::vector<SceneRow> &rows,
+                        const SceneOptions *options = nullptr) {
+        SceneSummary s{};
+        const gjkd_group g = group.view();
+        check(gjkd_within(handle_, &g, margin, options, rows.data(), rows.size(), &s));
+        return s;
+    }
+    /// The `k` objects nearest to `object`, into `rows`.
+    SceneSummary nearest(Id object, uint32_t k, std::vector<SceneRow> &rows,
+                         const SceneOptions *options = nullptr) {
+        SceneSummary s{};
+        check(gjkd_nearest(handle_, object, k, options, rows.data(), rows.size(), &s));
+        return s;
+    }
+    /// `question` (a gjkd_path_question) at every step of a motion of
+    /// `moving`: `poses` holds `poses.size() / moving.size()` steps.
+    SceneSummary path(const Group &group, gjkd_path_question question, double margin,
+                      const std::vector<Id> &moving, const std::vector<Pose> &poses,
+                      std::vector<SceneRow> &rows, const SceneOptions *options = nullptr) {
+        if (moving.empty() || poses.size() % moving.size() != 0) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "path: " + std::to_string(poses.size()) +
+                            " poses are no whole number of steps of " +
+                            std::to_string(moving.size()) + " objects");
+        }
+        SceneSummary s{};
+        const gjkd_group g = group.view();
+        check(gjkd_path(handle_, &g, static_cast<uint32_t>(question), margin, moving.data(),
+                        moving.size(), poses.data(), poses.size() / moving.size(), options,
+                        rows.data(), rows.size(), &s));
         return s;
     }
 

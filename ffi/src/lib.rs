@@ -27,6 +27,7 @@ mod connect;
 mod handle;
 mod objects;
 mod query;
+mod scene;
 mod status;
 mod types;
 
@@ -34,6 +35,7 @@ pub use connect::*;
 pub use handle::gjkd_client;
 pub use objects::*;
 pub use query::*;
+pub use scene::*;
 pub use status::gjkd_status;
 pub use types::*;
 

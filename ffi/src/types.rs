@@ -202,6 +202,11 @@ pub enum gjkd_query_status {
     /// Round-off stopped progress before the tolerance was met; the bounds
     /// still hold.
     GJKD_QUERY_TOLERANCE_NOT_MET = 5,
+    /// Scene queries only: answered from the pair's last certified interval
+    /// widened by how far the objects moved since, without running GJK;
+    /// the bounds hold, the distance and points are the last answer's
+    /// carried with the objects.
+    GJKD_QUERY_BOUNDED = 6,
 }
 
 /// The server's error codes: per item in `gjkd_results::error`, and for a

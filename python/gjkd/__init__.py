@@ -15,6 +15,13 @@ qw]`` rows or 4x4 matrices), then ask ``distance(a, b)`` for one pair or
 ``distances(pairs)`` for many in one call. Every answer carries certified
 bounds ``lower <= distance <= upper``, nearest points and a normal.
 
+Scene queries ask about a group of objects against everything the server
+holds, in one round trip, into a :class:`SceneRows` you own:
+``client.clearance(group, out=rows)`` (each member's nearest other object),
+``client.within(group, margin, out=rows)`` (every pair within a margin),
+``client.nearest(object, k, out=rows)`` and ``client.path(group, objects,
+poses, out=rows)`` (a question at every step of a candidate motion).
+
 Example::
 
     import numpy as np
@@ -55,6 +62,8 @@ from ._native import (
     Client,
     Distances,
     Local,
+    SceneRows,
+    SceneSummary,
     Shape,
 )
 from .server import Server
@@ -78,6 +87,8 @@ __all__ = [
     "NotFound",
     "ProtocolError",
     "Refused",
+    "SceneRows",
+    "SceneSummary",
     "Server",
     "ServerGone",
     "Shape",

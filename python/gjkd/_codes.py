@@ -80,3 +80,7 @@ class Status(enum.IntEnum):
     TOLERANCE_NOT_MET = 5
     """Round-off stopped progress before the tolerance was met; the bounds
     still hold."""
+    BOUNDED = 6
+    """Scene queries only: answered without running GJK, from the pair's last
+    certified interval widened by how far the objects moved since; the bounds
+    hold, the distance and points are the last answer's carried along."""

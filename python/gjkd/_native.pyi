@@ -17,6 +17,8 @@ __all__ = [
     "MAX_NAME_LEN",
     "MAX_PIECES",
     "PROTOCOL_VERSION",
+    "SceneRows",
+    "SceneSummary",
     "Shape",
     "error_codes",
     "serve",
@@ -35,6 +37,7 @@ transform, float64."""
 
 _F64 = npt.NDArray[np.float64]
 _U32 = npt.NDArray[np.uint32]
+_U64 = npt.NDArray[np.uint64]
 
 @final
 class Shape:
@@ -152,6 +155,70 @@ class Distances:
     def as_dict(self) -> dict[str, npt.NDArray[np.generic]]:
         """The arrays keyed by field name."""
 
+@final
+class SceneRows:
+    """Room for the rows of scene answers, reused from call to call."""
+
+    def __new__(cls, n: int) -> Self:
+        """Zeroed room for ``n`` rows."""
+    def __len__(self) -> int: ...
+    @property
+    def a(self) -> _U64:
+        """``(n,)`` the group's objects."""
+    @property
+    def b(self) -> _U64:
+        """``(n,)`` the other objects, 0 for none."""
+    @property
+    def step(self) -> _U32:
+        """``(n,)`` the path steps."""
+    @property
+    def answers(self) -> Distances:
+        """The pairs' answers."""
+    @property
+    def distance(self) -> _F64:
+        """``(n,)`` distances."""
+    @property
+    def lower(self) -> _F64:
+        """``(n,)`` certified lower bounds."""
+    @property
+    def upper(self) -> _F64:
+        """``(n,)`` certified upper bounds."""
+    @property
+    def status(self) -> _U32:
+        """``(n,)`` ``gjkd.Status`` values."""
+    @property
+    def error(self) -> _U32:
+        """``(n,)`` ``gjkd.ErrorCode`` values."""
+
+@final
+class SceneSummary:
+    """What a scene answer held besides its rows."""
+
+    @property
+    def written(self) -> int:
+        """Rows written."""
+    @property
+    def total(self) -> int:
+        """Rows that qualified, also those that did not fit."""
+    @property
+    def truncated(self) -> bool:
+        """More rows qualified than the rows hold."""
+    @property
+    def steps(self) -> int:
+        """Steps answered."""
+    @property
+    def first_hit(self) -> Optional[int]:
+        """The first step within the margin of a first-hit path."""
+    @property
+    def gjk_runs(self) -> int:
+        """Pair queries that ran GJK."""
+    @property
+    def bounded(self) -> int:
+        """Pairs answered from motion bounds alone."""
+    @property
+    def candidates(self) -> int:
+        """Pairs the broadphase could not rule out."""
+
 class _Objects:
     """The methods ``Client`` and ``Local`` share."""
 
@@ -256,6 +323,72 @@ class Client(_Objects):
         """The server's limits, wait mode and pid."""
     def stats(self) -> dict[str, int]:
         """The server's counters."""
+    def clearance(
+        self,
+        group: _ArrayLike,
+        *,
+        out: SceneRows,
+        allow: Optional[_ArrayLike] = None,
+        cutoff: Optional[float] = None,
+        tolerance: float = ...,
+        max_iterations: int = ...,
+        warm_start: bool = True,
+        motion_bounds: bool = True,
+        accept_absolute: float = 0.0,
+        accept_relative: float = 0.0,
+    ) -> SceneSummary:
+        """Each member's nearest object outside ``group``."""
+    def within(
+        self,
+        group: _ArrayLike,
+        margin: float,
+        *,
+        out: SceneRows,
+        all_pairs: bool = False,
+        allow: Optional[_ArrayLike] = None,
+        tolerance: float = ...,
+        max_iterations: int = ...,
+        warm_start: bool = True,
+        motion_bounds: bool = True,
+        accept_absolute: float = 0.0,
+        accept_relative: float = 0.0,
+    ) -> SceneSummary:
+        """Every pair within ``margin``."""
+    def nearest(
+        self,
+        object: int,
+        k: int,
+        *,
+        out: SceneRows,
+        allow: Optional[_ArrayLike] = None,
+        cutoff: Optional[float] = None,
+        tolerance: float = ...,
+        max_iterations: int = ...,
+        warm_start: bool = True,
+        motion_bounds: bool = True,
+        accept_absolute: float = 0.0,
+        accept_relative: float = 0.0,
+    ) -> SceneSummary:
+        """The ``k`` objects nearest to ``object``."""
+    def path(
+        self,
+        group: _ArrayLike,
+        objects: _ArrayLike,
+        poses: _ArrayLike,
+        *,
+        out: SceneRows,
+        question: str = "clearance",
+        margin: float = 0.0,
+        allow: Optional[_ArrayLike] = None,
+        cutoff: Optional[float] = None,
+        tolerance: float = ...,
+        max_iterations: int = ...,
+        warm_start: bool = True,
+        motion_bounds: bool = True,
+        accept_absolute: float = 0.0,
+        accept_relative: float = 0.0,
+    ) -> SceneSummary:
+        """A question at every step of a candidate motion."""
     def __enter__(self) -> Client: ...
     def __exit__(
         self,

@@ -114,7 +114,7 @@ impl Client {
     }
 
     /// Runs `call` on the Rust client with the GIL released.
-    fn call<R>(
+    pub(crate) fn call<R>(
         &mut self,
         py: Python<'_>,
         call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,

@@ -10,6 +10,7 @@ mod client;
 mod errors;
 mod local;
 mod runner;
+mod scene;
 mod server_lib;
 mod shape;
 
@@ -42,6 +43,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<shape::Shape>()?;
     m.add_class::<batch::Distances>()?;
     m.add_class::<batch::Answer>()?;
+    m.add_class::<scene::SceneRows>()?;
+    m.add_class::<scene::Summary>()?;
     m.add_function(wrap_pyfunction!(serve, m)?)?;
     m.add_function(wrap_pyfunction!(error_codes, m)?)?;
     m.add("DEFAULT_TOLERANCE", gjkd_proto::DEFAULT_TOLERANCE)?;

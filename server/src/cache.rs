@@ -84,6 +84,9 @@ pub struct PairBound {
     pub upper: f64,
     /// The distance answered.
     pub distance: f64,
+    /// Certified lower bound on the penetration depth then (0 when
+    /// separated): while the objects move by less, they still overlap.
+    pub penetration: f64,
     /// A's pose then.
     pub pose_a: Isometry3<f64>,
     /// B's pose then.
@@ -162,22 +165,15 @@ impl WarmCache {
         }
     }
 
-    /// The cached simplex and last certified answer of `key`, marking the
-    /// entry as recently used (counted as [`WarmCache::get`]).
+    /// The last certified answer kept for `key`, marking the entry as
+    /// recently used (not counted as a hit or miss: a look-up for the
+    /// simplex follows when the answer does not do).
     #[inline]
-    pub fn get_with_bound(&mut self, key: &PairKey) -> Option<(WarmStart, Option<PairBound>)> {
-        match self.index.get(key) {
-            Some(&i) => {
-                let slot = &mut self.slots[i as usize];
-                slot.referenced = true;
-                self.stats.hits += 1;
-                Some((slot.warm, slot.bound))
-            }
-            None => {
-                self.stats.misses += 1;
-                None
-            }
-        }
+    pub fn bound(&mut self, key: &PairKey) -> Option<&PairBound> {
+        let &i = self.index.get(key)?;
+        let slot = &mut self.slots[i as usize];
+        slot.referenced = true;
+        slot.bound.as_ref()
     }
 
     /// Stores the simplex of `key`, evicting an entry that has not been used

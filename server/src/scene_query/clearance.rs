@@ -18,7 +18,7 @@ use std::cell::RefCell;
 use gjkd_proto::{ItemResult, SceneRow};
 
 use super::broadphase::{node_gap_squared, root_up, sphere_gap, square_up};
-use super::motion_bound::{accepted, bounded_result, widen};
+use super::motion_bound::{accepted, bounded_result};
 use super::pair::{Ask, Ctx};
 
 /// The search's state: the best certified candidate so far (slot and
@@ -42,26 +42,23 @@ impl Search<'_, '_> {
     /// `best_cost`: returns the certified upper bound it brings, if lower.
     fn visit(&mut self, a: u32, leaf: u32, best_cost: f64) -> Option<f64> {
         let ctx = &mut *self.ctx;
-        let cached = ctx.lookup(a, leaf);
         let q = ctx.q;
-        if q.motion
-            && let Some((_, Some(bound))) = &cached
-        {
-            let (ea, eb) = (ctx.bp.entry(a), ctx.bp.entry(leaf));
-            let w = widen(bound, ea, eb);
+        let (ea, eb) = (ctx.bp.entry(a), ctx.bp.entry(leaf));
+        if let Some((bound, w)) = ctx.widened(a, leaf) {
             if w.lower >= best_cost {
                 ctx.counters.bounded += 1;
                 return None;
             }
             if accepted(&w, q.accept_absolute, q.accept_relative) {
-                ctx.counters.bounded += 1;
                 let r = bounded_result(bound, &w, ea, eb);
+                ctx.counters.bounded += 1;
                 self.approximate.push((leaf, r.lower));
                 self.offer(leaf, r);
                 return (r.upper < best_cost).then_some(r.upper);
             }
         }
-        let r = ctx.run(a, leaf, Ask::Below(best_cost), cached.map(|c| c.0));
+        let warm = ctx.warm(a, leaf);
+        let r = ctx.run(a, leaf, Ask::Below(best_cost), warm);
         self.offer(leaf, r);
         (r.error == 0 && r.upper < best_cost).then_some(r.upper)
     }
@@ -81,7 +78,7 @@ impl Search<'_, '_> {
                 break;
             };
             self.approximate.swap_remove(i);
-            let warm = self.ctx.lookup(a, leaf).map(|c| c.0);
+            let warm = self.ctx.warm(a, leaf);
             let r = self.ctx.run(a, leaf, Ask::Below(f64::INFINITY), warm);
             self.offer(leaf, r);
         }

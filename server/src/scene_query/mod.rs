@@ -1,7 +1,10 @@
 //! The scene service's engine: whole-scene questions ([`SceneRequest`])
-//! answered in-process against the store, with a broadphase
-//! ([`broadphase`]) and certified motion bounds ([`motion_bound`]). The
-//! iceoryx2 port calls [`State::scene`].
+//! answered in-process against the store, with a broadphase ([`Broadphase`]:
+//! parry3d-f64's BVH over one box per object, following the store's
+//! changes) and certified motion bounds (each pair's last certified
+//! interval, kept with its warm start in the [`cache`](crate::cache) and
+//! widened by how far either object can have moved since). The iceoryx2
+//! port calls [`State::scene`].
 //!
 //! ```
 //! use gjkd_server::state::{Limits, State};

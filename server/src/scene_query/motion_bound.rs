@@ -48,7 +48,13 @@ pub(crate) struct Widened {
 pub(crate) fn widen(bound: &PairBound, a: &Entry, b: &Entry) -> Widened {
     let d = displacement(a, &bound.pose_a) + displacement(b, &bound.pose_b);
     let lower = (bound.lower - d) * (1.0 - ROUND_OFF);
-    let upper = (bound.upper + d) * (1.0 + ROUND_OFF);
+    // Objects that overlapped by at least `penetration` and moved by less
+    // still overlap: the distance is 0.
+    let upper = if bound.penetration * (1.0 - ROUND_OFF) > d * (1.0 + ROUND_OFF) {
+        0.0
+    } else {
+        (bound.upper + d) * (1.0 + ROUND_OFF)
+    };
     Widened {
         // A NaN (never expected) reads as no information.
         lower: if lower > 0.0 { lower } else { 0.0 },
@@ -95,6 +101,11 @@ pub(crate) fn bound_of(result: &ItemResult, a: &Entry, b: &Entry) -> PairBound {
         lower: result.lower,
         upper: result.upper,
         distance: result.distance,
+        penetration: if result.penetration > 0.0 {
+            result.penetration
+        } else {
+            0.0
+        },
         pose_a: a.pose,
         pose_b: b.pose,
         point_a: a.pose.inverse_transform_point(&pa),

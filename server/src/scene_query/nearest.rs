@@ -1,7 +1,9 @@
 //! Nearest k: the k objects nearest to one object, nearest first.
 //!
 //! The same branch and bound as clearance, against the k-th best upper
-//! bound once k candidates are known.
+//! bound once k candidates are known. Motion bounds only rule candidates
+//! out here: an accepted width never stands for a GJK answer, since an
+//! approximate interval could put the k in the wrong order.
 
 use std::cell::RefCell;
 
@@ -46,7 +48,7 @@ pub(crate) fn nearest_of(
                 return None;
             }
             ctx.counters.candidates += 1;
-            let Outcome::Answer(r) = ctx.settle(a, leaf, Ask::Below(kth)) else {
+            let Outcome::Answer(r) = ctx.settle(a, leaf, Ask::BelowExactly(kth)) else {
                 return None;
             };
             if r.error != 0 {

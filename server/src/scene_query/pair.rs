@@ -6,7 +6,7 @@ use gjkd_proto::{ErrorCode, ItemResult};
 
 use super::broadphase::Broadphase;
 use super::groups::Group;
-use super::motion_bound::{accepted, bound_of, bounded_result, widen};
+use super::motion_bound::{Widened, accepted, bound_of, bounded_result, widen};
 use super::{Counters, Question};
 use crate::cache::{PairBound, PairKey, WarmCache};
 use crate::requests::run_pair;
@@ -20,6 +20,9 @@ pub(crate) enum Ask {
     Within(f64),
     /// Could it be nearer than this (the current best's upper bound)?
     Below(f64),
+    /// As `Below`, but an accepted width does not settle the pair (nearest
+    /// k, whose order an approximate answer could get wrong).
+    BelowExactly(f64),
 }
 
 /// How a pair was settled.
@@ -54,14 +57,27 @@ pub(crate) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    /// The cache entry of the pair of slots `a`, `b` (for this client), when
-    /// warm starts or motion bounds are on.
-    pub(crate) fn lookup(&mut self, a: u32, b: u32) -> Option<(WarmStart, Option<PairBound>)> {
-        if !(self.q.warm || self.q.motion) {
+    /// The cached simplex of the pair of slots `a`, `b` (for this client),
+    /// when warm starts are on.
+    pub(crate) fn warm(&mut self, a: u32, b: u32) -> Option<WarmStart> {
+        if !self.q.warm {
             return None;
         }
         let key = self.key(a, b);
-        self.cache.get_with_bound(&key)
+        self.cache.get(&key)
+    }
+
+    /// The pair's motion bound at the current poses, when motion bounds are
+    /// on and one is kept: the cached answer and its widened interval.
+    pub(crate) fn widened(&mut self, a: u32, b: u32) -> Option<(&PairBound, Widened)> {
+        if !self.q.motion {
+            return None;
+        }
+        let key = self.key(a, b);
+        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
+        let bound = self.cache.bound(&key)?;
+        let w = widen(bound, ea, eb);
+        Some((bound, w))
     }
 
     fn key(&self, a: u32, b: u32) -> PairKey {
@@ -74,28 +90,28 @@ impl Ctx<'_> {
 
     /// Settles the pair of slots `a`, `b` for `ask`.
     pub(crate) fn settle(&mut self, a: u32, b: u32, ask: Ask) -> Outcome {
-        let cached = self.lookup(a, b);
         let q = self.q;
-        if q.motion
-            && let Some((_, Some(bound))) = &cached
-        {
-            let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
-            let w = widen(bound, ea, eb);
+        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
+        let mut decided = None;
+        if let Some((bound, w)) = self.widened(a, b) {
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
                 Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
                 Ask::Below(best) => (w.lower >= best, ok),
+                Ask::BelowExactly(best) => (w.lower >= best, false),
             };
             if ruled {
-                self.counters.bounded += 1;
-                return Outcome::Ruled;
-            }
-            if settled {
-                self.counters.bounded += 1;
-                return Outcome::Answer(bounded_result(bound, &w, ea, eb));
+                decided = Some(Outcome::Ruled);
+            } else if settled {
+                decided = Some(Outcome::Answer(bounded_result(bound, &w, ea, eb)));
             }
         }
-        Outcome::Answer(self.run(a, b, ask, cached.map(|c| c.0)))
+        if let Some(outcome) = decided {
+            self.counters.bounded += 1;
+            return outcome;
+        }
+        let warm = self.warm(a, b);
+        Outcome::Answer(self.run(a, b, ask, warm))
     }
 
     /// Runs GJK on the pair of slots `a`, `b` (from `warm` if warm starts
@@ -109,7 +125,7 @@ impl Ctx<'_> {
         let mut options = q.options;
         options.margin = match ask {
             Ask::Within(m) => Some(m),
-            Ask::Below(_) => None,
+            Ask::Below(_) | Ask::BelowExactly(_) => None,
         };
         let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;

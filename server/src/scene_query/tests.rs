@@ -302,7 +302,7 @@ fn moved(pose: &Isometry3<f64>, m: &Motion, centre: &Vector3<f64>) -> Isometry3<
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     /// Along random motions, near and far from the origin, with motion
     /// bounds and an accepted accuracy: no pair within the margin is
@@ -802,4 +802,42 @@ fn the_index_follows_registrations_and_removals() {
     now.push(close);
     check_clearance(&s, &rows, &[ids[0]], &now);
     assert_eq!(rows[0].result.lower, 0.0);
+}
+
+#[test]
+fn overlapping_pairs_stay_within_by_their_penetration() {
+    let mut s = State::new(Limits::default(), WaitMode::Spin, 3);
+    let mut ball = |x: f64| {
+        s.insert(
+            NewObject {
+                shape: Convex::sphere(0.5).unwrap().into(),
+                pose: Isometry3::translation(x, 0.0, 0.0),
+                name: None,
+            },
+            Owner::Client(1),
+        )
+        .unwrap()
+    };
+    let (mover, other) = (ball(0.0), ball(0.8));
+    // Overlapping by 0.2 and moving 0.01 a step towards separation: the
+    // first steps are decided by the penetration bound; the last ones,
+    // separated, are not within 0.
+    let mut path = Vec::new();
+    for i in 0..30 {
+        let p = Isometry3::translation(-0.01 * f64::from(i), 0.0, 0.0);
+        path.push(Item::set_pose(ObjectId::from_raw(mover), &p));
+        path.push(Item::step());
+    }
+    let mut req = SceneRequest::new(SceneKind::Within, mover);
+    req.path = PathMode::EveryStep as u32;
+    let (reply, rows) = ask(&mut s, 1, &req, &path);
+    assert!(reply.bounded > 0, "{reply:?}");
+    // Centres 0.8 + 0.01 i apart, radii 0.5 each: within 0 up to i = 20.
+    let steps: Vec<u32> = rows.iter().map(|r| r.step).collect();
+    assert_eq!(steps, (0..=20).collect::<Vec<u32>>());
+    assert!(rows.iter().all(|r| r.b == other && r.result.lower == 0.0));
+    assert!(
+        rows.iter()
+            .any(|r| r.result.status == Status::Bounded as u32 && r.result.upper == 0.0)
+    );
 }

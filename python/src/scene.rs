@@ -1,0 +1,639 @@
+//! Scene queries on `gjkd.Client`: a group of objects against the whole
+//! scene in one round trip (`clearance`, `within`, `nearest`, `path`), the
+//! rows written into a caller-owned `gjkd.SceneRows`.
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyAnyMethods;
+
+use gjkd_client::{ClientError, Item, ObjectId, SceneRow};
+use gjkd_proto::{PathMode, SceneKind, SceneRequest, scene_flags};
+
+use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array, pose_array};
+use crate::batch::Distances;
+use crate::client::Client;
+use crate::errors::{self, invalid};
+
+/// Room for the rows of scene answers (`Client.clearance`, `within`,
+/// `nearest`, `path`): `SceneRows(n)` holds `n` rows, reused from call to
+/// call (nothing is allocated per call). A call writes its rows from the
+/// start and returns a `SceneSummary` whose `written` says how many.
+///
+/// Attributes (numpy arrays of `n` rows; rows past `written` keep what an
+/// earlier call left):
+///
+/// - `a` `(n,)` uint64: the group's object (the object asked about, for
+///   `nearest`);
+/// - `b` `(n,)` uint64: the other object, 0 when none qualifies;
+/// - `step` `(n,)` uint32: the path step (0 when not a path);
+/// - `answers`: a `gjkd.Distances` of `n` rows with each pair's
+///   `distance`, `lower`, `upper`, `point_a` (on `a`), `point_b`,
+///   `normal`, `status` (`gjkd.Status`, `BOUNDED` for rows answered from
+///   motion bounds), `error`, ...; `distance`, `lower`, `upper`, `status`
+///   and `error` are also attributes of the rows themselves.
+#[pyclass(module = "gjkd", name = "SceneRows")]
+pub struct SceneRows {
+    a: Py<PyArray1<u64>>,
+    b: Py<PyArray1<u64>>,
+    step: Py<PyArray1<u32>>,
+    answers: Py<Distances>,
+    len: usize,
+    busy: std::sync::atomic::AtomicBool,
+}
+
+#[pymethods]
+impl SceneRows {
+    /// Zeroed room for `n` rows.
+    #[new]
+    fn new(py: Python<'_>, n: usize) -> PyResult<Self> {
+        Ok(SceneRows {
+            a: PyArray1::zeros(py, n, false).unbind(),
+            b: PyArray1::zeros(py, n, false).unbind(),
+            step: PyArray1::zeros(py, n, false).unbind(),
+            answers: Py::new(py, Distances::new(py, n))?,
+            len: n,
+            busy: std::sync::atomic::AtomicBool::new(false),
+        })
+    }
+
+    fn __len__(&self) -> usize {
+        self.len
+    }
+
+    /// `(n,)` uint64: the group's objects.
+    #[getter]
+    fn a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
+        self.a.bind(py).clone()
+    }
+
+    /// `(n,)` uint64: the other objects, 0 for none.
+    #[getter]
+    fn b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
+        self.b.bind(py).clone()
+    }
+
+    /// `(n,)` uint32: the path steps.
+    #[getter]
+    fn step<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.step.bind(py).clone()
+    }
+
+    /// The pairs' answers, a `gjkd.Distances` of `n` rows.
+    #[getter]
+    fn answers<'py>(&self, py: Python<'py>) -> Bound<'py, Distances> {
+        self.answers.bind(py).clone()
+    }
+
+    /// `(n,)` float64: the distances (`answers.distance`).
+    #[getter]
+    fn distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("distance")
+    }
+
+    /// `(n,)` float64: certified lower bounds (`answers.lower`).
+    #[getter]
+    fn lower<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("lower")
+    }
+
+    /// `(n,)` float64: certified upper bounds (`answers.upper`).
+    #[getter]
+    fn upper<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("upper")
+    }
+
+    /// `(n,)` uint32: `gjkd.Status` values (`answers.status`).
+    #[getter]
+    fn status<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("status")
+    }
+
+    /// `(n,)` uint32: `gjkd.ErrorCode` values (`answers.error`).
+    #[getter]
+    fn error<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("error")
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<gjkd.SceneRows of {} rows>", self.len)
+    }
+}
+
+/// What a scene answer held besides its rows.
+#[pyclass(frozen, module = "gjkd", name = "SceneSummary")]
+#[derive(Clone, Copy)]
+pub struct Summary {
+    inner: gjkd_client::SceneSummary,
+}
+
+#[pymethods]
+impl Summary {
+    /// Rows written, from the start of the `SceneRows`.
+    #[getter]
+    fn written(&self) -> usize {
+        self.inner.written
+    }
+    /// Rows that qualified, also those that did not fit.
+    #[getter]
+    fn total(&self) -> u64 {
+        self.inner.total
+    }
+    /// More rows qualified than the `SceneRows` holds: the rows written
+    /// are a prefix of the answer.
+    #[getter]
+    fn truncated(&self) -> bool {
+        self.inner.truncated
+    }
+    /// Steps answered (1 when not a path).
+    #[getter]
+    fn steps(&self) -> u32 {
+        self.inner.steps
+    }
+    /// `path(..., question="first_hit")`: the first step with a pair within
+    /// the margin, `None` when the whole path is clear.
+    #[getter]
+    fn first_hit(&self) -> Option<u32> {
+        self.inner.first_hit
+    }
+    /// Pair queries that ran GJK.
+    #[getter]
+    fn gjk_runs(&self) -> u64 {
+        self.inner.gjk_runs
+    }
+    /// Pairs answered from motion bounds alone.
+    #[getter]
+    fn bounded(&self) -> u64 {
+        self.inner.bounded
+    }
+    /// Pairs the broadphase could not rule out.
+    #[getter]
+    fn candidates(&self) -> u64 {
+        self.inner.candidates
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.inner;
+        format!(
+            "SceneSummary(written={}, total={}, truncated={}, steps={}, first_hit={:?})",
+            s.written, s.total, s.truncated, s.steps, s.first_hit
+        )
+    }
+}
+
+/// The keyword options every scene call takes.
+struct Options {
+    tolerance: f64,
+    max_iterations: u32,
+    warm_start: bool,
+    motion_bounds: bool,
+    accept_absolute: f64,
+    accept_relative: f64,
+    cutoff: Option<f64>,
+}
+
+impl Options {
+    /// The request of `kind` about `group` (0 for listed members).
+    fn request(&self, kind: SceneKind, group: u64) -> SceneRequest {
+        let mut r = SceneRequest::new(kind, group);
+        r.tolerance = self.tolerance;
+        r.max_iterations = self.max_iterations;
+        r.accept_absolute = self.accept_absolute;
+        r.accept_relative = self.accept_relative;
+        r.flags = 0;
+        if self.warm_start {
+            r.flags |= scene_flags::WARM_START;
+        }
+        if self.motion_bounds {
+            r.flags |= scene_flags::MOTION_BOUNDS;
+        }
+        if let Some(c) = self.cutoff {
+            r.flags |= scene_flags::CUTOFF;
+            r.margin = c;
+        }
+        r
+    }
+}
+
+/// The group argument: an int (a robot or an object) or ids.
+enum GroupArg<'py> {
+    Id(u64),
+    Members(IdArray<'py>),
+}
+
+fn group_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<GroupArg<'py>> {
+    if let Ok(id) = obj.extract::<u64>() {
+        return Ok(GroupArg::Id(id));
+    }
+    let ids = id_array(obj, "group")?;
+    if ids.shape().len() != 1 {
+        return Err(invalid(
+            obj.py(),
+            "group",
+            None,
+            format!(
+                "group must be an id or a 1-D array of ids, got shape {:?}",
+                ids.shape()
+            ),
+        ));
+    }
+    Ok(GroupArg::Members(ids))
+}
+
+/// The pairs argument `(K, 2)`, or none.
+fn allow_arg<'py>(obj: Option<&Bound<'py, PyAny>>) -> PyResult<Option<IdArray<'py>>> {
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(None);
+    };
+    let ids = id_array(obj, "allow")?;
+    if !matches!(ids.shape(), [_, 2]) {
+        return Err(invalid(
+            obj.py(),
+            "allow",
+            None,
+            format!("allow must have shape (K, 2), got {:?}", ids.shape()),
+        ));
+    }
+    Ok(Some(ids))
+}
+
+/// The items of a scene request, readable without the GIL.
+#[derive(Clone, Copy)]
+struct Inputs<'a> {
+    members: Option<Ids<'a>>,
+    allowed: Option<Ids<'a>>,
+    moving: Option<Ids<'a>>,
+    poses: Option<Poses<'a>>,
+}
+
+impl Inputs<'_> {
+    fn counts(&self) -> (usize, usize, usize, usize) {
+        let members = self.members.map_or(0, |m| m.len());
+        let allowed = self.allowed.map_or(0, |a| a.len() / 2);
+        let moving = self.moving.map_or(0, |m| m.len());
+        let poses = self.poses.map_or(0, |p| p.len());
+        (members, allowed, moving, poses)
+    }
+
+    /// Number of items.
+    fn len(&self) -> usize {
+        let (m, a, n, p) = self.counts();
+        let steps = if n == 0 { 0 } else { p / n };
+        m + a + steps * (n + 1)
+    }
+
+    fn item(&self, i: usize) -> Item {
+        let (m, a, n, _) = self.counts();
+        if i < m {
+            let members = self.members.expect("counted");
+            return Item::member(ObjectId::from_raw(members.get(i)));
+        }
+        let i = i - m;
+        if i < a {
+            let allowed = self.allowed.expect("counted");
+            return Item::allow(
+                ObjectId::from_raw(allowed.get(2 * i)),
+                ObjectId::from_raw(allowed.get(2 * i + 1)),
+            );
+        }
+        let i = i - a;
+        let (s, k) = (i / (n + 1), i % (n + 1));
+        match (self.moving, self.poses) {
+            (Some(moving), Some(poses)) if k < n => {
+                let id = moving.get(k);
+                Item {
+                    a: id,
+                    pose_a: poses.get(s * n + k),
+                    ..Item::set_pose(ObjectId::from_raw(id), &Default::default())
+                }
+            }
+            _ => Item::step(),
+        }
+    }
+}
+
+impl SceneRows {
+    /// Runs `call` with the arrays' storage to write rows into.
+    fn with_rows<R>(
+        &self,
+        py: Python<'_>,
+        call: impl FnOnce(&mut dyn FnMut(&[SceneRow])) -> PyResult<R>,
+    ) -> PyResult<R> {
+        use std::sync::atomic::Ordering;
+        if self.busy.swap(true, Ordering::Acquire) {
+            return Err(invalid(
+                py,
+                "out",
+                None,
+                "out is being written by another call".into(),
+            ));
+        }
+        let (a, b, step) = (self.a.bind(py), self.b.bind(py), self.step.bind(py));
+        let answers = self.answers.bind(py).borrow();
+        let result = (|| {
+            // SAFETY: created contiguous by `SceneRows::new`, owned by their
+            // arrays, lent once per call (`busy` keeps two calls apart), as
+            // `Distances` does with its own.
+            let (a, b, step) =
+                unsafe { (a.as_slice_mut()?, b.as_slice_mut()?, step.as_slice_mut()?) };
+            answers.with_writer(py, |mut writer| {
+                let mut write = |rows: &[SceneRow]| {
+                    for (i, row) in rows.iter().enumerate() {
+                        a[i] = row.a;
+                        b[i] = row.b;
+                        step[i] = row.step;
+                        writer.write(i, std::slice::from_ref(&row.result));
+                    }
+                };
+                call(&mut write)
+            })
+        })();
+        self.busy.store(false, Ordering::Release);
+        result
+    }
+}
+
+/// Sends `request` with `inputs` from `client`, rows into `out`.
+fn run(
+    py: Python<'_>,
+    client: &mut Client,
+    mut request: SceneRequest,
+    inputs: Inputs<'_>,
+    out: &Bound<'_, SceneRows>,
+) -> PyResult<Summary> {
+    let rows = out.borrow();
+    request.max_rows = u32::try_from(rows.len).unwrap_or(u32::MAX);
+    let count = inputs.len();
+    let outcome = rows.with_rows(py, |write| {
+        client.call(py, move |c: &mut gjkd_client::Client| {
+            c.scene_with(&request, count, |i| inputs.item(i), |got| write(got))
+        })
+    })?;
+    outcome
+        .map(|inner| Summary { inner })
+        .map_err(|e: ClientError| errors::client(py, e, None))
+}
+
+/// Reads the group and allowed pairs, then runs.
+#[allow(clippy::too_many_arguments)]
+fn ask<'py>(
+    py: Python<'py>,
+    client: &mut Client,
+    kind: SceneKind,
+    group: &Bound<'py, PyAny>,
+    allow: Option<&Bound<'py, PyAny>>,
+    path: Option<(PathMode, IdArray<'py>, PoseArray<'py>)>,
+    options: &Options,
+    edit: impl FnOnce(&mut SceneRequest),
+    out: &Bound<'py, SceneRows>,
+) -> PyResult<Summary> {
+    let group = group_arg(group)?;
+    let allow = allow_arg(allow)?;
+    let (id, members) = match &group {
+        GroupArg::Id(id) => (*id, None),
+        GroupArg::Members(m) => (0, Some(m.slice()?)),
+    };
+    let mut request = options.request(kind, id);
+    edit(&mut request);
+    let (moving, poses) = match &path {
+        Some((mode, moving, poses)) => {
+            request.path = *mode as u32;
+            let (moving, poses) = (moving.slice()?, poses.poses()?);
+            if moving.len() == 0 || poses.len() == 0 || poses.len() % moving.len() != 0 {
+                return Err(invalid(
+                    py,
+                    "poses",
+                    None,
+                    format!(
+                        "poses holds {} poses, not a whole number of steps of {} objects",
+                        poses.len(),
+                        moving.len()
+                    ),
+                ));
+            }
+            (Some(moving), Some(poses))
+        }
+        None => (None, None),
+    };
+    let inputs = Inputs {
+        members,
+        allowed: allow.as_ref().map(|a| a.slice()).transpose()?,
+        moving,
+        poses,
+    };
+    run(py, client, request, inputs, out)
+}
+
+#[pymethods]
+impl Client {
+    /// For each member of `group`, the nearest object outside the group:
+    /// one row per member into `out` (a `gjkd.SceneRows`); returns a
+    /// `gjkd.SceneSummary`.
+    ///
+    /// `group` is a robot id (its links, with its allowed pairs), an object
+    /// id, or a 1-D array of object ids. `allow`: `(K, 2)` ids of pairs
+    /// never to report. `cutoff`: ignore objects farther than this (a
+    /// member with nothing that near may get `b == 0`). `warm_start`,
+    /// `motion_bounds`, `accept_absolute`, `accept_relative`: see the
+    /// README's "Scene queries". Raises `InvalidInput` (`UNKNOWN_OBJECT`,
+    /// `INVALID_OPTIONS`, `MALFORMED`, ...) when the server refuses the
+    /// whole request; nothing changes then.
+    #[pyo3(signature = (group, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn clearance<'py>(
+        &mut self,
+        py: Python<'py>,
+        group: &Bound<'py, PyAny>,
+        out: &Bound<'py, SceneRows>,
+        allow: Option<&Bound<'py, PyAny>>,
+        cutoff: Option<f64>,
+        tolerance: f64,
+        max_iterations: u32,
+        warm_start: bool,
+        motion_bounds: bool,
+        accept_absolute: f64,
+        accept_relative: f64,
+    ) -> PyResult<Summary> {
+        let options = Options {
+            tolerance,
+            max_iterations,
+            warm_start,
+            motion_bounds,
+            accept_absolute,
+            accept_relative,
+            cutoff,
+        };
+        ask(
+            py,
+            self,
+            SceneKind::Clearance,
+            group,
+            allow,
+            None,
+            &options,
+            |_| {},
+            out,
+        )
+    }
+
+    /// Every pair, `group` against the rest (or all against all with
+    /// `all_pairs=True`), whose distance is at most `margin`, into `out`.
+    /// Other arguments as `clearance`.
+    #[pyo3(signature = (group, margin, *, out, all_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn within<'py>(
+        &mut self,
+        py: Python<'py>,
+        group: &Bound<'py, PyAny>,
+        margin: f64,
+        out: &Bound<'py, SceneRows>,
+        all_pairs: bool,
+        allow: Option<&Bound<'py, PyAny>>,
+        tolerance: f64,
+        max_iterations: u32,
+        warm_start: bool,
+        motion_bounds: bool,
+        accept_absolute: f64,
+        accept_relative: f64,
+    ) -> PyResult<Summary> {
+        let options = Options {
+            tolerance,
+            max_iterations,
+            warm_start,
+            motion_bounds,
+            accept_absolute,
+            accept_relative,
+            cutoff: None,
+        };
+        let edit = |r: &mut SceneRequest| {
+            r.margin = margin;
+            if all_pairs {
+                r.flags |= scene_flags::ALL_PAIRS;
+            }
+        };
+        ask(
+            py,
+            self,
+            SceneKind::Within,
+            group,
+            allow,
+            None,
+            &options,
+            edit,
+            out,
+        )
+    }
+
+    /// The `k` objects nearest to `object`, nearest first, into `out`.
+    /// Other arguments as `clearance`.
+    #[pyo3(signature = (object, k, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn nearest<'py>(
+        &mut self,
+        py: Python<'py>,
+        object: &Bound<'py, PyAny>,
+        k: u32,
+        out: &Bound<'py, SceneRows>,
+        allow: Option<&Bound<'py, PyAny>>,
+        cutoff: Option<f64>,
+        tolerance: f64,
+        max_iterations: u32,
+        warm_start: bool,
+        motion_bounds: bool,
+        accept_absolute: f64,
+        accept_relative: f64,
+    ) -> PyResult<Summary> {
+        if object.extract::<u64>().is_err() {
+            return Err(invalid(py, "object", None, "object must be an id".into()));
+        }
+        let options = Options {
+            tolerance,
+            max_iterations,
+            warm_start,
+            motion_bounds,
+            accept_absolute,
+            accept_relative,
+            cutoff,
+        };
+        let edit = |r: &mut SceneRequest| r.k = k;
+        ask(
+            py,
+            self,
+            SceneKind::Nearest,
+            object,
+            allow,
+            None,
+            &options,
+            edit,
+            out,
+        )
+    }
+
+    /// A question asked at every step of a candidate motion, nothing moved
+    /// on the server: `poses` holds `S * len(objects)` poses (`(S*n, 7)`
+    /// rows or `(S*n, 4, 4)` matrices), row `s * n + i` the pose of
+    /// `objects[i]` at step `s`. `question` is `"clearance"` (each member's
+    /// clearance at every step), `"within"` (the pairs within `margin` at
+    /// every step) or `"first_hit"` (only the first step with a pair within
+    /// `margin`, its index in the summary's `first_hit`). Rows carry their
+    /// step in `out.step`. Other arguments as `clearance`.
+    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn path<'py>(
+        &mut self,
+        py: Python<'py>,
+        group: &Bound<'py, PyAny>,
+        objects: &Bound<'py, PyAny>,
+        poses: &Bound<'py, PyAny>,
+        out: &Bound<'py, SceneRows>,
+        question: &str,
+        margin: f64,
+        allow: Option<&Bound<'py, PyAny>>,
+        cutoff: Option<f64>,
+        tolerance: f64,
+        max_iterations: u32,
+        warm_start: bool,
+        motion_bounds: bool,
+        accept_absolute: f64,
+        accept_relative: f64,
+    ) -> PyResult<Summary> {
+        let (kind, mode) = match question {
+            "clearance" => (SceneKind::Clearance, PathMode::EveryStep),
+            "within" => (SceneKind::Within, PathMode::EveryStep),
+            "first_hit" => (SceneKind::Within, PathMode::FirstHit),
+            other => {
+                return Err(invalid(
+                    py,
+                    "question",
+                    None,
+                    format!("question must be 'clearance', 'within' or 'first_hit', not {other:?}"),
+                ));
+            }
+        };
+        let moving = id_array(objects, "objects")?;
+        if moving.shape().len() != 1 {
+            return Err(invalid(
+                py,
+                "objects",
+                None,
+                "objects must be a 1-D array of ids".into(),
+            ));
+        }
+        let poses = pose_array(poses, "poses")?;
+        let options = Options {
+            tolerance,
+            max_iterations,
+            warm_start,
+            motion_bounds,
+            accept_absolute,
+            accept_relative,
+            cutoff,
+        };
+        let edit = |r: &mut SceneRequest| {
+            if kind == SceneKind::Within {
+                r.margin = margin;
+            }
+        };
+        let path = Some((mode, moving, poses));
+        ask(py, self, kind, group, allow, path, &options, edit, out)
+    }
+}

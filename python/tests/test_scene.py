@@ -1,0 +1,117 @@
+"""Scene queries from Python: clearance, within, nearest and paths into a
+caller-owned ``SceneRows``, against the same server's per-pair answers."""
+
+from __future__ import annotations
+
+from typing import Iterator
+
+import numpy as np
+import pytest
+from conftest import unique_service
+
+import gjkd
+
+IDENTITY = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+
+
+def at(x: float, y: float = 0.0, z: float = 0.0) -> list[float]:
+    return [x, y, z, 0.0, 0.0, 0.0, 1.0]
+
+
+@pytest.fixture()
+def client() -> Iterator[gjkd.Client]:
+    """A server of the test's own: scene queries see every object."""
+    with gjkd.Server(service=unique_service("scene"), wait="spin") as server:
+        with gjkd.Client(server.service) as c:
+            yield c
+
+
+@pytest.fixture()
+def scene(client: gjkd.Client) -> tuple[list[int], list[int]]:
+    """Two balls of radius 0.5 at y = 0 and y = 6, and three unit boxes
+    along x: distances are analytic."""
+    group = [client.register_sphere(0.5), client.register_sphere(0.5)]
+    client.set_pose(group[0], at(0.0))
+    client.set_pose(group[1], at(0.0, 6.0))
+    boxes = [client.register_box([0.5, 0.5, 0.5]) for _ in range(3)]
+    for i, b in enumerate(boxes):
+        client.set_pose(b, at(2.0 + 2.0 * i))
+    return group, boxes
+
+
+def exact(client: gjkd.Client, a: int, b: int) -> float:
+    return client.distance(a, b, warm_start=False).distance
+
+
+def test_clearance_gives_each_members_nearest(client: gjkd.Client, scene) -> None:
+    group, boxes = scene
+    rows = gjkd.SceneRows(8)
+    s = client.clearance(np.array(group, dtype=np.uint64), out=rows)
+    assert s.written == 2 and s.total == 2 and not s.truncated and s.steps == 1
+    assert list(rows.a[:2]) == group
+    assert list(rows.b[:2]) == [boxes[0], boxes[0]]
+    # Ball at the origin to the box face at x = 1.5: 1.0.
+    assert rows.distance[0] == pytest.approx(1.0, abs=1e-9)
+    want = exact(client, group[1], boxes[0])
+    assert rows.distance[1] == pytest.approx(want, abs=1e-9)
+    assert np.all(rows.lower[:2] <= rows.distance[:2] + 1e-12)
+    assert np.all(rows.error[:2] == gjkd.ErrorCode.OK)
+
+
+def test_within_truncates_into_a_short_buffer(client: gjkd.Client, scene) -> None:
+    group, boxes = scene
+    rows = gjkd.SceneRows(16)
+    s = client.within(group, 3.2, out=rows)
+    want = sorted(
+        (a, b) for a in group for b in boxes if exact(client, a, b) <= 3.2
+    )
+    assert sorted(zip(rows.a[: s.written].tolist(), rows.b[: s.written].tolist())) == want
+    short = gjkd.SceneRows(1)
+    t = client.within(group, 3.2, out=short)
+    assert t.truncated and t.written == 1 and t.total == len(want)
+
+
+def test_nearest_and_allowed_pairs(client: gjkd.Client, scene) -> None:
+    group, boxes = scene
+    rows = gjkd.SceneRows(2)
+    s = client.nearest(group[0], 2, out=rows)
+    assert s.written == 2
+    assert list(rows.b) == [boxes[0], boxes[1]]
+    assert rows.distance[0] == pytest.approx(1.0, abs=1e-9)
+    assert rows.distance[1] == pytest.approx(3.0, abs=1e-9)
+    client.nearest(group[0], 1, out=rows, allow=np.array([[group[0], boxes[0]]]))
+    assert rows.b[0] != boxes[0]
+
+
+def test_path_moves_nothing_and_finds_the_first_hit(client: gjkd.Client, scene) -> None:
+    group, boxes = scene
+    ball = group[0]
+    steps = np.array([at(-3.0 + 0.5 * s) for s in range(6)])
+    rows = gjkd.SceneRows(16)
+    s = client.path([ball], [ball], steps, out=rows)
+    assert s.steps == 6 and s.written == 6
+    for k in range(6):
+        # The ball at x = -3 + 0.5 k, the first box face at x = 1.5.
+        assert rows.step[k] == k
+        assert rows.distance[k] == pytest.approx(4.0 - 0.5 * k, abs=1e-9)
+    hit = client.path([ball], [ball], steps, out=rows, question="first_hit", margin=2.1)
+    assert hit.first_hit == 4
+    assert np.all(rows.step[: hit.written] == 4)
+    # Nothing moved: the ball is still at the origin.
+    assert exact(client, ball, boxes[0]) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_whole_request_errors_raise(client: gjkd.Client, scene) -> None:
+    group, _ = scene
+    rows = gjkd.SceneRows(4)
+    with pytest.raises(gjkd.Error) as e:
+        client.clearance(0xDEAD00000001, out=rows)
+    assert e.value.code == gjkd.ErrorCode.UNKNOWN_OBJECT
+    with pytest.raises(gjkd.Error) as e:
+        client.within(group, float("nan"), out=rows)
+    assert e.value.code == gjkd.ErrorCode.INVALID_OPTIONS
+    with pytest.raises(gjkd.InvalidInput):
+        client.path(group, group, np.zeros((3, 7)), out=rows)
+    with pytest.raises(gjkd.InvalidInput):
+        client.path(group, group, np.array([IDENTITY, IDENTITY]), out=rows, question="nope")
+    assert gjkd.Status.BOUNDED == 6

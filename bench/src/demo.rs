@@ -22,7 +22,9 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use gjk::{Options, Shape};
-use gjkd_client::{Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions};
+use gjkd_client::{
+    Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions, Status,
+};
 use gjkd_testkit::paper::{self, Motion, OBSTACLES};
 use nalgebra::Isometry3;
 
@@ -114,12 +116,12 @@ impl Drop for ServerProcess {
 }
 
 /// The scene as registered with the server.
-struct Registered {
-    moving: ObjectId,
-    obstacles: [ObjectId; OBSTACLES],
+pub(crate) struct Registered {
+    pub(crate) moving: ObjectId,
+    pub(crate) obstacles: [ObjectId; OBSTACLES],
 }
 
-fn register(client: &mut Client, motion: &Motion) -> Result<Registered, DemoError> {
+pub(crate) fn register(client: &mut Client, motion: &Motion) -> Result<Registered, DemoError> {
     let Shape::Compound(moving) = motion.moving() else {
         return Err(DemoError::Check(
             "the moving object is not a compound".into(),
@@ -155,19 +157,22 @@ fn register(client: &mut Client, motion: &Motion) -> Result<Registered, DemoErro
 }
 
 /// One sweep through the server: distances per step, total iterations.
-struct ServedSweep {
-    distances: Vec<[f64; OBSTACLES]>,
+pub(crate) struct ServedSweep {
+    pub(crate) distances: Vec<[f64; OBSTACLES]>,
+    /// Per step, the obstacles proved within the query's margin (or at
+    /// distance 0 without one), as bits.
+    pub(crate) hits: Vec<u8>,
     iterations: u64,
-    elapsed: Duration,
+    pub(crate) elapsed: Duration,
 }
 
 /// Reusable buffers, so that timing measures the server and not `Vec` growth.
-struct Buffers {
-    items: Vec<Item>,
-    results: Vec<ItemResult>,
+pub(crate) struct Buffers {
+    pub(crate) items: Vec<Item>,
+    pub(crate) results: Vec<ItemResult>,
 }
 
-fn sweep(
+pub(crate) fn sweep(
     client: &mut Client,
     motion: &Motion,
     scene: &Registered,
@@ -184,6 +189,7 @@ fn sweep(
         .map(|t| motion.pose(t as f64 / steps as f64))
         .collect();
     let mut distances = Vec::with_capacity(steps + 1);
+    let mut hits = Vec::with_capacity(steps + 1);
     let mut iterations = 0u64;
     let mut elapsed = Duration::ZERO;
     for chunk in poses.chunks(per_batch) {
@@ -202,18 +208,27 @@ fn sweep(
         elapsed += start.elapsed();
         for step in buffers.results[..n].chunks(OBSTACLES) {
             let mut d = [0.0; OBSTACLES];
-            for (slot, r) in d.iter_mut().zip(step) {
+            let mut hit = 0u8;
+            for (i, (slot, r)) in d.iter_mut().zip(step).enumerate() {
                 let a = r
                     .answer()
                     .map_err(|e| DemoError::Check(format!("query failed: {e}")))?;
                 *slot = a.distance;
                 iterations += u64::from(a.iterations);
+                let within = match a.status {
+                    Some(Status::Closer) => true,
+                    Some(Status::Farther) => false,
+                    _ => a.distance <= options.margin.unwrap_or(0.0),
+                };
+                hit |= u8::from(within) << i;
             }
             distances.push(d);
+            hits.push(hit);
         }
     }
     Ok(ServedSweep {
         distances,
+        hits,
         iterations,
         elapsed,
     })
@@ -242,7 +257,7 @@ pub struct DemoArgs {
 /// disagrees with the in-process computation.
 pub fn run(steps: &[usize], repeats: usize) -> Result<(), DemoError> {
     let service = format!("gjkd-demo-{}", std::process::id());
-    let mut server = ServerProcess::spawn(&service, &["--wait", "spin", "--no-persist"])
+    let mut server = ServerProcess::spawn(&service, &crate::collision_sweep::SERVER_ARGS)
         .map_err(DemoError::Spawn)?;
     let outcome = run_with_server(&service, steps, repeats);
     let clean = server.stop();
@@ -391,6 +406,7 @@ fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(),
             "{:>6} {:>8} {:>12} {:>12}   (subalgorithm iterations)",
             "", "", it_cold, it_warm
         );
+        collision_row(&mut out, &mut client, &motion, &scene, t, repeats, c)?;
     }
     let stats = client.stats()?;
     let _ = writeln!(
@@ -412,6 +428,57 @@ fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(),
     );
     let _ = writeln!(out);
     crate::robot_demo::run(&mut client, &mut out, 20)?;
+    Ok(())
+}
+
+/// The collision-sweep row of the table: is any obstacle within margin 0
+/// at each step, as one path request through the server, against `cold`,
+/// the cold sweep's time.
+fn collision_row(
+    out: &mut impl Write,
+    client: &mut Client,
+    motion: &Motion,
+    scene: &Registered,
+    t: usize,
+    repeats: usize,
+    cold: Duration,
+) -> Result<(), DemoError> {
+    use crate::collision_sweep::{PathBuffers, path_sweep};
+    if !crate::scene_call::available() {
+        let _ = writeln!(
+            out,
+            "{:>6} {:>8} (collision sweep: this build has no scene requests)",
+            "", ""
+        );
+        return Ok(());
+    }
+    let mut buf = PathBuffers::new(t);
+    let mut times = Vec::with_capacity(repeats);
+    let mut hits = 0;
+    for _ in 0..repeats {
+        let p = path_sweep(
+            client,
+            motion,
+            scene,
+            t,
+            gjkd_proto::PathMode::EveryStep,
+            &mut buf,
+        )
+        .map_err(|e| DemoError::Check(format!("path request: {e}")))?;
+        hits = p.hits.iter().filter(|&&h| h != 0).count();
+        times.push(p.elapsed);
+    }
+    let path = median(times);
+    let _ = writeln!(
+        out,
+        "{:>6} {:>8} {:>12}   collision sweep (any obstacle within margin 0?) as one path request: \
+         cold / path {:.1}×; {hits} of {} steps hit",
+        "",
+        "",
+        format!("{:.3} ms", path.as_secs_f64() * 1e3),
+        cold.as_secs_f64() / path.as_secs_f64().max(1e-12),
+        t + 1
+    );
     Ok(())
 }
 

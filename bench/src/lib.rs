@@ -17,6 +17,11 @@
 //!   vertices `M`.
 //! - [`robot`]: a 7-joint robot moved by one joint request, against link
 //!   poses computed by the client.
+//! - [`scene_robot`]: a 7-link arm among 1 000 obstacles, clearance and
+//!   pairs within a margin per step, by parry3d-f64 in process, gjkd
+//!   per-pair queries and gjkd scene requests.
+//! - [`collision_sweep`]: the paper's Section 8 as a collision sweep, one
+//!   path request against cold per-pair queries.
 //!
 //! Each writes a table to stdout, CSV and SVG plots to `--out`, and shows a
 //! progress bar while it runs. Timing is never asserted anywhere: the tests
@@ -26,6 +31,7 @@
 
 use std::path::PathBuf;
 
+pub mod collision_sweep;
 pub mod demo;
 pub mod extremes;
 pub mod latency;
@@ -33,6 +39,11 @@ pub mod paper;
 pub mod plot;
 pub mod robot;
 pub mod robot_demo;
+pub mod scene_call;
+pub mod scene_inprocess;
+pub mod scene_parry;
+pub mod scene_robot;
+pub mod scene_world;
 pub mod stats;
 pub mod tradeoff;
 pub mod uds;
@@ -59,6 +70,13 @@ enum BenchCommand {
     /// A 7-joint robot moved by one joint request with 70 link-obstacle
     /// queries, against the same queries at link poses the client computed.
     Robot(robot::RobotArgs),
+    /// A 7-link arm among 1 000 obstacles: per step each link's clearance
+    /// and the pairs within 5 % of the arm's size, by parry3d-f64 in
+    /// process, gjkd per-pair queries and gjkd scene requests.
+    SceneRobot(scene_robot::SceneRobotArgs),
+    /// The paper's Section 8 as a collision sweep: one path request against
+    /// cold per-pair queries in batches.
+    Sweep(collision_sweep::SweepArgs),
     /// The socket server `latency` starts as a child process.
     #[command(hide = true)]
     UdsServer(uds::UdsServerArgs),
@@ -96,6 +114,13 @@ pub enum BenchError {
     Other(String),
 }
 
+impl BenchError {
+    /// An item's or a scene request's error code.
+    pub(crate) fn from_code(code: gjkd_client::ErrorCode) -> Self {
+        BenchError::Client(gjkd_client::ClientError::Rejected(code))
+    }
+}
+
 /// `Result::map_err` helper naming what was being done.
 pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T, BenchError> {
     r.map_err(|e| BenchError::Io(what.into(), e))
@@ -128,6 +153,14 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
         BenchCommand::Robot(a) => {
             robot::run(&a)?;
             "robot"
+        }
+        BenchCommand::SceneRobot(a) => {
+            scene_robot::run(&a)?;
+            "scene-robot"
+        }
+        BenchCommand::Sweep(a) => {
+            collision_sweep::run(&a)?;
+            "sweep"
         }
         BenchCommand::UdsServer(_) => unreachable!("handled above"),
     };

@@ -29,8 +29,10 @@ enum Command {
     /// Start a server, sweep the Section 8 scene through it and print the
     /// distances and the warm-start speed-up.
     Demo(DemoArgs),
-    /// Measurements: `latency`, `tradeoff` (speed against accuracy) and
-    /// `paper` (Section 7). See docs/benchmarks.md.
+    /// Measurements: `latency`, `tradeoff` (speed against accuracy),
+    /// `paper` (Section 7), `robot`, `scene-robot` (a robot among 1 000
+    /// obstacles, beside parry3d-f64) and `sweep` (Section 8 as a collision
+    /// sweep). See docs/benchmarks.md.
     Bench(gjkd_bench::BenchArgs),
     /// List the objects of a stopped server's state file, with whether each
     /// owner still runs; with --remove-departed, remove those whose

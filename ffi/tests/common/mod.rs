@@ -107,11 +107,14 @@ pub fn run_ok(exe: &Path, args: &[&str]) -> String {
     stdout
 }
 
-/// Runs `exe` with `args`.
+/// Runs `exe` with `args`, finding its library by its own rpath only:
+/// `cargo test` puts `target/<profile>` on LD_LIBRARY_PATH, which outranks
+/// a runpath, and a `cargo build` of the library leaves an older copy there.
 pub fn run(exe: &Path, args: &[&str]) -> Output {
     Command::new(exe)
         .args(args)
         .env_remove("IOX2_LOG_LEVEL")
+        .env_remove("LD_LIBRARY_PATH")
         .output()
         .unwrap_or_else(|e| panic!("start {}: {e}", exe.display()))
 }

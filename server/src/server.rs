@@ -341,6 +341,7 @@ fn serve_until(
         reap_after: Instant::now(),
     };
     let mut turns: u32 = 0;
+    let mut scene_rows = Vec::new();
     while !shutdown.load(Ordering::Relaxed) {
         turns = turns.wrapping_add(1);
         let mut served = serve_queries(&endpoints.query, state);
@@ -348,7 +349,7 @@ fn serve_until(
         // receiving takes a lock, which servers whose clients never ask a
         // scene question should not pay on every turn.
         if endpoints.scene_service.dynamic_config().number_of_clients() > 0 {
-            served += serve_scenes(&endpoints.scene, state);
+            served += serve_scenes(&endpoints.scene, state, &mut scene_rows);
         }
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
@@ -573,7 +574,13 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
 }
 
 /// Answers every scene request waiting; returns how many.
-fn serve_scenes(scene: &SceneServer, state: &mut State) -> usize {
+///
+/// The engine writes into `scratch`, kept from one request to the next,
+/// and only the rows written go into shared memory: a reply slice as
+/// large as the caller's capacity would be initialised and sent whole,
+/// which cost more than the question for a handful of rows in a buffer
+/// of a thousand.
+fn serve_scenes(scene: &SceneServer, state: &mut State, scratch: &mut Vec<SceneRow>) -> usize {
     let mut served = 0;
     loop {
         let request = match scene.receive() {
@@ -595,16 +602,11 @@ fn serve_scenes(scene: &SceneServer, state: &mut State) -> usize {
             SceneReply::error(ErrorCode::BatchTooLarge)
         } else {
             let rows = (header.max_rows as usize).min(max_batch);
-            let reply = match request.loan_slice_uninit(rows) {
-                Ok(r) => r,
-                Err(e) => {
-                    warn!(error = ?e, rows, "cannot loan scene reply");
-                    continue;
-                }
-            };
-            let mut reply = reply.write_from_fn(|_| SceneRow::default());
+            if scratch.len() < rows {
+                scratch.resize(rows, SceneRow::default());
+            }
             let answer = catch_unwind(AssertUnwindSafe(|| {
-                state.scene(client, &header, items, reply.payload_mut())
+                state.scene(client, &header, items, &mut scratch[..rows])
             }))
             .unwrap_or_else(|_| {
                 // A bug of ours, not the client's: answer, log, keep serving.
@@ -616,14 +618,19 @@ fn serve_scenes(scene: &SceneServer, state: &mut State) -> usize {
                 SceneReply::error(ErrorCode::Internal)
             });
             if answer.error_code() == ErrorCode::Ok {
-                *reply.user_header_mut() = answer;
-                if let Err(e) = reply.send() {
-                    debug!(error = ?e, "scene reply not delivered (client gone?)");
+                let written = usize::try_from(answer.total).map_or(rows, |t| t.min(rows));
+                match request.loan_slice_uninit(written) {
+                    Ok(reply) => {
+                        let mut reply = reply.write_from_slice(&scratch[..written]);
+                        *reply.user_header_mut() = answer;
+                        if let Err(e) = reply.send() {
+                            debug!(error = ?e, "scene reply not delivered (client gone?)");
+                        }
+                    }
+                    Err(e) => warn!(error = ?e, written, "cannot loan scene reply"),
                 }
                 continue;
             }
-            // A refused request's reply has no rows: this loan goes back
-            // unsent.
             answer
         };
         debug!(kind = header.kind, code = ?answer.error_code(), "scene request refused");

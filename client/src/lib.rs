@@ -245,6 +245,17 @@ fn quiet_iceoryx2_notices() {
     });
 }
 
+/// `Ok` for a reply header's [`ErrorCode::Ok`], the request's rejection
+/// for another code, a protocol error for a value this version does not
+/// know: how the query and scene services say a whole request failed.
+fn reply_accepted(raw: u32) -> Result<(), ClientError> {
+    match ErrorCode::from_raw(raw) {
+        Some(ErrorCode::Ok) => Ok(()),
+        Some(code) => Err(ClientError::Rejected(code)),
+        None => Err(ClientError::Protocol(format!("unknown error code {raw}"))),
+    }
+}
+
 fn ipc_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ClientError {
     move |e| ClientError::Ipc(format!("{what}: {e:?}"))
 }
@@ -1339,12 +1350,7 @@ impl Client {
                     return Ok(None);
                 };
                 let header = *response.user_header();
-                let code = ErrorCode::from_raw(header.error).ok_or_else(|| {
-                    ClientError::Protocol(format!("unknown error code {}", header.error))
-                })?;
-                if code != ErrorCode::Ok {
-                    return Err(ClientError::Rejected(code));
-                }
+                reply_accepted(header.error)?;
                 let payload = response.payload();
                 if payload.len() != count {
                     return Err(ClientError::Protocol(format!(

@@ -603,12 +603,7 @@ impl Client {
                     return Ok(None);
                 };
                 let reply = *response.user_header();
-                let code = ErrorCode::from_raw(reply.error).ok_or_else(|| {
-                    ClientError::Protocol(format!("unknown error code {}", reply.error))
-                })?;
-                if code != ErrorCode::Ok {
-                    return Err(ClientError::Rejected(code));
-                }
+                crate::reply_accepted(reply.error)?;
                 let payload = response.payload();
                 let written = usize::try_from(reply.total)
                     .unwrap_or(usize::MAX)

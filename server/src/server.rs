@@ -59,6 +59,20 @@ pub enum ServerError {
     AlreadyRunning(String),
 }
 
+/// The error of creating a server port on a service of `service`: a
+/// second server of the same service is [`ServerError::AlreadyRunning`].
+fn server_port_error<'a>(
+    service: &'a str,
+    what: &'static str,
+) -> impl FnOnce(iceoryx2::service::port_factory::server::ServerCreateError) -> ServerError + 'a {
+    move |e| match e {
+        iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
+            ServerError::AlreadyRunning(service.to_owned())
+        }
+        e => ServerError::Ipc(format!("{what}: {e:?}")),
+    }
+}
+
 fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError {
     move |e| ServerError::Ipc(format!("{what}: {e:?}"))
 }
@@ -217,12 +231,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     let admin: AdminServer = admin_service
         .server_builder()
         .create()
-        .map_err(|e| match e {
-            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
-                ServerError::AlreadyRunning(options.service.clone())
-            }
-            e => ServerError::Ipc(format!("admin server: {e:?}")),
-        })?;
+        .map_err(server_port_error(&options.service, "admin server"))?;
     // Sized as the query server (below): at most `max_batch` rows a reply.
     let scene: SceneServer = scene_service
         .server_builder()
@@ -230,12 +239,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .allocation_strategy(AllocationStrategy::Static)
         .override_response_preallocation(move |_| response_chunks(clients))
         .create()
-        .map_err(|e| match e {
-            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
-                ServerError::AlreadyRunning(options.service.clone())
-            }
-            e => ServerError::Ipc(format!("scene server: {e:?}")),
-        })?;
+        .map_err(server_port_error(&options.service, "scene server"))?;
     // The query server port comes last: clients take it as the sign that
     // the server is ready, and a request sent to a service before its server
     // port exists is never answered.
@@ -251,12 +255,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         // as many again for replies to requests it gave up on.
         .override_response_preallocation(move |_| response_chunks(clients))
         .create()
-        .map_err(|e| match e {
-            iceoryx2::service::port_factory::server::ServerCreateError::ExceedsMaxSupportedServers => {
-                ServerError::AlreadyRunning(options.service.clone())
-            }
-            e => ServerError::Ipc(format!("query server: {e:?}")),
-        })?;
+        .map_err(server_port_error(&options.service, "query server"))?;
 
     Ok(Endpoints {
         query,

@@ -78,6 +78,21 @@ impl Robots {
     pub fn is_empty(&self) -> bool {
         self.by_id.is_empty()
     }
+
+    /// Drops the robots attached by clients for which `alive` is false, and
+    /// returns how many: their link objects go with their client (see
+    /// [`State::remove_departed`]), so their kinematics would only move
+    /// nothing while holding their names.
+    pub fn drop_departed(&mut self, alive: impl Fn(u128) -> bool) -> usize {
+        let before = self.by_id.len();
+        self.by_id.retain(|_, r| match r.owner {
+            Owner::Client(c) => alive(c),
+            Owner::Scene => true,
+        });
+        let by_id = &self.by_id;
+        self.names.retain(|_, id| by_id.contains_key(id));
+        before - self.by_id.len()
+    }
 }
 
 /// What a robot starts as.
@@ -313,17 +328,7 @@ mod tests {
 
     fn state_with_links() -> State {
         let mut s = State::new(Limits::default(), WaitMode::Spin, 5);
-        let model = gjkd_model::RobotModel::from_urdf_str(URDF, None, &Default::default()).unwrap();
-        for link in &model.links {
-            if let Some(shape) = &link.shape {
-                let new = NewObject {
-                    shape: shape.clone(),
-                    pose: Isometry3::identity(),
-                    name: Some(format!("two/{}", link.name)),
-                };
-                s.insert(new, Owner::Client(CLIENT)).unwrap();
-            }
-        }
+        insert_links(&mut s, CLIENT);
         let ball = NewObject {
             shape: Shape::Convex(Convex::sphere(0.25).unwrap()),
             pose: Isometry3::translation(0.0, 1.5, 0.1),
@@ -331,6 +336,25 @@ mod tests {
         };
         s.insert(ball, Owner::Scene).unwrap();
         s
+    }
+
+    /// Registers the links of `URDF` that have geometry for `owner`;
+    /// returns how many.
+    fn insert_links(s: &mut State, owner: u128) -> usize {
+        let model = gjkd_model::RobotModel::from_urdf_str(URDF, None, &Default::default()).unwrap();
+        let mut count = 0;
+        for link in &model.links {
+            if let Some(shape) = &link.shape {
+                let new = NewObject {
+                    shape: shape.clone(),
+                    pose: Isometry3::identity(),
+                    name: Some(format!("two/{}", link.name)),
+                };
+                s.insert(new, Owner::Client(owner)).unwrap();
+                count += 1;
+            }
+        }
+        count
     }
 
     fn attach_text(s: &mut State, text: &str, who: u128) -> Result<u64, ErrorCode> {
@@ -530,5 +554,29 @@ mod tests {
             Err(ErrorCode::NotOwner)
         );
         assert_eq!(attach_text(&mut s, URDF, CLIENT), Ok(id));
+    }
+
+    #[test]
+    fn departed_clients_robots_go_with_their_links() {
+        let mut s = state_with_links();
+        let id = attach_text(&mut s, URDF, CLIENT).unwrap();
+        // A living owner keeps its robot.
+        let (removed, failed) = s.remove_departed(|c| c == CLIENT);
+        assert_eq!((removed.len(), failed), (0, None));
+        assert_eq!(s.robots.lookup("two"), Some(id));
+        let (removed, failed) = s.remove_departed(|c| c != CLIENT);
+        // The three links with geometry, not the scene's ball.
+        assert_eq!((removed.len(), failed), (3, None));
+        assert!(s.robots.is_empty());
+        assert_eq!(s.robots.lookup("two"), None);
+        assert!(s.lookup("ball").is_some());
+        let r = one(
+            &mut s,
+            Item::set_joints(ObjectId::from_raw(id), 0, &[0.1], None, false),
+        );
+        assert_eq!(r.error_code(), ErrorCode::UnknownObject);
+        // The name is free again for the next client.
+        assert_eq!(insert_links(&mut s, CLIENT + 1), 3);
+        assert!(attach_text(&mut s, URDF, CLIENT + 1).is_ok());
     }
 }

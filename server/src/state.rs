@@ -268,12 +268,17 @@ impl State {
         &mut self,
         alive: impl Fn(u128) -> bool,
     ) -> (Vec<u64>, Option<ErrorCode>) {
-        let (removed, failed) = self.store.remove_departed(alive);
+        let (removed, failed) = self.store.remove_departed(&alive);
         // One pass over the cache for all of them, not one per object.
         let gone: std::collections::HashSet<u64> = removed.iter().copied().collect();
         if !gone.is_empty() {
             self.cache
                 .retain(|k| !gone.contains(&k.a) && !gone.contains(&k.b));
+        }
+        // Only once every object of theirs is gone: a failed commit leaves
+        // objects a robot still moves, retried at the next housekeeping.
+        if failed.is_none() {
+            self.robots.drop_departed(&alive);
         }
         (removed, failed)
     }
@@ -293,6 +298,7 @@ impl State {
     /// eviction.
     pub fn retain_clients(&mut self, alive: impl Fn(u128) -> bool) {
         self.cache.retain(|k| alive(k.client));
+        self.scene.retain_clients(alive);
     }
 }
 

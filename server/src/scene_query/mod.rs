@@ -121,6 +121,12 @@ impl SceneEngine {
     pub fn broadphase(&self) -> &Broadphase {
         &self.broadphase
     }
+
+    /// Forgets the remembered nearest objects of every client for which
+    /// `alive` is false: a departed client's members are never asked again.
+    pub fn retain_clients(&mut self, alive: impl Fn(u128) -> bool) {
+        self.nearest.retain(|&(client, _), _| alive(client));
+    }
 }
 
 /// Checks a request's header.

@@ -841,3 +841,21 @@ fn overlapping_pairs_stay_within_by_their_penetration() {
             .any(|r| r.result.status == Status::Bounded as u32 && r.result.upper == 0.0)
     );
 }
+
+#[test]
+fn departed_clients_nearest_objects_are_forgotten() {
+    let (mut s, ids) = scene(30, Vector3::zeros(), 3.0, 8);
+    let req = SceneRequest::new(SceneKind::Clearance, ids[0]);
+    let (_, first) = ask(&mut s, 1, &req, &[]);
+    let (_, second) = ask(&mut s, 2, &req, &[]);
+    let remembered = |s: &State, client: u128| s.scene.nearest.get(&(client, ids[0])).copied();
+    assert_eq!(remembered(&s, 1), Some(first[0].b));
+    assert_eq!(remembered(&s, 2), Some(second[0].b));
+    s.retain_clients(|c| c == 2);
+    assert_eq!(remembered(&s, 1), None);
+    assert_eq!(remembered(&s, 2), Some(second[0].b));
+    // The one who stays still gets the same answer.
+    let (_, again) = ask(&mut s, 2, &req, &[]);
+    assert_eq!(again[0].b, second[0].b);
+    assert_eq!(again[0].result.upper, second[0].result.upper);
+}

@@ -26,6 +26,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         k.link_names().len(),
         k.joint_names()
     );
+    for warning in k.warnings() {
+        println!("warning: {warning}");
+    }
     let mut q = vec![0.0; k.dof()];
     k.check_positions(&mut q, LimitMode::Clamp)?;
     let poses = k.link_poses(&Isometry3::identity(), &q, LimitMode::Reject)?;

@@ -5,8 +5,12 @@
 //! `<joint>` elements, keeping only the *moving* ones: revolute, continuous
 //! and prismatic joints that do not mimic another. Fixed joints take no
 //! position; a mimic joint follows its leader (`multiplier * leader +
-//! offset`, chains of mimics followed). [`Kinematics::joint_names`] lists
-//! the order.
+//! offset`, chains of mimics followed). A mimic joint naming a leader that
+//! does not exist is an error in the URDF, but one that real descriptions
+//! make: like MoveIt, gjkd logs it (and lists it in
+//! [`Kinematics::warnings`]) and moves that joint on its own, so it takes
+//! its place in the position array. [`Kinematics::joint_names`] lists the
+//! order.
 //!
 //! A link's pose is its parent's pose, times the joint's origin, times the
 //! joint's motion (a rotation about its axis by the position in radians, or
@@ -38,6 +42,9 @@ pub enum KinematicsError {
         /// The link.
         link: String,
     },
+    /// The robot has no link at all.
+    #[error("the robot has no link")]
+    NoLinks,
     /// The links do not make one tree: no root, several roots, a link with
     /// two parents, or a cycle.
     #[error("the links do not form one tree: {0}")]
@@ -68,8 +75,9 @@ pub enum KinematicsError {
         /// Upper limit.
         upper: f64,
     },
-    /// A mimic joint follows a joint that does not exist, a fixed joint, or
-    /// (through a chain) itself; or its multiplier or offset is not finite.
+    /// A mimic joint follows a fixed joint or (through a chain) itself; or
+    /// its multiplier or offset is not finite. (One naming a joint that does
+    /// not exist moves on its own, see [`Kinematics::warnings`].)
     #[error("joint `{joint}` cannot mimic `{leader}`: {reason}")]
     BadMimic {
         /// The mimic joint.
@@ -192,6 +200,8 @@ pub struct Kinematics {
     root: usize,
     /// The moving joints, in position-array order (indices into `joints`).
     moving: Vec<usize>,
+    /// What the URDF gets wrong that was accepted.
+    warnings: Vec<String>,
 }
 
 impl Kinematics {
@@ -200,9 +210,7 @@ impl Kinematics {
     /// # Errors
     /// A [`KinematicsError`] naming the problem.
     pub fn from_urdf_str(text: &str) -> Result<Self, KinematicsError> {
-        let robot = urdf_rs::read_from_string(text)
-            .map_err(|e| KinematicsError::Malformed(e.to_string()))?;
-        Self::from_urdf(&robot)
+        Self::from_urdf(&crate::urdf::parse_urdf(text)?)
     }
 
     /// The kinematic tree of a parsed URDF.
@@ -210,20 +218,36 @@ impl Kinematics {
     /// # Errors
     /// A [`KinematicsError`] naming the problem.
     pub fn from_urdf(robot: &urdf_rs::Robot) -> Result<Self, KinematicsError> {
+        if robot.links.is_empty() {
+            return Err(KinematicsError::NoLinks);
+        }
         let links: Vec<String> = robot.links.iter().map(|l| l.name.clone()).collect();
         let link_index = unique_index(&links, "links")?;
         let joint_names: Vec<String> = robot.joints.iter().map(|j| j.name.clone()).collect();
-        unique_index(&joint_names, "joints")?;
+        let joint_index = unique_index(&joint_names, "joints")?;
         let mut joints = Vec::with_capacity(robot.joints.len());
         let mut moving = Vec::new();
+        let mut warnings = Vec::new();
         for joint in &robot.joints {
             let info = joint_info(joint, &link_index)?;
-            if info.source != JointSource::Fixed && joint.mimic.is_none() {
-                moving.push(joints.len());
+            if info.source != JointSource::Fixed {
+                if let Some(mimic) = &joint.mimic
+                    && !joint_index.contains_key(mimic.joint.as_str())
+                {
+                    let warning = format!(
+                        "joint `{}` mimics `{}`, which does not exist: it moves on its own",
+                        joint.name, mimic.joint
+                    );
+                    tracing::warn!(robot = %robot.name, "{warning}");
+                    warnings.push(warning);
+                }
+                if leader(joint, &joint_index).is_none() {
+                    moving.push(joints.len());
+                }
             }
             joints.push(info);
         }
-        resolve_mimics(robot, &mut joints, &moving)?;
+        resolve_mimics(robot, &joint_index, &mut joints, &moving)?;
         let (root, order) = tree_order(&links, &joints)?;
         Ok(Kinematics {
             name: robot.name.clone(),
@@ -232,7 +256,16 @@ impl Kinematics {
             order,
             root,
             moving,
+            warnings,
         })
+    }
+
+    /// What the URDF gets wrong that gjkd accepts all the same, one
+    /// sentence each (also logged with `tracing` as warnings when loaded):
+    /// so far, mimic joints naming a leader that does not exist, which move
+    /// on their own (as MoveIt treats them).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// The robot's name in the URDF.
@@ -522,39 +555,46 @@ fn joint_info(
     })
 }
 
+/// The mimic element of a joint that follows another, `None` for a joint
+/// that moves on its own: no mimic element, or one naming a joint that does
+/// not exist (MoveIt, too, logs those and moves such a joint on its own).
+fn leader<'a>(
+    joint: &'a urdf_rs::Joint,
+    joint_index: &HashMap<&str, usize>,
+) -> Option<&'a urdf_rs::Mimic> {
+    joint
+        .mimic
+        .as_ref()
+        .filter(|m| joint_index.contains_key(m.joint.as_str()))
+}
+
 /// Gives each moving joint its array entry and each mimic joint its leader's
 /// entry, chains of mimics composed.
 fn resolve_mimics(
     robot: &urdf_rs::Robot,
+    joint_index: &HashMap<&str, usize>,
     joints: &mut [JointInfo],
     moving: &[usize],
 ) -> Result<(), KinematicsError> {
     for (k, &j) in moving.iter().enumerate() {
         joints[j].source = JointSource::Moving(k);
     }
-    let by_name: HashMap<&str, usize> = robot
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(i, j)| (j.name.as_str(), i))
-        .collect();
     for (i, joint) in robot.joints.iter().enumerate() {
-        if joint.mimic.is_none() || joints[i].source == JointSource::Fixed {
+        let Some(first) = leader(joint, joint_index) else {
+            continue;
+        };
+        if joints[i].source == JointSource::Fixed {
             continue;
         }
+        let fail = |reason| KinematicsError::BadMimic {
+            joint: joint.name.clone(),
+            leader: first.joint.clone(),
+            reason,
+        };
         let (mut multiplier, mut offset) = (1.0, 0.0);
         let mut at = i;
         let mut steps = 0;
-        let fail = |reason| KinematicsError::BadMimic {
-            joint: joint.name.clone(),
-            leader: joint
-                .mimic
-                .as_ref()
-                .map(|m| m.joint.clone())
-                .unwrap_or_default(),
-            reason,
-        };
-        while let Some(mimic) = &robot.joints[at].mimic {
+        while let Some(mimic) = leader(&robot.joints[at], joint_index) {
             let m = mimic.multiplier.unwrap_or(1.0);
             let o = mimic.offset.unwrap_or(0.0);
             if !(m.is_finite() && o.is_finite()) {
@@ -563,9 +603,7 @@ fn resolve_mimics(
             // q_at = m * q_leader + o, and q_i = multiplier * q_at + offset.
             offset += multiplier * o;
             multiplier *= m;
-            at = *by_name
-                .get(mimic.joint.as_str())
-                .ok_or_else(|| fail("no joint has that name"))?;
+            at = joint_index[mimic.joint.as_str()];
             steps += 1;
             if steps > robot.joints.len() {
                 return Err(fail("the mimic chain is a cycle"));

@@ -41,6 +41,7 @@ pub mod mesh;
 pub mod paths;
 pub mod robot;
 pub mod srdf;
+mod urdf;
 
 pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
 pub use mesh::{Decomposition, Mesh, MeshError};

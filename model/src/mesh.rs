@@ -101,9 +101,13 @@ impl Mesh {
             path: path.to_path_buf(),
             source,
         })?;
-        let scene = mesh_loader::Loader::default()
-            .merge_meshes(true)
+        let loader = mesh_loader::Loader::default().merge_meshes(true);
+        let scene = loader
             .load_from_slice(&bytes, path)
+            .or_else(|e| match binary_stl_named_solid(&bytes) {
+                Some(binary) => loader.load_from_slice(&binary, path),
+                None => Err(e),
+            })
             .map_err(|e| MeshError::Parse {
                 path: path.to_path_buf(),
                 message: e.to_string(),
@@ -306,6 +310,33 @@ impl Decomposition {
             .collect::<Result<Vec<_>, gjk::Error>>()?;
         Ok(Compound::new(pieces)?)
     }
+}
+
+/// Binary STL's header: free text, then the triangle count.
+const STL_HEADER: usize = 80;
+/// One binary STL triangle: normal, three vertices, attribute count.
+const STL_TRIANGLE: usize = 50;
+
+/// The bytes of a binary STL file whose header begins with `solid` (as
+/// some exporters write it), with that header blanked; `None` for anything
+/// else. `mesh-loader` takes such a file for ASCII STL and fails on its
+/// first triangle; the header is free text, so blanking it changes no
+/// triangle. Binary is recognised by its size: exactly the header, the
+/// count and the count's triangles, which ASCII text beginning with
+/// `solid` does not match by chance.
+fn binary_stl_named_solid(bytes: &[u8]) -> Option<Vec<u8>> {
+    let header = bytes.get(..STL_HEADER)?;
+    let count = u32::from_le_bytes(bytes.get(STL_HEADER..STL_HEADER + 4)?.try_into().ok()?);
+    let size = (count as usize)
+        .checked_mul(STL_TRIANGLE)?
+        .checked_add(STL_HEADER + 4)?;
+    let named_solid = header.trim_ascii_start().starts_with(b"solid");
+    if !named_solid || size != bytes.len() {
+        return None;
+    }
+    let mut binary = bytes.to_vec();
+    binary[..STL_HEADER].fill(0);
+    Some(binary)
 }
 
 fn check_scale(what: &str, scale: [f64; 3]) -> Result<(), MeshError> {

@@ -100,8 +100,7 @@ impl RobotModel {
         base: Option<&Path>,
         packages: &PackagePath,
     ) -> Result<Self, RobotError> {
-        let urdf = urdf_rs::read_from_string(text)
-            .map_err(|e| KinematicsError::Malformed(e.to_string()))?;
+        let urdf = crate::urdf::parse_urdf(text)?;
         let kinematics = Kinematics::from_urdf(&urdf)?;
         let links = urdf
             .links

@@ -292,9 +292,22 @@ fn bad_trees_get_their_errors() {
         KinematicsError::BadLimits { .. }
     ));
     assert!(matches!(
-        bad(&two_links(r#"<joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="nope"/></joint>"#)),
-        KinematicsError::BadMimic { leader, .. } if leader == "nope"
+        bad(r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+            <joint name="x" type="revolute"><parent link="a"/><child link="b"/><limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="y"/></joint>
+            <joint name="y" type="revolute"><parent link="a"/><child link="c"/><limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="x"/></joint></robot>"#),
+        KinematicsError::BadMimic { reason, .. } if reason.contains("cycle")
     ));
+    assert!(matches!(
+        bad(r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+            <joint name="x" type="fixed"><parent link="a"/><child link="b"/></joint>
+            <joint name="y" type="revolute"><parent link="a"/><child link="c"/><limit lower="0" upper="1" effort="1" velocity="1"/><mimic joint="x"/></joint></robot>"#),
+        KinematicsError::BadMimic { leader, reason, .. } if leader == "x" && reason.contains("fixed")
+    ));
+    assert_eq!(bad(r#"<robot name="r"></robot>"#), KinematicsError::NoLinks);
+    assert_eq!(
+        KinematicsError::NoLinks.to_string(),
+        "the robot has no link"
+    );
     assert!(matches!(
         bad(r#"<robot name="r"><link name="a"/><link name="a"/></robot>"#),
         KinematicsError::DuplicateName { what: "links", .. }
@@ -305,6 +318,47 @@ fn bad_trees_get_their_errors() {
             <joint name="y" type="fixed"><parent link="b"/><child link="a"/></joint></robot>"#),
         KinematicsError::NotATree(_)
     ));
+}
+
+#[test]
+fn a_mimic_joint_without_its_leader_moves_on_its_own() {
+    // As in real descriptions (example-robot-data's psyonic hands), and as
+    // MoveIt reads them: the joint is an ordinary one, with a warning.
+    let urdf = r#"<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="first" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="orphan" type="prismatic"><parent link="b"/><child link="c"/><axis xyz="0 1 0"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="nope" multiplier="2"/></joint>
+    </robot>"#;
+    let k = Kinematics::from_urdf_str(urdf).unwrap();
+    assert_eq!(k.joint_names(), ["first", "orphan"]);
+    assert_eq!(k.warnings().len(), 1);
+    assert!(
+        k.warnings()[0].contains("`orphan` mimics `nope`"),
+        "{:?}",
+        k.warnings()
+    );
+    let p = k
+        .link_poses(&Isometry3::identity(), &[0.25, -0.5], LimitMode::Reject)
+        .unwrap();
+    assert_eq!(p[2].translation.vector, Vector3::new(0.25, -0.5, 0.0));
+    // Its own limits hold, not a leader's.
+    assert!(matches!(
+        k.link_poses(&Isometry3::identity(), &[0.0, 1.5], LimitMode::Reject),
+        Err(JointError::OutOfLimits { joint, .. }) if joint == "orphan"
+    ));
+    // A joint following the orphan follows it as it would any leader.
+    let chained = urdf.replace(
+        "</robot>",
+        r#"<link name="d"/><joint name="follower" type="prismatic"><parent link="a"/><child link="d"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="orphan" multiplier="-1"/></joint></robot>"#,
+    );
+    let k = Kinematics::from_urdf_str(&chained).unwrap();
+    assert_eq!(k.joint_names(), ["first", "orphan"]);
+    let p = k
+        .link_poses(&Isometry3::identity(), &[0.0, 0.75], LimitMode::Reject)
+        .unwrap();
+    assert_eq!(p[3].translation.vector, Vector3::new(0.0, 0.0, -0.75));
 }
 
 #[test]
@@ -319,6 +373,7 @@ fn mimic_chains_compose() {
     </robot>"#;
     let k = Kinematics::from_urdf_str(urdf).unwrap();
     assert_eq!(k.joint_names(), ["lead"]);
+    assert!(k.warnings().is_empty());
     let p = k
         .link_poses(&Isometry3::identity(), &[0.25], LimitMode::Reject)
         .unwrap();

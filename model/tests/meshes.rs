@@ -52,6 +52,35 @@ fn every_format_loads_the_vertices_written() {
 }
 
 #[test]
+fn binary_stl_with_a_header_saying_solid_loads_as_binary() {
+    // Some exporters (those of example-robot-data's bolt and solo feet,
+    // for one) begin binary STL's free-text header with `solid NAME` and a
+    // line break, which mesh-loader alone takes for ASCII STL and refuses.
+    let dir = files::scratch("solid-header");
+    let (v, t) = files::cuboid([0.5, 0.25, 0.125]);
+    let plain = dir.join("plain.stl");
+    files::write_stl_binary(&plain, &v, &t);
+    let mut bytes = std::fs::read(&plain).unwrap();
+    let mut header = format!("solid foot{}", " ".repeat(69)).into_bytes();
+    header.push(b'\n');
+    bytes[..80].copy_from_slice(&header);
+    let named = dir.join("named.stl");
+    std::fs::write(&named, &bytes).unwrap();
+    let mesh = Mesh::load(&named, [1.0; 3]).unwrap();
+    assert_same_points(&mesh.hull(), &v, 0.0);
+    assert_eq!(mesh.triangles.len(), 12);
+    // One byte more and the size no longer says binary: the ASCII error
+    // stands.
+    bytes.push(0);
+    std::fs::write(&named, &bytes).unwrap();
+    assert!(matches!(
+        Mesh::load(&named, [1.0; 3]),
+        Err(MeshError::Parse { .. })
+    ));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn the_hull_drops_interior_vertices() {
     let (mut v, t) = files::cuboid([1.0, 1.0, 1.0]);
     v.push([0.1, -0.2, 0.3]);
@@ -240,6 +269,15 @@ fn bad_meshes_get_their_errors() {
     std::fs::write(dir.join("junk.dae"), "<COLLADA><oops").unwrap();
     assert!(matches!(
         Mesh::load(&dir.join("junk.dae"), [1.0; 3]),
+        Err(MeshError::Parse { .. })
+    ));
+    std::fs::write(
+        dir.join("junk.stl"),
+        "solid x\nfacet normal 0 0 1\n  oops\n",
+    )
+    .unwrap();
+    assert!(matches!(
+        Mesh::load(&dir.join("junk.stl"), [1.0; 3]),
         Err(MeshError::Parse { .. })
     ));
     std::fs::write(dir.join("junk.xyz"), "1 2 3").unwrap();

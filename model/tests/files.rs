@@ -253,3 +253,32 @@ pub fn write_arm(dir: &Path) -> (PathBuf, PathBuf) {
     std::fs::write(&urdf, ARM_URDF).unwrap();
     (urdf, dir.join("pkg"))
 }
+
+/// A small deterministic generator (xorshift), so that failures reproduce.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// A number in `[lo, hi)`.
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The folder holding the vendored real robots (example-robot-data's
+/// panda and UR5): the package search path their `package://` URLs need.
+pub fn real_robots() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+/// The vendored panda's URDF (example-robot-data's, Franka's arm and hand).
+pub fn panda_urdf() -> PathBuf {
+    real_robots().join("example-robot-data/robots/panda_description/urdf/panda.urdf")
+}
+
+/// The vendored UR5's URDF (example-robot-data's, from ros-industrial).
+pub fn ur5_urdf() -> PathBuf {
+    real_robots().join("example-robot-data/robots/ur_description/urdf/ur5_robot.urdf")
+}

@@ -17,6 +17,7 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhNode};
 
+use super::motion_bound::displacement;
 use crate::cache::FxBuild;
 use crate::store::ObjectStore;
 
@@ -50,6 +51,10 @@ pub(crate) struct Entry {
     pub live: bool,
     /// Whether `pose` is a path's, not the stored one.
     pub overlaid: bool,
+    /// Along a path: the sum of the largest distances any of its points
+    /// moved at each of its moves ([`Broadphase::move_along`]), which bounds
+    /// how far any point moved between two steps; 0 at stored poses.
+    pub travel: f64,
 }
 
 /// The index: slots, the BVH over their boxes, and the ids' slots.
@@ -114,6 +119,7 @@ impl Broadphase {
                     maxs: [0.0; 3],
                     live: true,
                     overlaid: false,
+                    travel: 0.0,
                 };
                 let slot = match self.free.pop() {
                     Some(slot) => {
@@ -131,6 +137,7 @@ impl Broadphase {
         };
         self.place(slot, pose);
         self.entries[slot as usize].overlaid = false;
+        self.entries[slot as usize].travel = 0.0;
     }
 
     fn remove(&mut self, id: u64) {
@@ -164,10 +171,21 @@ impl Broadphase {
         self.moved.push(slot);
     }
 
-    /// Marks slot `slot` as holding a path's pose (see
-    /// [`Broadphase::overlaid`]).
+    /// Moves slot `slot` to a path's `pose`, adding to its travel the
+    /// largest distance any of its points moved.
+    pub(crate) fn move_along(&mut self, slot: u32, pose: &Isometry3<f64>) {
+        let from = self.entries[slot as usize].pose;
+        self.place(slot, pose);
+        let e = &mut self.entries[slot as usize];
+        e.travel += displacement(e, &from);
+    }
+
+    /// Marks slot `slot` as holding a path's pose, or back at its stored
+    /// one (see [`Entry::overlaid`]); either way its travel starts at 0.
     pub(crate) fn set_overlaid(&mut self, slot: u32, overlaid: bool) {
-        self.entries[slot as usize].overlaid = overlaid;
+        let e = &mut self.entries[slot as usize];
+        e.overlaid = overlaid;
+        e.travel = 0.0;
     }
 
     /// Refits the tree to the boxes moved since the last refit.

@@ -30,19 +30,14 @@ use super::pair::{Ask, Ctx, Outcome};
 use super::rows::Rows;
 use crate::cache::PairBound;
 
-/// A pair's motion bound at the step it was kept, and the member's travel
-/// then.
-#[derive(Clone, Copy, Debug)]
-struct Anchor {
-    travel: f64,
-    bound: PairBound,
-}
-
-/// One object that may come within the margin of a member.
+/// One object that may come within the margin of a member, and the
+/// pair's anchor: its motion bound at the step it was kept, and the
+/// member's travel then.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
     slot: u32,
-    anchor: Option<Anchor>,
+    travel: f64,
+    bound: Option<PairBound>,
 }
 
 /// A member's candidates and how far they hold.
@@ -89,12 +84,15 @@ impl Lookahead {
             {
                 continue;
             }
-            let anchor = self
-                .previous
-                .binary_search_by_key(&leaf, |c| c.slot)
-                .ok()
-                .and_then(|i| self.previous[i].anchor);
-            self.candidates.push(Candidate { slot: leaf, anchor });
+            let kept = self.previous.binary_search_by_key(&leaf, |c| c.slot);
+            self.candidates.push(match kept {
+                Ok(i) => self.previous[i],
+                Err(_) => Candidate {
+                    slot: leaf,
+                    travel: 0.0,
+                    bound: None,
+                },
+            });
         }
     }
 }
@@ -124,18 +122,15 @@ pub(crate) fn within_along(
         }
         ctx.counters.candidates += 1;
         let settled = candidate
-            .anchor
+            .bound
             .as_ref()
-            .and_then(|an| by_travel(ctx, an, ea, eb, moves));
+            .and_then(|bound| by_travel(ctx, bound, candidate.travel, ea, eb, moves));
         let result = match settled {
             Some(outcome) => outcome,
             None => {
-                let (outcome, bound) = ctx.settle_keeping(a, candidate.slot, Ask::Within(m), true);
-                candidate.anchor = bound.map(|bound| Anchor {
-                    travel: ea.travel,
-                    bound,
-                });
-                outcome
+                candidate.travel = ea.travel;
+                let keep = Some(&mut candidate.bound);
+                ctx.settle_keeping(a, candidate.slot, Ask::Within(m), keep)
             }
         };
         if let Outcome::Answer(result) = result
@@ -154,21 +149,23 @@ pub(crate) fn within_along(
     hits
 }
 
-/// The pair's outcome from its anchor widened by the member's travel
-/// since, when that settles it as [`Ctx::settle_keeping`] would.
+/// The pair's outcome from its anchor (`bound`, kept when the member's
+/// travel was `then`) widened by the member's travel since, when that
+/// settles it as [`Ctx::settle_keeping`] would.
 fn by_travel(
     ctx: &mut Ctx<'_>,
-    anchor: &Anchor,
+    bound: &PairBound,
+    then: f64,
     ea: &Entry,
     eb: &Entry,
     moves: u32,
 ) -> Option<Outcome> {
     let q = ctx.q;
-    let w = widen_by(&anchor.bound, travelled(ea.travel, anchor.travel, moves));
+    let w = widen_by(bound, travelled(ea.travel, then, moves));
     let outcome = if w.lower > q.margin {
         Outcome::Ruled
     } else if w.upper <= q.margin || accepted(&w, q.accept_absolute, q.accept_relative) {
-        Outcome::Answer(bounded_result(&anchor.bound, &w, ea, eb))
+        Outcome::Answer(bounded_result(bound, &w, ea, eb))
     } else {
         return None;
     };

@@ -43,6 +43,8 @@ pub(crate) struct Entry {
     pub local_half: [f64; 3],
     /// The pose its box was computed at: the stored pose, or a path's.
     pub pose: Isometry3<f64>,
+    /// `centre` at `pose`.
+    pub world_centre: Point3<f64>,
     /// Its box at `pose`.
     pub mins: [f64; 3],
     /// Its box at `pose`.
@@ -115,6 +117,7 @@ impl Broadphase {
                     local_centre: std::array::from_fn(|i| 0.5 * (mins[i] + maxs[i])),
                     local_half: std::array::from_fn(|i| 0.5 * (maxs[i] - mins[i])),
                     pose: *pose,
+                    world_centre: pose * centre,
                     mins: [0.0; 3],
                     maxs: [0.0; 3],
                     live: true,
@@ -155,6 +158,7 @@ impl Broadphase {
     pub(crate) fn place(&mut self, slot: u32, pose: &Isometry3<f64>) {
         let e = &mut self.entries[slot as usize];
         e.pose = *pose;
+        e.world_centre = pose * e.centre;
         let r = pose.rotation.to_rotation_matrix();
         let m = r.matrix();
         let c = pose * Point3::from(e.local_centre);
@@ -275,8 +279,7 @@ pub(crate) fn node_gap(amin: &[f64; 3], amax: &[f64; 3], node: &BvhNode) -> f64 
 /// spheres at their index poses.
 #[inline]
 pub(crate) fn sphere_gap(a: &Entry, b: &Entry) -> f64 {
-    let ca = a.pose * a.centre;
-    let cb = b.pose * b.centre;
+    let (ca, cb) = (a.world_centre, b.world_centre);
     let round = ROUND_OFF * (ca.coords.abs().sum() + cb.coords.abs().sum() + a.reach + b.reach);
     (ca - cb).norm() * (1.0 - 4.0 * f64::EPSILON) - a.extent - b.extent - round
 }

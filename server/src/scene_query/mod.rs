@@ -305,8 +305,28 @@ impl State {
         engine.overlay.reset();
         engine.plan.clear();
         engine.plan_ends.clear();
+        // Consecutive pose items mostly move the same object: its checks
+        // and slot are looked up once.
+        let mut last: Option<(u64, Option<u32>)> = None;
         for item in items {
-            if is_pose_item(item) {
+            if item.kind == ItemKind::SetPose as u32 {
+                let slot = match last {
+                    Some((id, slot)) if id == item.a => slot,
+                    _ => {
+                        if self.store.object(item.a).is_none() {
+                            return Err(ErrorCode::UnknownObject);
+                        }
+                        let slot = engine.broadphase.slot(item.a);
+                        last = Some((item.a, slot));
+                        slot
+                    }
+                };
+                let pose = crate::requests::check_pose(&item.pose_a)?;
+                // Every stored object has a slot since the last sync.
+                if let Some(slot) = slot {
+                    engine.plan.push((slot, pose));
+                }
+            } else if is_pose_item(item) {
                 engine.poses.clear();
                 item_poses(
                     &self.store,
@@ -317,7 +337,6 @@ impl State {
                     &mut engine.poses,
                 )?;
                 for &(id, pose) in &engine.poses {
-                    // Every stored object has a slot since the last sync.
                     if let Some(slot) = engine.broadphase.slot(id) {
                         engine.plan.push((slot, pose));
                     }

@@ -25,7 +25,7 @@ pub(crate) fn displacement(entry: &Entry, from: &Isometry3<f64>) -> f64 {
     if to == from {
         return 0.0;
     }
-    let moved = (to * entry.centre - from * entry.centre).norm();
+    let moved = (entry.world_centre - from * entry.centre).norm();
     let relative = to.rotation * from.rotation.inverse();
     // |imaginary part| of a unit quaternion is sin(theta / 2), for either
     // sign of the quaternion.

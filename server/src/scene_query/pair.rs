@@ -92,19 +92,19 @@ impl Ctx<'_> {
 
     /// Settles the pair of slots `a`, `b` for `ask`.
     pub(crate) fn settle(&mut self, a: u32, b: u32, ask: Ask) -> Outcome {
-        self.settle_keeping(a, b, ask, false).0
+        self.settle_keeping(a, b, ask, None)
     }
 
-    /// [`Ctx::settle`], with `keep`, also returning the pair's motion bound
-    /// at the current poses when motion bounds are on: the answer GJK kept,
-    /// or the kept one carried here ([`carried`]).
+    /// [`Ctx::settle`], also writing into `keep` the pair's motion bound
+    /// at the current poses (`None` without motion bounds): the answer GJK
+    /// kept, or the kept one carried here ([`carried`]).
     pub(crate) fn settle_keeping(
         &mut self,
         a: u32,
         b: u32,
         ask: Ask,
-        keep: bool,
-    ) -> (Outcome, Option<PairBound>) {
+        keep: Option<&mut Option<PairBound>>,
+    ) -> Outcome {
         let q = self.q;
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         if q.motion
@@ -126,33 +126,39 @@ impl Ctx<'_> {
                 None
             };
             if let Some(outcome) = outcome {
-                let here = keep.then(|| carried(bound, d, &w, ea, eb));
+                if let Some(keep) = keep {
+                    *keep = Some(carried(bound, d, &w, ea, eb));
+                }
                 self.counters.bounded += 1;
-                return (outcome, here);
+                return outcome;
             }
         }
         let warm = self.warm(a, b);
-        let (result, bound) = self.run_keeping(a, b, ask, warm);
-        (Outcome::Answer(result), bound)
+        Outcome::Answer(self.run_keeping(a, b, ask, warm, keep))
     }
 
     /// Runs GJK on the pair of slots `a`, `b` (from `warm` if warm starts
     /// are on) and caches its simplex and, with motion bounds, its answer.
     pub(crate) fn run(&mut self, a: u32, b: u32, ask: Ask, warm: Option<WarmStart>) -> ItemResult {
-        self.run_keeping(a, b, ask, warm).0
+        self.run_keeping(a, b, ask, warm, None)
     }
 
-    /// [`Ctx::run`], also returning the motion bound it kept.
+    /// [`Ctx::run`], also writing into `keep` the motion bound it kept
+    /// (`None` if none).
     fn run_keeping(
         &mut self,
         a: u32,
         b: u32,
         ask: Ask,
         warm: Option<WarmStart>,
-    ) -> (ItemResult, Option<PairBound>) {
+        mut keep: Option<&mut Option<PairBound>>,
+    ) -> ItemResult {
+        if let Some(keep) = keep.as_deref_mut() {
+            *keep = None;
+        }
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         let (Some(oa), Some(ob)) = (self.store.object(ea.id), self.store.object(eb.id)) else {
-            return (ItemResult::error(ErrorCode::UnknownObject), None);
+            return ItemResult::error(ErrorCode::UnknownObject);
         };
         let q = self.q;
         let mut options = q.options;
@@ -174,13 +180,15 @@ impl Ctx<'_> {
                 if q.motion {
                     let bound = bound_of(&result, ea, eb);
                     self.cache.put_with_bound(key, next, bound);
-                    return (result, Some(bound));
+                    if let Some(keep) = keep {
+                        *keep = Some(bound);
+                    }
                 } else if q.warm {
                     self.cache.put(key, next);
                 }
-                (result, None)
+                result
             }
-            Err(code) => (ItemResult::error(code), None),
+            Err(code) => ItemResult::error(code),
         }
     }
 }

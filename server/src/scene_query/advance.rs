@@ -24,7 +24,7 @@
 
 use gjkd_proto::SceneRow;
 
-use super::broadphase::{Entry, box_gap, node_gap, sphere_gap};
+use super::broadphase::{Entry, box_gap_squared, node_gap, sphere_gap, square_up};
 use super::motion_bound::{accepted, bounded_result, travelled, widen_by};
 use super::pair::{Ask, Ctx, Outcome};
 use super::rows::Rows;
@@ -115,9 +115,10 @@ pub(crate) fn within_along(
         look.search(ctx, a, ea, m);
     }
     let mut hits = 0;
+    let m2 = square_up(m);
     for candidate in &mut look.candidates {
         let eb = bp.entry(candidate.slot);
-        if box_gap(&ea.mins, &ea.maxs, &eb.mins, &eb.maxs) > m || sphere_gap(ea, eb) > m {
+        if box_gap_squared(&ea.mins, &ea.maxs, &eb.mins, &eb.maxs) > m2 || sphere_gap(ea, eb) > m {
             continue;
         }
         ctx.counters.candidates += 1;

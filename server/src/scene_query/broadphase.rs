@@ -17,7 +17,7 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhNode};
 
-use super::motion_bound::displacement;
+use super::motion_bound::displacement_from;
 use crate::cache::FxBuild;
 use crate::store::ObjectStore;
 
@@ -53,6 +53,8 @@ pub(crate) struct Entry {
     pub live: bool,
     /// Whether `pose` is a path's, not the stored one.
     pub overlaid: bool,
+    /// Whether its box waits for the next refit.
+    queued: bool,
     /// Along a path: the sum of the largest distances any of its points
     /// moved at each of its moves ([`Broadphase::move_along`]), which bounds
     /// how far any point moved between two steps; 0 at stored poses.
@@ -122,6 +124,7 @@ impl Broadphase {
                     maxs: [0.0; 3],
                     live: true,
                     overlaid: false,
+                    queued: false,
                     travel: 0.0,
                 };
                 let slot = match self.free.pop() {
@@ -146,6 +149,7 @@ impl Broadphase {
     fn remove(&mut self, id: u64) {
         if let Some(slot) = self.slots.remove(&id) {
             self.entries[slot as usize].live = false;
+            self.entries[slot as usize].queued = false;
             self.bvh.remove(slot);
             self.moved.retain(|&s| s != slot);
             self.free.push(slot);
@@ -172,16 +176,22 @@ impl Broadphase {
             e.mins[i] = c[i] - half - slack;
             e.maxs[i] = c[i] + half + slack;
         }
-        self.moved.push(slot);
+        if !e.queued {
+            e.queued = true;
+            self.moved.push(slot);
+        }
     }
 
     /// Moves slot `slot` to a path's `pose`, adding to its travel the
     /// largest distance any of its points moved.
     pub(crate) fn move_along(&mut self, slot: u32, pose: &Isometry3<f64>) {
-        let from = self.entries[slot as usize].pose;
+        let (from, from_centre) = {
+            let e = &self.entries[slot as usize];
+            (e.pose, e.world_centre)
+        };
         self.place(slot, pose);
         let e = &mut self.entries[slot as usize];
-        e.travel += displacement(e, &from);
+        e.travel += displacement_from(e, &from, &from_centre);
     }
 
     /// Marks slot `slot` as holding a path's pose, or back at its stored
@@ -200,7 +210,8 @@ impl Broadphase {
         self.moved.sort_unstable();
         self.moved.dedup();
         for &slot in &self.moved {
-            let e = &self.entries[slot as usize];
+            let e = &mut self.entries[slot as usize];
+            e.queued = false;
             let aabb = Aabb::new(Vector::from(e.mins), Vector::from(e.maxs));
             self.bvh.insert_or_update_partially(aabb, slot, 0.0);
         }
@@ -240,6 +251,23 @@ pub(crate) fn box_gap(amin: &[f64; 3], amax: &[f64; 3], bmin: &[f64; 3], bmax: &
         sum += gap * gap;
     }
     sum.sqrt() * (1.0 - 4.0 * f64::EPSILON)
+}
+
+/// The square of [`box_gap`], rounded down, for comparisons with
+/// [`square_up`] without a square root.
+#[inline]
+pub(crate) fn box_gap_squared(
+    amin: &[f64; 3],
+    amax: &[f64; 3],
+    bmin: &[f64; 3],
+    bmax: &[f64; 3],
+) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..3 {
+        let gap = (bmin[i] - amax[i]).max(amin[i] - bmax[i]).max(0.0);
+        sum += gap * gap;
+    }
+    sum * (1.0 - 8.0 * f64::EPSILON)
 }
 
 /// The square of [`box_gap`] between a box and a tree node, rounded down:

@@ -10,7 +10,7 @@
 //! by `dA + dB` holds the distance at the new poses.
 
 use gjkd_proto::{ErrorCode, ItemResult, Status};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Point3};
 
 use super::broadphase::{Entry, ROUND_OFF};
 use crate::cache::PairBound;
@@ -21,11 +21,21 @@ use crate::cache::PairBound;
 /// centroid, extent), which covers the round-off of the arithmetic here and
 /// of the rotation matrices the poses stand for.
 pub(crate) fn displacement(entry: &Entry, from: &Isometry3<f64>) -> f64 {
-    let to = &entry.pose;
-    if to == from {
+    if entry.pose == *from {
         return 0.0;
     }
-    let moved = (entry.world_centre - from * entry.centre).norm();
+    displacement_from(entry, from, &(from * entry.centre))
+}
+
+/// [`displacement`] from `from`, where the centroid was `from_centre`
+/// (computed as `from * entry.centre`).
+pub(crate) fn displacement_from(
+    entry: &Entry,
+    from: &Isometry3<f64>,
+    from_centre: &Point3<f64>,
+) -> f64 {
+    let to = &entry.pose;
+    let moved = (entry.world_centre - from_centre).norm();
     let relative = to.rotation * from.rotation.inverse();
     // |imaginary part| of a unit quaternion is sin(theta / 2), for either
     // sign of the quaternion.

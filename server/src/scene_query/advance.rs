@@ -24,7 +24,7 @@
 
 use gjkd_proto::SceneRow;
 
-use super::broadphase::{Entry, box_gap_squared, node_gap, sphere_gap, square_up};
+use super::broadphase::{Entry, ROUND_OFF, box_gap_squared, node_gap, sphere_gap, square_up};
 use super::motion_bound::{accepted, bounded_result, travelled, widen_by};
 use super::pair::{Ask, Ctx, Outcome};
 use super::rows::Rows;
@@ -38,6 +38,14 @@ struct Candidate {
     slot: u32,
     travel: f64,
     bound: Option<PairBound>,
+    /// The pair is beyond the margin while the member's travel since
+    /// `quiet_from` is below `quiet` (a certified lower bound on their
+    /// distance then, less the margin): it is not looked at.
+    quiet: f64,
+    quiet_from: f64,
+    /// Whether `quiet` is from the pair's motion bound (else its boxes or
+    /// spheres).
+    quiet_by_bound: bool,
 }
 
 /// A member's candidates and how far they hold.
@@ -91,6 +99,9 @@ impl Lookahead {
                     slot: leaf,
                     travel: 0.0,
                     bound: None,
+                    quiet: 0.0,
+                    quiet_from: 0.0,
+                    quiet_by_bound: false,
                 },
             });
         }
@@ -117,8 +128,22 @@ pub(crate) fn within_along(
     let mut hits = 0;
     let m2 = square_up(m);
     for candidate in &mut look.candidates {
+        if travelled(ea.travel, candidate.quiet_from, moves) < candidate.quiet {
+            // Counted as its motion bound's answer, as when it is asked.
+            ctx.counters.bounded += u64::from(candidate.quiet_by_bound);
+            continue;
+        }
         let eb = bp.entry(candidate.slot);
-        if box_gap_squared(&ea.mins, &ea.maxs, &eb.mins, &eb.maxs) > m2 || sphere_gap(ea, eb) > m {
+        let gap2 = box_gap_squared(&ea.mins, &ea.maxs, &eb.mins, &eb.maxs);
+        let gap = if gap2 > m2 {
+            gap2.sqrt() * (1.0 - 4.0 * f64::EPSILON)
+        } else {
+            sphere_gap(ea, eb)
+        };
+        if gap > m {
+            candidate.quiet_from = ea.travel;
+            candidate.quiet = slack(gap, m);
+            candidate.quiet_by_bound = false;
             continue;
         }
         ctx.counters.candidates += 1;
@@ -145,9 +170,23 @@ pub(crate) fn within_along(
                 reserved: 0,
                 result,
             });
+        } else if let Some(bound) = &candidate.bound {
+            candidate.quiet_from = candidate.travel;
+            candidate.quiet = slack(bound.lower, m);
+            candidate.quiet_by_bound = true;
         }
     }
     hits
+}
+
+/// How far the member may travel while a pair whose certified lower bound
+/// was `lower` stays beyond margin `m`, rounded down; 0 if it is not beyond.
+fn slack(lower: f64, m: f64) -> f64 {
+    if lower > m {
+        (lower - m) * (1.0 - ROUND_OFF)
+    } else {
+        0.0
+    }
 }
 
 /// The pair's outcome from its anchor (`bound`, kept when the member's

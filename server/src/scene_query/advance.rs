@@ -122,7 +122,10 @@ pub(crate) fn within_along(
     let bp = ctx.bp;
     let ea = bp.entry(a);
     let m = ctx.q.margin;
-    if !look.searched || travelled(ea.travel, look.travel, moves) > look.reach {
+    // Searched again past the reach, or if the travel is no number (an
+    // overflow), never trusted then.
+    let within_reach = travelled(ea.travel, look.travel, moves) <= look.reach;
+    if !look.searched || !within_reach {
         look.search(ctx, a, ea, m);
     }
     let mut hits = 0;

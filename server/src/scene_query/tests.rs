@@ -1034,3 +1034,34 @@ fn paths_with_a_bad_step_are_refused_whole() {
         .collect();
     check_path_within(&s, &rows, &steps, &group_pairs(&[mover], &ids), req.margin);
 }
+
+/// A path through the far ends of the number line overflows the travel:
+/// the candidates are searched again rather than trusted, and the pair
+/// met on the way back is found.
+#[test]
+fn overflowing_travel_searches_again() {
+    let mut s = State::new(Limits::default(), WaitMode::Spin, 3);
+    let mut ball = |x: f64| {
+        s.insert(
+            NewObject {
+                shape: Convex::sphere(0.5).unwrap().into(),
+                pose: Isometry3::translation(x, 0.0, 0.0),
+                name: None,
+            },
+            Owner::Client(1),
+        )
+        .unwrap()
+    };
+    let (mover, other) = (ball(0.0), ball(2.0));
+    let mut path = Vec::new();
+    for x in [0.0, 1e308, -1e308, 1.5, 1.6] {
+        let p = Isometry3::translation(x, 0.0, 0.0);
+        path.push(Item::set_pose(ObjectId::from_raw(mover), &p));
+        path.push(Item::step());
+    }
+    let mut req = SceneRequest::new(SceneKind::Within, mover);
+    req.path = PathMode::EveryStep as u32;
+    let (_, rows) = ask(&mut s, 1, &req, &path);
+    let hits: Vec<(u32, u64)> = rows.iter().map(|r| (r.step, r.b)).collect();
+    assert_eq!(hits, [(3, other), (4, other)]);
+}

@@ -30,7 +30,11 @@ pub enum SceneKind {
     Clearance = 1,
     /// Every pair, group against the rest (or all against all with
     /// [`scene_flags::ALL_PAIRS`]), whose distance is at most
-    /// [`SceneRequest::margin`].
+    /// [`SceneRequest::margin`]. A row answered from motion bounds
+    /// ([`Status::Bounded`](crate::Status::Bounded), an interval no wider
+    /// than the accepted accuracy) is reported when its interval reaches
+    /// below the margin, so such a pair may lie beyond the margin by at most
+    /// its interval's width.
     Within = 2,
     /// The [`SceneRequest::k`] objects nearest to the group's only member,
     /// nearest first.

@@ -17,6 +17,7 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 use parry3d_f64::partitioning::{Bvh, BvhNode};
 
+use super::motion_bound::displacement_from;
 use crate::cache::FxBuild;
 use crate::store::ObjectStore;
 
@@ -42,6 +43,8 @@ pub(crate) struct Entry {
     pub local_half: [f64; 3],
     /// The pose its box was computed at: the stored pose, or a path's.
     pub pose: Isometry3<f64>,
+    /// `centre` at `pose`.
+    pub world_centre: Point3<f64>,
     /// Its box at `pose`.
     pub mins: [f64; 3],
     /// Its box at `pose`.
@@ -50,6 +53,12 @@ pub(crate) struct Entry {
     pub live: bool,
     /// Whether `pose` is a path's, not the stored one.
     pub overlaid: bool,
+    /// Whether its box waits for the next refit.
+    queued: bool,
+    /// Along a path: the sum of the largest distances any of its points
+    /// moved at each of its moves ([`Broadphase::move_along`]), which bounds
+    /// how far any point moved between two steps; 0 at stored poses.
+    pub travel: f64,
 }
 
 /// The index: slots, the BVH over their boxes, and the ids' slots.
@@ -110,10 +119,13 @@ impl Broadphase {
                     local_centre: std::array::from_fn(|i| 0.5 * (mins[i] + maxs[i])),
                     local_half: std::array::from_fn(|i| 0.5 * (maxs[i] - mins[i])),
                     pose: *pose,
+                    world_centre: pose * centre,
                     mins: [0.0; 3],
                     maxs: [0.0; 3],
                     live: true,
                     overlaid: false,
+                    queued: false,
+                    travel: 0.0,
                 };
                 let slot = match self.free.pop() {
                     Some(slot) => {
@@ -131,11 +143,13 @@ impl Broadphase {
         };
         self.place(slot, pose);
         self.entries[slot as usize].overlaid = false;
+        self.entries[slot as usize].travel = 0.0;
     }
 
     fn remove(&mut self, id: u64) {
         if let Some(slot) = self.slots.remove(&id) {
             self.entries[slot as usize].live = false;
+            self.entries[slot as usize].queued = false;
             self.bvh.remove(slot);
             self.moved.retain(|&s| s != slot);
             self.free.push(slot);
@@ -148,6 +162,7 @@ impl Broadphase {
     pub(crate) fn place(&mut self, slot: u32, pose: &Isometry3<f64>) {
         let e = &mut self.entries[slot as usize];
         e.pose = *pose;
+        e.world_centre = pose * e.centre;
         let r = pose.rotation.to_rotation_matrix();
         let m = r.matrix();
         let c = pose * Point3::from(e.local_centre);
@@ -161,13 +176,30 @@ impl Broadphase {
             e.mins[i] = c[i] - half - slack;
             e.maxs[i] = c[i] + half + slack;
         }
-        self.moved.push(slot);
+        if !e.queued {
+            e.queued = true;
+            self.moved.push(slot);
+        }
     }
 
-    /// Marks slot `slot` as holding a path's pose (see
-    /// [`Broadphase::overlaid`]).
+    /// Moves slot `slot` to a path's `pose`, adding to its travel the
+    /// largest distance any of its points moved.
+    pub(crate) fn move_along(&mut self, slot: u32, pose: &Isometry3<f64>) {
+        let (from, from_centre) = {
+            let e = &self.entries[slot as usize];
+            (e.pose, e.world_centre)
+        };
+        self.place(slot, pose);
+        let e = &mut self.entries[slot as usize];
+        e.travel += displacement_from(e, &from, &from_centre);
+    }
+
+    /// Marks slot `slot` as holding a path's pose, or back at its stored
+    /// one (see [`Entry::overlaid`]); either way its travel starts at 0.
     pub(crate) fn set_overlaid(&mut self, slot: u32, overlaid: bool) {
-        self.entries[slot as usize].overlaid = overlaid;
+        let e = &mut self.entries[slot as usize];
+        e.overlaid = overlaid;
+        e.travel = 0.0;
     }
 
     /// Refits the tree to the boxes moved since the last refit.
@@ -178,7 +210,8 @@ impl Broadphase {
         self.moved.sort_unstable();
         self.moved.dedup();
         for &slot in &self.moved {
-            let e = &self.entries[slot as usize];
+            let e = &mut self.entries[slot as usize];
+            e.queued = false;
             let aabb = Aabb::new(Vector::from(e.mins), Vector::from(e.maxs));
             self.bvh.insert_or_update_partially(aabb, slot, 0.0);
         }
@@ -220,6 +253,23 @@ pub(crate) fn box_gap(amin: &[f64; 3], amax: &[f64; 3], bmin: &[f64; 3], bmax: &
     sum.sqrt() * (1.0 - 4.0 * f64::EPSILON)
 }
 
+/// The square of [`box_gap`], rounded down, for comparisons with
+/// [`square_up`] without a square root.
+#[inline]
+pub(crate) fn box_gap_squared(
+    amin: &[f64; 3],
+    amax: &[f64; 3],
+    bmin: &[f64; 3],
+    bmax: &[f64; 3],
+) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..3 {
+        let gap = (bmin[i] - amax[i]).max(amin[i] - bmax[i]).max(0.0);
+        sum += gap * gap;
+    }
+    sum * (1.0 - 8.0 * f64::EPSILON)
+}
+
 /// The square of [`box_gap`] between a box and a tree node, rounded down:
 /// the search compares squares and so takes no square root per node.
 #[inline]
@@ -257,8 +307,7 @@ pub(crate) fn node_gap(amin: &[f64; 3], amax: &[f64; 3], node: &BvhNode) -> f64 
 /// spheres at their index poses.
 #[inline]
 pub(crate) fn sphere_gap(a: &Entry, b: &Entry) -> f64 {
-    let ca = a.pose * a.centre;
-    let cb = b.pose * b.centre;
+    let (ca, cb) = (a.world_centre, b.world_centre);
     let round = ROUND_OFF * (ca.coords.abs().sum() + cb.coords.abs().sum() + a.reach + b.reach);
     (ca - cb).norm() * (1.0 - 4.0 * f64::EPSILON) - a.extent - b.extent - round
 }

@@ -30,6 +30,7 @@
 //! assert!(row.lower <= 2.0 && 2.0 <= row.upper);
 //! ```
 
+mod advance;
 mod broadphase;
 mod clearance;
 mod groups;
@@ -52,6 +53,7 @@ use std::collections::HashMap;
 
 use crate::cache::FxBuild;
 
+use advance::Lookahead;
 pub use broadphase::Broadphase;
 use groups::Group;
 use pair::Ctx;
@@ -105,6 +107,12 @@ pub struct SceneEngine {
     poses: Vec<(u64, Isometry3<f64>)>,
     /// Slots a path moved, to put back.
     touched: Vec<u32>,
+    /// A path's moves, in order: slot and pose.
+    plan: Vec<(u32, Isometry3<f64>)>,
+    /// Per step of a path, the end of its moves in `plan`.
+    plan_ends: Vec<usize>,
+    /// Per member, its lookahead along a path ([`advance`]).
+    lookahead: Vec<Lookahead>,
     found: Vec<(u32, ItemResult)>,
     /// Clearance's candidates answered from accepted motion bounds.
     approximate: Vec<(u32, f64)>,
@@ -248,7 +256,11 @@ impl State {
         if q.kind == SceneKind::Nearest && self.scene.group.members.len() != 1 {
             return Err(ErrorCode::Malformed);
         }
-        self.check_poses(&q, inputs)?;
+        if q.mode == PathMode::Single {
+            self.check_poses(&q, inputs)?;
+        } else {
+            self.plan_path(&q, inputs)?;
+        }
         let mut rows = Rows::new(rows);
         let mut counters = Counters::default();
         let mut reply = SceneReply::error(ErrorCode::Ok);
@@ -259,7 +271,7 @@ impl State {
             reply.steps = 1;
         } else {
             (reply.steps, reply.first_hit) =
-                self.answer_path(client, &q, inputs, steps, &mut rows, &mut counters);
+                self.answer_path(client, &q, steps, &mut rows, &mut counters);
         }
         self.scene.group.clear();
         reply.total = rows.total;
@@ -291,6 +303,57 @@ impl State {
         Ok(())
     }
 
+    /// Computes every pose a path's items set, storing none (an error in
+    /// any of them is found before anything changes), into the plan: each
+    /// step's moves as slots and poses.
+    fn plan_path(&mut self, q: &Question, items: &[Item]) -> Result<(), ErrorCode> {
+        let engine = &mut self.scene;
+        engine.overlay.reset();
+        engine.plan.clear();
+        engine.plan_ends.clear();
+        // Consecutive pose items mostly move the same object: its checks
+        // and slot are looked up once.
+        let mut last: Option<(u64, Option<u32>)> = None;
+        for item in items {
+            if item.kind == ItemKind::SetPose as u32 {
+                let slot = match last {
+                    Some((id, slot)) if id == item.a => slot,
+                    _ => {
+                        if self.store.object(item.a).is_none() {
+                            return Err(ErrorCode::UnknownObject);
+                        }
+                        let slot = engine.broadphase.slot(item.a);
+                        last = Some((item.a, slot));
+                        slot
+                    }
+                };
+                let pose = crate::requests::check_pose(&item.pose_a)?;
+                // Every stored object has a slot since the last sync.
+                if let Some(slot) = slot {
+                    engine.plan.push((slot, pose));
+                }
+            } else if is_pose_item(item) {
+                engine.poses.clear();
+                item_poses(
+                    &self.store,
+                    &self.robots,
+                    &mut engine.overlay,
+                    item,
+                    q.clamp,
+                    &mut engine.poses,
+                )?;
+                for &(id, pose) in &engine.poses {
+                    if let Some(slot) = engine.broadphase.slot(id) {
+                        engine.plan.push((slot, pose));
+                    }
+                }
+            } else if item.kind == ItemKind::Step as u32 {
+                engine.plan_ends.push(engine.plan.len());
+            }
+        }
+        Ok(())
+    }
+
     /// Stores the poses of a single question's items, as the query
     /// service would (checked before by [`State::check_poses`]).
     fn apply_poses(&mut self, q: &Question, items: &[Item]) -> Result<(), ErrorCode> {
@@ -313,67 +376,105 @@ impl State {
         Ok(())
     }
 
-    /// Answers a path: each step's poses in the overlay, then the question;
-    /// the overlay is undone at the end. Returns the steps answered and the
-    /// first hit.
+    /// Answers a path (planned by [`State::plan_path`]): each step's poses
+    /// in the overlay, then the question; the overlay is undone at the end.
+    /// Returns the steps answered and the first hit.
     fn answer_path(
         &mut self,
         client: u128,
         q: &Question,
-        items: &[Item],
         steps: u32,
         rows: &mut Rows<'_>,
         counters: &mut Counters,
     ) -> (u32, u32) {
-        self.scene.overlay.reset();
-        self.scene.touched.clear();
-        let mut step = 0;
+        let engine = &mut self.scene;
+        engine.touched.clear();
+        let plan = std::mem::take(&mut engine.plan);
+        let ends = std::mem::take(&mut engine.plan_ends);
+        // Members only move: the tree's other leaves stay put, which is
+        // what the questions of a group ask of it (members are never
+        // their own candidates), and the lookaheads hold.
+        let members_only =
+            !q.all_pairs && plan.iter().all(|&(slot, _)| engine.group.contains(slot));
+        let advance = members_only && q.kind == SceneKind::Within;
+        if advance {
+            let n = engine.group.members.len();
+            if engine.lookahead.len() < n {
+                engine.lookahead.resize_with(n, Lookahead::default);
+            }
+            engine.lookahead[..n].iter_mut().for_each(Lookahead::reset);
+        }
         let mut first_hit = u32::MAX;
-        for item in items {
-            if is_pose_item(item) {
-                self.overlay_item(q, item);
-            } else if item.kind == ItemKind::Step as u32 {
-                self.scene.broadphase.refit();
-                let (written, total) = (rows.written, rows.total);
-                let hits = self.answer_step(client, q, step, rows, counters);
-                step += 1;
-                if q.mode == PathMode::FirstHit {
-                    if hits > 0 {
-                        first_hit = step - 1;
-                        break;
-                    }
-                    rows.truncate(written, total);
+        let (mut start, mut step) = (0, 0);
+        for &end in &ends {
+            self.move_step(&plan[start..end], !members_only);
+            start = end;
+            let (written, total) = (rows.written, rows.total);
+            let moves = u32::try_from(end).unwrap_or(u32::MAX);
+            let hits = if advance {
+                self.answer_step_along(client, q, step, moves, rows, counters)
+            } else {
+                self.answer_step(client, q, step, rows, counters)
+            };
+            step += 1;
+            if q.mode == PathMode::FirstHit {
+                if hits > 0 {
+                    first_hit = step - 1;
+                    break;
                 }
+                rows.truncate(written, total);
             }
         }
         debug_assert!(step <= steps);
+        self.scene.plan = plan;
+        self.scene.plan_ends = ends;
         self.restore_overlay();
         (step, first_hit)
     }
 
-    /// Moves the objects of pose item `item` in the overlay.
-    fn overlay_item(&mut self, q: &Question, item: &Item) {
+    /// Moves the objects of one step of a path in the overlay; with
+    /// `refit`, refits the tree to them.
+    fn move_step(&mut self, moves: &[(u32, Isometry3<f64>)], refit: bool) {
         let engine = &mut self.scene;
-        engine.poses.clear();
-        // Checked whole before (check_poses): cannot fail.
-        let _ = item_poses(
-            &self.store,
-            &self.robots,
-            &mut engine.overlay,
-            item,
-            q.clamp,
-            &mut engine.poses,
-        );
-        for &(id, pose) in &engine.poses {
-            let Some(slot) = engine.broadphase.slot(id) else {
-                continue;
-            };
-            engine.broadphase.place(slot, &pose);
-            if !engine.broadphase.entry(slot).overlaid {
-                engine.broadphase.set_overlaid(slot, true);
-                engine.touched.push(slot);
+        for (slot, pose) in moves {
+            if !engine.broadphase.entry(*slot).overlaid {
+                engine.broadphase.set_overlaid(*slot, true);
+                engine.touched.push(*slot);
             }
+            engine.broadphase.move_along(*slot, pose);
         }
+        if refit {
+            engine.broadphase.refit();
+        }
+    }
+
+    /// Within, group against the rest, at one step of a path that moves
+    /// members only ([`advance`]); returns the rows found.
+    fn answer_step_along(
+        &mut self,
+        client: u128,
+        q: &Question,
+        step: u32,
+        moves: u32,
+        rows: &mut Rows<'_>,
+        counters: &mut Counters,
+    ) -> u64 {
+        let engine = &mut self.scene;
+        let mut ctx = Ctx {
+            store: &self.store,
+            bp: &engine.broadphase,
+            cache: &mut self.cache,
+            workspace: &mut self.workspace,
+            client,
+            q,
+            group: &engine.group,
+            counters,
+        };
+        let mut hits = 0;
+        for (&m, look) in engine.group.members.iter().zip(&mut engine.lookahead) {
+            hits += advance::within_along(&mut ctx, look, m, step, moves, rows);
+        }
+        hits
     }
 
     /// Puts the objects a path moved back at their stored poses.

@@ -10,7 +10,7 @@
 //! by `dA + dB` holds the distance at the new poses.
 
 use gjkd_proto::{ErrorCode, ItemResult, Status};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Point3};
 
 use super::broadphase::{Entry, ROUND_OFF};
 use crate::cache::PairBound;
@@ -21,8 +21,21 @@ use crate::cache::PairBound;
 /// centroid, extent), which covers the round-off of the arithmetic here and
 /// of the rotation matrices the poses stand for.
 pub(crate) fn displacement(entry: &Entry, from: &Isometry3<f64>) -> f64 {
+    if entry.pose == *from {
+        return 0.0;
+    }
+    displacement_from(entry, from, &(from * entry.centre))
+}
+
+/// [`displacement`] from `from`, where the centroid was `from_centre`
+/// (computed as `from * entry.centre`).
+pub(crate) fn displacement_from(
+    entry: &Entry,
+    from: &Isometry3<f64>,
+    from_centre: &Point3<f64>,
+) -> f64 {
     let to = &entry.pose;
-    let moved = (to * entry.centre - from * entry.centre).norm();
+    let moved = (entry.world_centre - from_centre).norm();
     let relative = to.rotation * from.rotation.inverse();
     // |imaginary part| of a unit quaternion is sin(theta / 2), for either
     // sign of the quaternion.
@@ -46,7 +59,27 @@ pub(crate) struct Widened {
 
 /// `bound` widened to the index poses of `a` and `b`.
 pub(crate) fn widen(bound: &PairBound, a: &Entry, b: &Entry) -> Widened {
-    let d = displacement(a, &bound.pose_a) + displacement(b, &bound.pose_b);
+    widen_by(bound, moved_since(bound, a, b))
+}
+
+/// The largest distance any point of `a` or `b` can have moved from the
+/// poses of `bound` to their index poses, rounded up (the sum of both).
+pub(crate) fn moved_since(bound: &PairBound, a: &Entry, b: &Entry) -> f64 {
+    displacement(a, &bound.pose_a) + displacement(b, &bound.pose_b)
+}
+
+/// An upper bound on how far any point of an object moved between two
+/// steps of a path, from its [`Entry::travel`] `then` and `now`, after
+/// `moves` moves in all: the difference, plus the round-off of two sums of
+/// at most `moves` non-negative terms each.
+#[inline]
+pub(crate) fn travelled(now: f64, then: f64, moves: u32) -> f64 {
+    (now - then) * (1.0 + ROUND_OFF) + (2.0 * f64::from(moves) + 4.0) * f64::EPSILON * now
+}
+
+/// `bound` widened by `d`, an upper bound on how far any point of either
+/// object moved since.
+pub(crate) fn widen_by(bound: &PairBound, d: f64) -> Widened {
     let lower = (bound.lower - d) * (1.0 - ROUND_OFF);
     // Objects that overlapped by at least `penetration` and moved by less
     // still overlap: the distance is 0.
@@ -89,6 +122,22 @@ pub(crate) fn bounded_result(bound: &PairBound, w: &Widened, a: &Entry, b: &Entr
         iterations: 0,
         flags: 0,
         pieces: bound.pieces,
+    }
+}
+
+/// `bound` carried to the index poses of `a` and `b`, which it holds at
+/// widened by `d` ([`moved_since`]) to `w`: the interval `w`, the
+/// penetration left, the same points and normal in the bodies' frames.
+pub(crate) fn carried(bound: &PairBound, d: f64, w: &Widened, a: &Entry, b: &Entry) -> PairBound {
+    let left = (bound.penetration * (1.0 - ROUND_OFF) - d * (1.0 + ROUND_OFF)) * (1.0 - ROUND_OFF);
+    PairBound {
+        lower: w.lower,
+        upper: w.upper,
+        distance: bound.distance.clamp(w.lower, w.upper.max(w.lower)),
+        penetration: if left > 0.0 { left } else { 0.0 },
+        pose_a: a.pose,
+        pose_b: b.pose,
+        ..*bound
     }
 }
 

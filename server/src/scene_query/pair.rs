@@ -6,7 +6,9 @@ use gjkd_proto::{ErrorCode, ItemResult};
 
 use super::broadphase::Broadphase;
 use super::groups::Group;
-use super::motion_bound::{Widened, accepted, bound_of, bounded_result, widen};
+use super::motion_bound::{
+    Widened, accepted, bound_of, bounded_result, carried, moved_since, widen, widen_by,
+};
 use super::{Counters, Question};
 use crate::cache::{PairBound, PairKey, WarmCache};
 use crate::requests::run_pair;
@@ -90,33 +92,70 @@ impl Ctx<'_> {
 
     /// Settles the pair of slots `a`, `b` for `ask`.
     pub(crate) fn settle(&mut self, a: u32, b: u32, ask: Ask) -> Outcome {
+        self.settle_keeping(a, b, ask, None)
+    }
+
+    /// [`Ctx::settle`], also writing into `keep` the pair's motion bound
+    /// at the current poses (`None` without motion bounds): the answer GJK
+    /// kept, or the kept one carried here ([`carried`]).
+    pub(crate) fn settle_keeping(
+        &mut self,
+        a: u32,
+        b: u32,
+        ask: Ask,
+        keep: Option<&mut Option<PairBound>>,
+    ) -> Outcome {
         let q = self.q;
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
-        let mut decided = None;
-        if let Some((bound, w)) = self.widened(a, b) {
+        if q.motion
+            && let Some(bound) = self.cache.bound(&self.key(a, b))
+        {
+            let d = moved_since(bound, ea, eb);
+            let w = widen_by(bound, d);
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
                 Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
                 Ask::Below(best) => (w.lower >= best, ok),
                 Ask::BelowExactly(best) => (w.lower >= best, false),
             };
-            if ruled {
-                decided = Some(Outcome::Ruled);
+            let outcome = if ruled {
+                Some(Outcome::Ruled)
             } else if settled {
-                decided = Some(Outcome::Answer(bounded_result(bound, &w, ea, eb)));
+                Some(Outcome::Answer(bounded_result(bound, &w, ea, eb)))
+            } else {
+                None
+            };
+            if let Some(outcome) = outcome {
+                if let Some(keep) = keep {
+                    *keep = Some(carried(bound, d, &w, ea, eb));
+                }
+                self.counters.bounded += 1;
+                return outcome;
             }
         }
-        if let Some(outcome) = decided {
-            self.counters.bounded += 1;
-            return outcome;
-        }
         let warm = self.warm(a, b);
-        Outcome::Answer(self.run(a, b, ask, warm))
+        Outcome::Answer(self.run_keeping(a, b, ask, warm, keep))
     }
 
     /// Runs GJK on the pair of slots `a`, `b` (from `warm` if warm starts
     /// are on) and caches its simplex and, with motion bounds, its answer.
     pub(crate) fn run(&mut self, a: u32, b: u32, ask: Ask, warm: Option<WarmStart>) -> ItemResult {
+        self.run_keeping(a, b, ask, warm, None)
+    }
+
+    /// [`Ctx::run`], also writing into `keep` the motion bound it kept
+    /// (`None` if none).
+    fn run_keeping(
+        &mut self,
+        a: u32,
+        b: u32,
+        ask: Ask,
+        warm: Option<WarmStart>,
+        mut keep: Option<&mut Option<PairBound>>,
+    ) -> ItemResult {
+        if let Some(keep) = keep.as_deref_mut() {
+            *keep = None;
+        }
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         let (Some(oa), Some(ob)) = (self.store.object(ea.id), self.store.object(eb.id)) else {
             return ItemResult::error(ErrorCode::UnknownObject);
@@ -139,8 +178,11 @@ impl Ctx<'_> {
             Ok((result, next)) => {
                 let key = self.key(a, b);
                 if q.motion {
-                    self.cache
-                        .put_with_bound(key, next, bound_of(&result, ea, eb));
+                    let bound = bound_of(&result, ea, eb);
+                    self.cache.put_with_bound(key, next, bound);
+                    if let Some(keep) = keep {
+                        *keep = Some(bound);
+                    }
                 } else if q.warm {
                     self.cache.put(key, next);
                 }

@@ -69,6 +69,17 @@ int main(int argc, char **argv) {
         std::printf("unknown pair           %s\n", gjkd_error_code_name(out.error[5]));
         failures += out.error[5] != GJKD_CODE_UNKNOWN_OBJECT;
 
+        // The same pairs as rows, poses given per row: the fastest batch.
+        std::vector<gjkd::PairQuery> rows = {
+            gjkd::pair(box, ball),
+            gjkd::pair_at(box, gjkd::identity(), ball, gjkd::at(0, 0, -5)),
+            gjkd::pair(box, 0xdead)};
+        std::vector<gjkd::Result> answers;
+        client.query_pairs(rows, answers);
+        expect("rows box-sphere", answers[0].distance, 1.5);
+        expect("rows box-sphere below", answers[1].distance, 3.5);
+        failures += answers[2].error != GJKD_CODE_UNKNOWN_OBJECT;
+
         // One pair at a pose given for this query only.
         gjkd::Pose above = gjkd::at(0, 0, 4);
         expect("box-sphere above", client.distance(box, ball, nullptr, &above).distance, 2.5);

@@ -4,7 +4,8 @@
 // every failed call into a gjkd::Error carrying the gjkd_status, the
 // server's gjkd_error_code (for GJKD_ERR_REJECTED) and the message. Batches
 // take pointer + count, std::vector, or (C++20) std::span, and write into
-// a gjkd::Distances the caller keeps and reuses. Like the handle it wraps,
+// a gjkd::Distances the caller keeps and reuses, or (query_pairs(), the
+// fastest) read PairQuery rows and write Result rows. Like the handle it wraps,
 // a Client belongs to the thread that created it.
 //
 //   gjkd::Client client("gjkd");
@@ -39,6 +40,10 @@ using Pose = gjkd_pose;
 using Answer = gjkd_answer;
 /// Query options; start from default_options().
 using Options = gjkd_query_options;
+/// A row of Client::query_pairs(): a pair, and poses for this query only.
+using PairQuery = gjkd_pair_query;
+/// An answer row of Client::query_pairs() (`error` 0 when answered).
+using Result = gjkd_result;
 /// A convex shape (see sphere(), capsule(), box(), polytope()).
 using Shape = gjkd_shape;
 /// A piece of a compound: an offset and a convex shape.
@@ -81,6 +86,19 @@ inline Pose identity() { return Pose{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}}; }
 /// A translation by (x, y, z), no rotation.
 inline Pose at(double x, double y, double z) {
     return Pose{{x, y, z}, {0.0, 0.0, 0.0, 1.0}};
+}
+
+/// A row asking the distance of `a` and `b` at their stored poses.
+inline PairQuery pair(Id a, Id b) { return gjkd_pair_query_of(a, b); }
+
+/// A row asking the distance of `a` at `pose_a` and `b` at `pose_b`, for
+/// this query only.
+inline PairQuery pair_at(Id a, const Pose &pose_a, Id b, const Pose &pose_b) {
+    PairQuery q = gjkd_pair_query_of(a, b);
+    q.pose_a = pose_a;
+    q.pose_b = pose_b;
+    q.poses = GJKD_POSE_A | GJKD_POSE_B;
+    return q;
 }
 
 /// The default query options.
@@ -392,7 +410,32 @@ public:
         distances(ids, pairs.size(), out, nullptr, nullptr, options);
     }
 
+    /// The answers of `count` rows into `out[0..count)`: the fastest batch
+    /// (each row copied once each way). Rows that fail carry their code in
+    /// `error`.
+    void query_pairs(const PairQuery *queries, std::size_t count, Result *out,
+                     const Options *options = nullptr) {
+        check(gjkd_query_pairs(handle_, queries, count, options, out));
+    }
+    /// The answers of `queries` into `out`, resized to match (allocates
+    /// only when growing).
+    void query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out,
+                     const Options *options = nullptr) {
+        if (out.size() != queries.size()) out.resize(queries.size());
+        query_pairs(queries.data(), queries.size(), out.data(), options);
+    }
+
 #ifdef GJKD_HAS_SPAN
+    /// The answers of `queries` into `out`, which must be as long (C++20).
+    void query_pairs(std::span<const PairQuery> queries, std::span<Result> out,
+                     const Options *options = nullptr) {
+        if (out.size() != queries.size()) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "query_pairs: " + std::to_string(out.size()) + " result rows for " +
+                            std::to_string(queries.size()) + " queries");
+        }
+        query_pairs(queries.data(), queries.size(), out.data(), options);
+    }
     /// Stores poses[i] for ids[i] (C++20).
     void set_poses(std::span<const Id> ids, std::span<const Pose> poses) {
         same_size(ids.size(), poses.size());

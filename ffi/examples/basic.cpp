@@ -105,6 +105,17 @@ int main(int argc, char **argv) {
         expect("rod hanging", client.distance(pendulum.link("rod"), floor_ball).distance, 1.5);
         client.set_joints(pendulum, {std::acos(0.0)});
         expect("rod swung level", client.distance(pendulum.link("rod"), floor_ball).distance, 2.4);
+        // The swing back as a candidate motion: the clearance at each step
+        // of joint positions, nothing moved on the server.
+        gjkd::Group arm;
+        arm.id = pendulum.id();
+        std::vector<gjkd::SceneRow> steps(4);
+        gjkd::SceneSummary swing = client.path_joints(arm, GJKD_PATH_CLEARANCE, 0.0, pendulum,
+                                                      {std::acos(0.0), 0.0}, steps);
+        failures += swing.steps != 2 || swing.written != 2;
+        expect("path: level", steps[0].answer.distance, 2.4);
+        expect("path: hanging", steps[1].answer.distance, 1.5);
+        expect("rod still level", client.distance(pendulum.link("rod"), floor_ball).distance, 2.4);
         std::remove(urdf.c_str());
 
         // A refused call throws, with the status, the server's code and words.

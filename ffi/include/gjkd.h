@@ -1293,6 +1293,39 @@ enum gjkd_status gjkd_path(struct gjkd_client *client,
                            size_t capacity,
                            struct gjkd_scene_summary *summary);
 
+// `gjkd_path()` along a motion given as joint positions of `robot`:
+// `positions` holds `step_count` steps of the robot's moving joints
+// (`dof` doubles each, in `gjkd_robot_joint()` order), `positions[s * dof
+// + j]` joint `j` at step `s`. The server places the links by forward
+// kinematics at each step and answers there; nothing moves on the server
+// (the robot's stored joints and link poses stay as they were). A position
+// outside its limits is refused, or moved to the nearest limit when
+// `options->clamp` is true. The group is usually the robot itself
+// (`group->id` its id, so that its allowed pairs apply).
+//
+// Errors: as `gjkd_path()` (`GJKD_ERR_NULL_POINTER` for `positions` and
+// `robot`), plus `GJKD_ERR_INVALID_ARGUMENT` for a robot without moving
+// joints, no step, or a position NaN or infinite (last error code
+// `GJKD_CODE_NON_FINITE_POSE`) or outside its limits without clamp
+// (`GJKD_CODE_OUT_OF_LIMITS`), the message naming the step and joint:
+// nothing is sent; `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`
+// when the robot is gone from the server.
+//
+// # Safety
+// As `gjkd_clearance()`; `robot` NULL or live; `positions` NULL or
+// `step_count * dof` doubles.
+enum gjkd_status gjkd_path_joints(struct gjkd_client *client,
+                                  const struct gjkd_group *group,
+                                  uint32_t question,
+                                  double margin,
+                                  const struct gjkd_robot *robot,
+                                  const double *positions,
+                                  size_t step_count,
+                                  const struct gjkd_scene_options *options,
+                                  struct gjkd_scene_row *rows,
+                                  size_t capacity,
+                                  struct gjkd_scene_summary *summary);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

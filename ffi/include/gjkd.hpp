@@ -505,6 +505,29 @@ public:
         return s;
     }
 
+    /// `question` at every step of a motion of `robot` given as joint
+    /// positions: `positions` holds `positions.size() / robot.dof()` steps
+    /// of `dof` positions each (in Robot::joint_names() order). Nothing
+    /// moves on the server; `options->clamp` clamps positions outside
+    /// their limits instead of throwing.
+    SceneSummary path_joints(const Group &group, gjkd_path_question question, double margin,
+                             const Robot &robot, const std::vector<double> &positions,
+                             std::vector<SceneRow> &rows, const SceneOptions *options = nullptr) {
+        const std::size_t dof = robot.dof();
+        if (dof == 0 || positions.size() % dof != 0) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "path_joints: " + std::to_string(positions.size()) +
+                            " positions are no whole number of steps of " +
+                            std::to_string(dof) + " joints");
+        }
+        SceneSummary s{};
+        const gjkd_group g = group.view();
+        check(gjkd_path_joints(handle_, &g, static_cast<uint32_t>(question), margin,
+                               robot.native_handle(), positions.data(), positions.size() / dof,
+                               options, rows.data(), rows.size(), &s));
+        return s;
+    }
+
 private:
     static void same_size(std::size_t a, std::size_t b) {
         if (a != b) {

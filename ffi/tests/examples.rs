@@ -40,10 +40,13 @@ fn cpp_example_answers_match_the_analytic_distances() {
     let stdout = common::run_ok(&exe, &[&server.service]);
     assert_answers(&stdout);
     assert!(stdout.contains("lookup gives the id    1.0"), "{stdout}");
-    assert!(
-        stdout.contains("rows box-sphere below  3.500000000000"),
-        "{stdout}"
-    );
+    for line in [
+        "rows box-sphere below  3.500000000000",
+        "path: hanging          1.500000000000",
+        "rod still level        2.400000000000",
+    ] {
+        assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
+    }
 }
 
 #[test]

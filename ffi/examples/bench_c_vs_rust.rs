@@ -391,12 +391,15 @@ impl Drop for InProcessC {
     }
 }
 
+/// One batch through a C entry point.
+type BatchCall = fn(&mut InProcessC);
+
 /// `batches` adjacent pairs of batches, C and Rust, their order
 /// alternating: (C median, Rust median, median of the pairs' ratios, C p10,
 /// Rust p10), in ns per pair.
 fn interleaved(
     c: &mut InProcessC,
-    call: fn(&mut InProcessC),
+    call: BatchCall,
     rust: &mut RustSide,
     batches: usize,
 ) -> [f64; 5] {
@@ -532,7 +535,7 @@ fn main() {
         median(&mut arrays_ratios)
     );
     let mut in_process = InProcessC::new(&service, &rows);
-    let calls: [(&str, fn(&mut InProcessC)); 2] = [
+    let calls: [(&str, BatchCall); 2] = [
         ("gjkd_query_pairs", InProcessC::rows),
         ("gjkd_distances", InProcessC::batch),
     ];

@@ -117,17 +117,17 @@ int main(int argc, char **argv) {
     gjkd_pair_query *queries = malloc(n * sizeof *queries);
     gjkd_result *results = malloc(n * sizeof *results);
     for (size_t i = 0; i < n; i++) {
-        queries[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1]);
+        queries[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1], NULL);
         queries[i].pose_a = poses_a[i];
         queries[i].pose_b = poses_b[i];
-        queries[i].poses = GJKD_POSE_A | GJKD_POSE_B;
+        queries[i].flags |= GJKD_POSE_A | GJKD_POSE_B;
     }
     for (size_t k = 0; k < 20; k++) {
-        must(gjkd_query_pairs(c, queries, n, NULL, results), "warm-up rows");
+        must(gjkd_query_pairs(c, queries, n, results), "warm-up rows");
     }
     for (size_t k = 0; k < batches; k++) {
         double start = now_ns();
-        gjkd_status s = gjkd_query_pairs(c, queries, n, NULL, results);
+        gjkd_status s = gjkd_query_pairs(c, queries, n, results);
         t[k] = (now_ns() - start) / (double)n;
         must(s, "query_pairs");
     }

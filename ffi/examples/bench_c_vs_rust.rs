@@ -276,6 +276,9 @@ struct InProcessC {
     queries: Vec<gjkd_c::gjkd_pair_query>,
     /// Its answers.
     results: Vec<gjkd_c::gjkd_result>,
+    /// The same queries as Rust items, for the Rust client to ask of the
+    /// same objects.
+    twin_items: Vec<Item>,
 }
 
 impl InProcessC {
@@ -309,20 +312,38 @@ impl InProcessC {
                 }
             }
         }
-        let queries = pairs
+        let queries: Vec<gjkd_pair_query> = pairs
             .chunks(2)
             .zip(rows)
-            .map(|(ab, r)| gjkd_pair_query {
-                pose_a: pose(&r[6..13]),
-                pose_b: pose(&r[13..20]),
-                poses: GJKD_POSE_A | GJKD_POSE_B,
-                ..gjkd_pair_query_of(ab[0], ab[1])
+            .map(|(ab, r)| {
+                // SAFETY: NULL options.
+                let row = unsafe { gjkd_pair_query_of(ab[0], ab[1], std::ptr::null()) };
+                gjkd_pair_query {
+                    pose_a: pose(&r[6..13]),
+                    pose_b: pose(&r[13..20]),
+                    flags: row.flags | GJKD_POSE_A | GJKD_POSE_B,
+                    ..row
+                }
+            })
+            .collect();
+        let twin_items = pairs
+            .chunks(2)
+            .zip(rows)
+            .map(|(ab, r)| {
+                Item::distance_at(
+                    ObjectId::from_raw(ab[0]),
+                    &isometry(&r[6..13]),
+                    ObjectId::from_raw(ab[1]),
+                    &isometry(&r[13..20]),
+                    &QueryOptions::default(),
+                )
             })
             .collect();
         InProcessC {
             client,
             pairs,
             queries,
+            twin_items,
             results: vec![gjkd_result::default(); n],
             poses_a: rows.iter().map(|r| pose(&r[6..13])).collect(),
             poses_b: rows.iter().map(|r| pose(&r[13..20])).collect(),
@@ -376,7 +397,6 @@ impl InProcessC {
                 self.client,
                 self.queries.as_ptr(),
                 self.queries.len(),
-                std::ptr::null(),
                 self.results.as_mut_ptr(),
             )
         };
@@ -401,13 +421,14 @@ fn interleaved(
     c: &mut InProcessC,
     call: BatchCall,
     rust: &mut RustSide,
+    items: &[Item],
     batches: usize,
 ) -> [f64; 5] {
-    let per = rust.items.len() as f64;
+    let per = items.len() as f64;
     for _ in 0..20 {
         call(c);
         rust.client
-            .query_batch(&rust.items, &mut rust.results)
+            .query_batch(items, &mut rust.results)
             .expect("warm-up");
     }
     let (mut tc, mut tr, mut ratio) = (vec![], vec![], vec![]);
@@ -419,7 +440,7 @@ fn interleaved(
         };
         let mut time_rust = || {
             let start = Instant::now();
-            let r = rust.client.query_batch(&rust.items, &mut rust.results);
+            let r = rust.client.query_batch(items, &mut rust.results);
             let ns = start.elapsed().as_nanos() as f64 / per;
             r.expect("batch");
             ns
@@ -535,17 +556,38 @@ fn main() {
         median(&mut arrays_ratios)
     );
     let mut in_process = InProcessC::new(&service, &rows);
-    let calls: [(&str, BatchCall); 2] = [
-        ("gjkd_query_pairs", InProcessC::rows),
-        ("gjkd_distances", InProcessC::batch),
+    // Like with like: the Rust client asks the same objects (the server's
+    // time differs from one set of objects to another), with its items
+    // built once, as the C rows are.
+    let twin = in_process.twin_items.clone();
+    let own = rust.items.clone();
+    let runs: [(&str, BatchCall, &[Item], &str); 3] = [
+        (
+            "gjkd_query_pairs",
+            InProcessC::rows,
+            &twin,
+            "the same objects",
+        ),
+        (
+            "gjkd_distances",
+            InProcessC::batch,
+            &twin,
+            "the same objects",
+        ),
+        (
+            "gjkd_query_pairs",
+            InProcessC::rows,
+            &own,
+            "Rust's own objects",
+        ),
     ];
-    for (name, call) in calls {
+    for (name, call, items, whose) in runs {
         let [c, r, ratio, c10, r10] =
-            interleaved(&mut in_process, call, &mut rust, batches * rounds);
+            interleaved(&mut in_process, call, &mut rust, items, batches * rounds);
         println!(
-            "in process, {name}, {} adjacent batch pairs: C {c:.1} ns/pair, Rust {r:.1} \
-             (p10 {c10:.1}, {r10:.1}); C / Rust = {:.3}, median of the pairs' ratios \
-             {ratio:.3}, of the p10s {:.3}",
+            "in process, {name} beside Rust on {whose}, {} adjacent batch pairs: C {c:.1} \
+             ns/pair, Rust {r:.1} (p10 {c10:.1}, {r10:.1}); C / Rust = {:.3}, median of \
+             the pairs' ratios {ratio:.3}, of the p10s {:.3}",
             batches * rounds,
             c / r,
             c10 / r10

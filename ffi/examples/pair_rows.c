@@ -53,28 +53,28 @@ int main(int argc, char **argv) {
     check(gjkd_register_capsule(client, end_a, end_b, 0.25, NULL, NULL, &rod),
           "register capsule");
 
-    /* The rows, built once. Start from gjkd_pair_query_of() (stored poses),
+    /* The rows, built once. Start from gjkd_pair_query_of(, NULL) (stored poses),
      * then give a pose and set its bit where this query has its own. */
     enum { N = 5 };
     gjkd_pair_query rows[N];
-    rows[0] = gjkd_pair_query_of(box, ball); /* ball at x = 3 */
+    rows[0] = gjkd_pair_query_of(box, ball, NULL); /* ball at x = 3 */
     rows[0].pose_b = at(3, 0, 0);
-    rows[0].poses = GJKD_POSE_B;
-    rows[1] = gjkd_pair_query_of(box, ball); /* both given: box lifted to z = 10 */
+    rows[0].flags |= GJKD_POSE_B;
+    rows[1] = gjkd_pair_query_of(box, ball, NULL); /* both given: box lifted to z = 10 */
     rows[1].pose_a = at(0, 0, 10);
     rows[1].pose_b = at(0, 0, 0);
-    rows[1].poses = GJKD_POSE_A | GJKD_POSE_B;
-    rows[2] = gjkd_pair_query_of(box, rod); /* rod at y = 5 */
+    rows[1].flags |= GJKD_POSE_A | GJKD_POSE_B;
+    rows[2] = gjkd_pair_query_of(box, rod, NULL); /* rod at y = 5 */
     rows[2].pose_b = at(0, 5, 0);
-    rows[2].poses = GJKD_POSE_B;
-    rows[3] = gjkd_pair_query_of(ball, rod); /* ball at x = -4, rod at the origin */
+    rows[2].flags |= GJKD_POSE_B;
+    rows[3] = gjkd_pair_query_of(ball, rod, NULL); /* ball at x = -4, rod at the origin */
     rows[3].pose_a = at(-4, 0, 0);
     rows[3].pose_b = at(0, 0, 0);
-    rows[3].poses = GJKD_POSE_A | GJKD_POSE_B;
-    rows[4] = gjkd_pair_query_of(box, 0xdead); /* an id no server gave out */
+    rows[3].flags |= GJKD_POSE_A | GJKD_POSE_B;
+    rows[4] = gjkd_pair_query_of(box, 0xdead, NULL); /* an id no server gave out */
 
     gjkd_result out[N];
-    check(gjkd_query_pairs(client, rows, N, NULL, out), "gjkd_query_pairs");
+    check(gjkd_query_pairs(client, rows, N, out), "gjkd_query_pairs");
     const double want[N - 1] = {1.5, 8.5, 2.75, 3.25};
     const char *names[N - 1] = {"box-sphere", "box lifted-sphere", "box-capsule",
                                 "sphere-capsule"};
@@ -98,7 +98,7 @@ int main(int argc, char **argv) {
      * second and later steps start warm from the pair's last simplex. */
     for (int step = 1; step <= 3; step++) {
         rows[0].pose_b.translation[0] = 3.0 + step;
-        check(gjkd_query_pairs(client, rows, 1, NULL, out), "gjkd_query_pairs");
+        check(gjkd_query_pairs(client, rows, 1, out), "gjkd_query_pairs");
         char what[32];
         snprintf(what, sizeof what, "ball at x = %d", 3 + step);
         expect(what, out[0].distance, 1.5 + step);
@@ -107,8 +107,8 @@ int main(int argc, char **argv) {
            out[0].flags & GJKD_RESULT_WARM_STARTED ? "yes" : "no");
 
     /* A row with bits the API does not define is refused, nothing sent. */
-    rows[0].poses = 4;
-    gjkd_status s = gjkd_query_pairs(client, rows, N, NULL, out);
+    rows[0].flags |= 1u << 5;
+    gjkd_status s = gjkd_query_pairs(client, rows, N, out);
     printf("undefined pose bit: %s: %s\n", gjkd_status_name(s), gjkd_last_error());
     failures += s != GJKD_ERR_INVALID_ARGUMENT;
 

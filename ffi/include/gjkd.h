@@ -38,11 +38,11 @@
 // Longest object name, in bytes of UTF-8 (not counting the NUL).
 #define GJKD_MAX_NAME_LEN 64
 
-// `gjkd_pair_query::poses` bit: this row's `pose_a` replaces the stored
+// `gjkd_pair_query::flags` bit: this row's `pose_a` replaces the stored
 // pose of `a`, for this query only.
 #define GJKD_POSE_A 1
 
-// `gjkd_pair_query::poses` bit: this row's `pose_b` replaces the stored
+// `gjkd_pair_query::flags` bit: this row's `pose_b` replaces the stored
 // pose of `b`, for this query only.
 #define GJKD_POSE_B 2
 
@@ -463,21 +463,33 @@ typedef struct gjkd_results {
   bool *warm_started;
 } gjkd_results;
 
-// One pair of a `gjkd_query_pairs()` batch. Zero it (or start from
-// `gjkd_pair_query_of()`), then set the ids and, for a pose given for this
-// query only, the pose and its bit in `poses`.
+// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
+// server reads (so a batch of rows is copied into it in one piece). Make
+// it with `gjkd_pair_query_of()`, which sets `kind` and the options'
+// fields; then, for a pose given for this query only, set the pose and OR
+// its bit into `flags` (`row.flags |= GJKD_POSE_B`). Keep the rows from
+// call to call and rewrite only the poses that move.
 typedef struct gjkd_pair_query {
+  // What the row asks: set by `gjkd_pair_query_of()`, not to be changed.
+  uint32_t kind;
+  // `GJKD_POSE_A` and `GJKD_POSE_B`, ORed into the bits
+  // `gjkd_pair_query_of()` set from the options (keep those).
+  uint32_t flags;
   // Object A.
   gjkd_id a;
   // Object B.
   gjkd_id b;
-  // The pose of A for this query, used when `poses` has `GJKD_POSE_A`.
+  // The pose of A for this query, used when `flags` has `GJKD_POSE_A`
+  // (the stored pose is then neither used nor changed).
   struct gjkd_pose pose_a;
-  // The pose of B for this query, used when `poses` has `GJKD_POSE_B`.
+  // The pose of B for this query, used when `flags` has `GJKD_POSE_B`.
   struct gjkd_pose pose_b;
-  // `GJKD_POSE_A | GJKD_POSE_B` bits; 0: both at their stored poses
-  // (which are neither used nor changed for a pose given here).
-  uint32_t poses;
+  // The options' tolerance.
+  double tolerance;
+  // The options' margin.
+  double margin;
+  // The options' iteration cap.
+  uint32_t max_iterations;
   // Zero.
   uint32_t reserved;
 } gjkd_pair_query;
@@ -1171,35 +1183,42 @@ enum gjkd_status gjkd_robot_link_poses(const struct gjkd_robot *robot,
                                        struct gjkd_pose *out_poses,
                                        size_t out_count);
 
-// A row asking the distance of `a` and `b` at their stored poses.
-struct gjkd_pair_query gjkd_pair_query_of(gjkd_id a, gjkd_id b);
+// A row asking the distance of `a` and `b` at their stored poses, with
+// `options` (NULL: the defaults). Options out of their domain (see
+// `gjkd_query_options`) make the row fail alone, with
+// `GJKD_CODE_INVALID_OPTIONS` in its result.
+//
+// # Safety
+// `options` is NULL or readable.
+struct gjkd_pair_query gjkd_pair_query_of(gjkd_id a,
+                                          gjkd_id b,
+                                          const struct gjkd_query_options *options);
 
 // The distances of `count` pairs in one call: `queries[i]` in, its answer
-// into `out[i]`. The fastest batch of this API: each row is copied once
-// into the request's shared memory, and the answers once, whole, from the
-// response's into `out`. `options` (NULL: the defaults) is the same for
-// every pair.
+// into `out[i]`. The fastest batch of this API: the rows are copied into
+// the request's shared memory in one piece, and the answers, whole, from
+// the response's into `out`, as the Rust client does with its items.
 //
-// A pair that fails (an unknown id, a bad pose given in its row) has its
-// `gjkd_error_code` in `out[i].error`, zeros elsewhere, and the other
-// pairs are answered: the call still returns `GJKD_OK`. Batches larger
-// than the server takes are split. A count of 0 does nothing (`queries`
-// and `out` may then be NULL).
+// A pair that fails (an unknown id, a bad pose given in its row, bad
+// options) has its `gjkd_error_code` in `out[i].error`, zeros elsewhere,
+// and the other pairs are answered: the call still returns `GJKD_OK`.
+// Batches larger than the server takes are split. A count of 0 does
+// nothing (`queries` and `out` may then be NULL).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `queries`, `out`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (bad options, a
-// count larger than any array, a row whose `poses` has bits other than
-// `GJKD_POSE_A | GJKD_POSE_B` or whose `reserved` is not 0: nothing is
-// sent); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks
-// answered before are written, the others left as they were).
+// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
+// than any array; a row not made by `gjkd_pair_query_of()`, or whose
+// `flags` has bits other than those it set and `GJKD_POSE_A |
+// GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);
+// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks answered
+// before are written, the others left as they were).
 //
 // # Safety
 // `client` is NULL or a live handle; `queries` NULL or `count` readable
-// rows; `out` NULL or `count` writable rows; `options` NULL or readable.
+// rows; `out` NULL or `count` writable rows.
 enum gjkd_status gjkd_query_pairs(struct gjkd_client *client,
                                   const struct gjkd_pair_query *queries,
                                   size_t count,
-                                  const struct gjkd_query_options *options,
                                   struct gjkd_result *out);
 
 // The default scene options: default tolerance and iteration cap, warm

@@ -89,15 +89,18 @@ inline Pose at(double x, double y, double z) {
 }
 
 /// A row asking the distance of `a` and `b` at their stored poses.
-inline PairQuery pair(Id a, Id b) { return gjkd_pair_query_of(a, b); }
+inline PairQuery pair(Id a, Id b, const Options *options = nullptr) {
+    return gjkd_pair_query_of(a, b, options);
+}
 
 /// A row asking the distance of `a` at `pose_a` and `b` at `pose_b`, for
 /// this query only.
-inline PairQuery pair_at(Id a, const Pose &pose_a, Id b, const Pose &pose_b) {
-    PairQuery q = gjkd_pair_query_of(a, b);
+inline PairQuery pair_at(Id a, const Pose &pose_a, Id b, const Pose &pose_b,
+                         const Options *options = nullptr) {
+    PairQuery q = gjkd_pair_query_of(a, b, options);
     q.pose_a = pose_a;
     q.pose_b = pose_b;
-    q.poses = GJKD_POSE_A | GJKD_POSE_B;
+    q.flags |= GJKD_POSE_A | GJKD_POSE_B;
     return q;
 }
 
@@ -410,31 +413,28 @@ public:
         distances(ids, pairs.size(), out, nullptr, nullptr, options);
     }
 
-    /// The answers of `count` rows into `out[0..count)`: the fastest batch
-    /// (each row copied once each way). Rows that fail carry their code in
-    /// `error`.
-    void query_pairs(const PairQuery *queries, std::size_t count, Result *out,
-                     const Options *options = nullptr) {
-        check(gjkd_query_pairs(handle_, queries, count, options, out));
+    /// The answers of `count` rows (made by pair() or pair_at(), which
+    /// take the options) into `out[0..count)`: the fastest batch, copied in
+    /// one piece each way. Rows that fail carry their code in `error`.
+    void query_pairs(const PairQuery *queries, std::size_t count, Result *out) {
+        check(gjkd_query_pairs(handle_, queries, count, out));
     }
     /// The answers of `queries` into `out`, resized to match (allocates
     /// only when growing).
-    void query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out,
-                     const Options *options = nullptr) {
+    void query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out) {
         if (out.size() != queries.size()) out.resize(queries.size());
-        query_pairs(queries.data(), queries.size(), out.data(), options);
+        query_pairs(queries.data(), queries.size(), out.data());
     }
 
 #ifdef GJKD_HAS_SPAN
     /// The answers of `queries` into `out`, which must be as long (C++20).
-    void query_pairs(std::span<const PairQuery> queries, std::span<Result> out,
-                     const Options *options = nullptr) {
+    void query_pairs(std::span<const PairQuery> queries, std::span<Result> out) {
         if (out.size() != queries.size()) {
             throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
                         "query_pairs: " + std::to_string(out.size()) + " result rows for " +
                             std::to_string(queries.size()) + " queries");
         }
-        query_pairs(queries.data(), queries.size(), out.data(), options);
+        query_pairs(queries.data(), queries.size(), out.data());
     }
     /// Stores poses[i] for ids[i] (C++20).
     void set_poses(std::span<const Id> ids, std::span<const Pose> poses) {

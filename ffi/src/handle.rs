@@ -84,6 +84,32 @@ impl gjkd_client {
     }
 }
 
+impl gjkd_client {
+    /// Sends `items` in chunks the server takes, each copied into the
+    /// request in one piece, and copies each chunk's results, whole, into
+    /// the same rows of `out` (as long as `items`).
+    ///
+    /// # Errors
+    /// The first whole-request failure; chunks before it were answered.
+    pub fn run_slices(&mut self, items: &[Item], out: &mut [ItemResult]) -> Result<(), Failure> {
+        let mut start = 0;
+        while start < items.len() {
+            let max = self.max_batch();
+            let end = items.len().min(start + max);
+            let chunk = self
+                .client
+                .query_batch(&items[start..end], &mut out[start..end]);
+            match chunk {
+                Ok(()) => start = end,
+                // As in `run`.
+                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Whether the calling thread is the handle's `owner`.
 fn check_thread(owner: u64) -> Result<(), Failure> {
     if owner == thread_token() {

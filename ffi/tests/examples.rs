@@ -62,7 +62,7 @@ fn pair_rows_example_answers_match_the_analytic_distances() {
         "box-sphere point_b.x   2.500000000000",
         "ball at x = 6          4.500000000000",
         "unknown pair           GJKD_CODE_UNKNOWN_OBJECT",
-        "undefined pose bit: GJKD_ERR_INVALID_ARGUMENT: gjkd_query_pairs: queries[0]: poses 0x4",
+        "undefined pose bit: GJKD_ERR_INVALID_ARGUMENT: gjkd_query_pairs: queries[0]: flags 0x2a",
     ] {
         assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
     }

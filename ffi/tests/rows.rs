@@ -1,6 +1,7 @@
 //! `gjkd_query_pairs`, the batch of rows: analytic distances and points,
-//! the Rust client's answers bit for bit over several chunks, per-row
-//! failures, and every whole-call error path changing nothing.
+//! rows equal to the Rust client's items and answers equal to its answers,
+//! bit for bit, over several chunks; per-row failures (poses, options);
+//! every whole-call error path changing nothing.
 
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
@@ -82,16 +83,22 @@ fn box_and_ball(c: *mut gjkd_client) -> (gjkd_id, gjkd_id) {
     (b, s)
 }
 
-fn query(
-    c: *mut gjkd_client,
-    rows: &[gjkd_pair_query],
-    options: Option<&gjkd_query_options>,
-    out: &mut [gjkd_result],
-) -> gjkd_status {
+/// A row of `a` and `b` at their stored poses, default options.
+fn base(a: gjkd_id, b: gjkd_id) -> gjkd_pair_query {
+    // SAFETY: NULL options.
+    unsafe { gjkd_pair_query_of(a, b, null()) }
+}
+
+/// A row of `a` and `b` with `options`.
+fn with_options(a: gjkd_id, b: gjkd_id, options: &gjkd_query_options) -> gjkd_pair_query {
+    // SAFETY: readable options.
+    unsafe { gjkd_pair_query_of(a, b, options) }
+}
+
+fn query(c: *mut gjkd_client, rows: &[gjkd_pair_query], out: &mut [gjkd_result]) -> gjkd_status {
     assert!(out.len() >= rows.len());
-    let options = options.map_or(null(), |o| o as *const _);
     // SAFETY: `out` has a row per query.
-    unsafe { gjkd_query_pairs(c, rows.as_ptr(), rows.len(), options, out.as_mut_ptr()) }
+    unsafe { gjkd_query_pairs(c, rows.as_ptr(), rows.len(), out.as_mut_ptr()) }
 }
 
 #[test]
@@ -99,35 +106,35 @@ fn rows_answer_the_analytic_distances_and_points() {
     let server = Server::start("ffi-rows-analytic", &["--no-persist"]);
     let c = connect(&server);
     let (cube, ball) = box_and_ball(c);
-    let mut rows = vec![gjkd_pair_query_of(cube, ball)];
+    let mut rows = vec![base(cube, ball)];
     // Ball given at y = 4: 4 - 1 - 0.5 apart, along +y.
     rows.push(gjkd_pair_query {
         pose_b: at(0.0, 4.0, 0.0),
-        poses: GJKD_POSE_B,
-        ..gjkd_pair_query_of(cube, ball)
+        flags: base(cube, ball).flags | GJKD_POSE_B,
+        ..base(cube, ball)
     });
     // Box given turned by 45 degrees about z: its corner reaches sqrt(2)
     // along x, the stored ball is 3 - sqrt(2) - 0.5 away.
     rows.push(gjkd_pair_query {
         pose_a: turned(0.0, 0.0, 0.0, std::f64::consts::FRAC_PI_4),
-        poses: GJKD_POSE_A,
-        ..gjkd_pair_query_of(cube, ball)
+        flags: base(cube, ball).flags | GJKD_POSE_A,
+        ..base(cube, ball)
     });
     // Both given: box at z = -10, ball at z = 2 (-10 + 1 .. 2 - 0.5).
     rows.push(gjkd_pair_query {
         pose_a: at(0.0, 0.0, -10.0),
         pose_b: at(0.0, 0.0, 2.0),
-        poses: GJKD_POSE_A | GJKD_POSE_B,
-        ..gjkd_pair_query_of(cube, ball)
+        flags: base(cube, ball).flags | GJKD_POSE_A | GJKD_POSE_B,
+        ..base(cube, ball)
     });
     // Ball given inside the box: they overlap, the distance is 0.
     rows.push(gjkd_pair_query {
         pose_b: at(0.25, 0.0, 0.0),
-        poses: GJKD_POSE_B,
-        ..gjkd_pair_query_of(cube, ball)
+        flags: base(cube, ball).flags | GJKD_POSE_B,
+        ..base(cube, ball)
     });
     let mut out = vec![gjkd_result::default(); rows.len()];
-    ok(query(c, &rows, None, &mut out));
+    ok(query(c, &rows, &mut out));
     let want = [1.5, 2.5, 2.5 - 2f64.sqrt(), 10.5, 0.0];
     for (i, (r, w)) in out.iter().zip(want).enumerate() {
         assert_eq!(r.error, GJKD_CODE_OK as u32, "row {i}");
@@ -149,7 +156,7 @@ fn rows_answer_the_analytic_distances_and_points() {
     }
     // The stored poses were not changed by the rows' own.
     let mut again = [gjkd_result::default()];
-    ok(query(c, &rows[..1], None, &mut again));
+    ok(query(c, &rows[..1], &mut again));
     assert!((again[0].distance - 1.5).abs() <= 1e-9);
     assert_ne!(
         again[0].flags & GJKD_RESULT_WARM_STARTED,
@@ -168,6 +175,8 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
     let (cube, ball) = box_and_ball(c);
     let mut rust = server.client(std::time::Duration::from_secs(2));
     let cold = QueryOptions::cold();
+    let mut options = gjkd_query_options_default();
+    options.warm_start = false;
     let (mut rows, mut items) = (Vec::new(), Vec::new());
     let (oc, ob) = (ObjectId::from_raw(cube), ObjectId::from_raw(ball));
     for i in 0..4 * MAX_BATCH + 2 {
@@ -176,11 +185,12 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
         let pb = turned(3.0 + 0.2 * f, 0.4 * f, -0.1 * f, -0.2 * f);
         // Rows alternate between given and stored poses.
         let poses = (i % 4) as u32;
+        let row = with_options(cube, ball, &options);
         rows.push(gjkd_pair_query {
             pose_a: pa,
             pose_b: pb,
-            poses,
-            ..gjkd_pair_query_of(cube, ball)
+            flags: row.flags | poses,
+            ..row
         });
         let mut item = Item::distance(oc, ob, &cold);
         if poses & GJKD_POSE_A != 0 {
@@ -194,7 +204,7 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
         items.push(item);
     }
     // An id no server gave out fails alone, in its row.
-    rows.push(gjkd_pair_query_of(cube, 0xdead));
+    rows.push(with_options(cube, 0xdead, &options));
     items.push(Item::distance(oc, ObjectId::from_raw(0xdead), &cold));
     let n = rows.len();
     let mut want = vec![ItemResult::default(); n];
@@ -203,10 +213,34 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
         rust.query_batch(&items[chunk..end], &mut want[chunk..end])
             .expect("the Rust client answers");
     }
-    let mut options = gjkd_query_options_default();
-    options.warm_start = false;
+    // The rows are the Rust items, bit for bit (a pose whose bit is not
+    // set is not read).
+    for (row, item) in rows.iter().zip(&items) {
+        assert_eq!(
+            (row.kind, row.flags, row.a, row.b),
+            (item.kind, item.flags, item.a, item.b)
+        );
+        if row.flags & GJKD_POSE_A != 0 {
+            assert_eq!(row.pose_a.wire(), item.pose_a);
+        }
+        if row.flags & GJKD_POSE_B != 0 {
+            assert_eq!(row.pose_b.wire(), item.pose_b);
+        }
+        assert_eq!(
+            (
+                row.tolerance.to_bits(),
+                row.margin.to_bits(),
+                row.max_iterations
+            ),
+            (
+                item.tolerance.to_bits(),
+                item.margin.to_bits(),
+                item.max_iterations
+            )
+        );
+    }
     let mut out = vec![gjkd_result::default(); n];
-    ok(query(c, &rows, Some(&options), &mut out));
+    ok(query(c, &rows, &mut out));
     for (i, (got, want)) in out.iter().zip(&want).enumerate() {
         let bits = |r: &gjkd_result| {
             let mut v = vec![r.distance, r.lower, r.upper, r.penetration];
@@ -258,26 +292,45 @@ fn bad_poses_in_a_row_fail_that_row_alone() {
     let rows = [
         gjkd_pair_query {
             pose_b: crooked,
-            poses: GJKD_POSE_B,
-            ..gjkd_pair_query_of(cube, ball)
+            flags: base(cube, ball).flags | GJKD_POSE_B,
+            ..base(cube, ball)
         },
         gjkd_pair_query {
             pose_a: nan,
-            poses: GJKD_POSE_A,
-            ..gjkd_pair_query_of(cube, ball)
+            flags: base(cube, ball).flags | GJKD_POSE_A,
+            ..base(cube, ball)
         },
         // A bad pose whose bit is not set is not used.
         gjkd_pair_query {
             pose_a: nan,
-            ..gjkd_pair_query_of(cube, ball)
+            ..base(cube, ball)
         },
     ];
     let mut out = [gjkd_result::default(); 3];
-    ok(query(c, &rows, None, &mut out));
+    ok(query(c, &rows, &mut out));
     assert_eq!(out[0].error, GJKD_CODE_BAD_QUATERNION as u32);
     assert_eq!(out[1].error, GJKD_CODE_NON_FINITE_POSE as u32);
     assert_eq!(out[2].error, GJKD_CODE_OK as u32);
     assert!((out[2].distance - 1.5).abs() <= 1e-9);
+    // Bad options fail their rows alone too.
+    let mut no_iterations = gjkd_query_options_default();
+    no_iterations.max_iterations = 0;
+    let mut no_precision = gjkd_query_options_default();
+    no_precision.precision = 7;
+    let mut nan_tolerance = gjkd_query_options_default();
+    nan_tolerance.tolerance = f64::NAN;
+    let rows = [
+        with_options(cube, ball, &no_iterations),
+        with_options(cube, ball, &no_precision),
+        with_options(cube, ball, &nan_tolerance),
+        base(cube, ball),
+    ];
+    let mut out = [gjkd_result::default(); 4];
+    ok(query(c, &rows, &mut out));
+    for r in &out[..3] {
+        assert_eq!(r.error, GJKD_CODE_INVALID_OPTIONS as u32, "{r:?}");
+    }
+    assert!((out[3].distance - 1.5).abs() <= 1e-9);
     // SAFETY: a live handle.
     ok(unsafe { gjkd_close(c) });
 }
@@ -287,7 +340,7 @@ fn whole_call_errors_are_reported_and_send_nothing() {
     let server = Server::start("ffi-rows-errors", &["--no-persist"]);
     let c = connect(&server);
     let (cube, ball) = box_and_ball(c);
-    let good = [gjkd_pair_query_of(cube, ball)];
+    let good = [base(cube, ball)];
     let mut out = [gjkd_result::default(); 2];
     let stats = |c| {
         let mut s = gjkd_server_stats::default();
@@ -302,55 +355,62 @@ fn whole_call_errors_are_reported_and_send_nothing() {
     unsafe {
         let o = out.as_mut_ptr();
         assert_fails(
-            gjkd_query_pairs(null_mut(), good.as_ptr(), 1, null(), o),
+            gjkd_query_pairs(null_mut(), good.as_ptr(), 1, o),
             GJKD_ERR_NULL_POINTER,
             "client is NULL",
         );
         assert_fails(
-            gjkd_query_pairs(c, null(), 1, null(), o),
+            gjkd_query_pairs(c, null(), 1, o),
             GJKD_ERR_NULL_POINTER,
             "queries is NULL",
         );
         assert_fails(
-            gjkd_query_pairs(c, good.as_ptr(), 1, null(), null_mut()),
+            gjkd_query_pairs(c, good.as_ptr(), 1, null_mut()),
             GJKD_ERR_NULL_POINTER,
             "out is NULL",
         );
         assert_fails(
-            gjkd_query_pairs(c, good.as_ptr(), usize::MAX / 8, null(), o),
+            gjkd_query_pairs(c, good.as_ptr(), usize::MAX / 8, o),
             GJKD_ERR_INVALID_ARGUMENT,
             "larger than any array",
         );
-        let mut bad = gjkd_query_options_default();
-        bad.max_iterations = 0;
+        // A row that would store a pose, a zeroed row, a row with a bit
+        // this call does not define.
+        let set_pose = [good[0], gjkd_pair_query { kind: 1, ..good[0] }];
         assert_fails(
-            gjkd_query_pairs(c, good.as_ptr(), 1, &bad, o),
+            gjkd_query_pairs(c, set_pose.as_ptr(), 2, o),
             GJKD_ERR_INVALID_ARGUMENT,
-            "max_iterations",
+            "queries[1]: kind 1 is not a distance query",
+        );
+        let zeroed: [gjkd_pair_query; 1] = std::mem::zeroed();
+        assert_fails(
+            gjkd_query_pairs(c, zeroed.as_ptr(), 1, o),
+            GJKD_ERR_INVALID_ARGUMENT,
+            "queries[0]: kind 0",
         );
         let stray = [
             good[0],
             gjkd_pair_query {
-                poses: 8,
+                flags: good[0].flags | gjkd_proto::item_flags::CLAMP,
                 ..good[0]
             },
         ];
         assert_fails(
-            gjkd_query_pairs(c, stray.as_ptr(), 2, null(), o),
+            gjkd_query_pairs(c, stray.as_ptr(), 2, o),
             GJKD_ERR_INVALID_ARGUMENT,
-            "queries[1]: poses 0x8",
+            "queries[1]: flags 0x28",
         );
         let reserved = [gjkd_pair_query {
             reserved: 1,
             ..good[0]
         }];
         assert_fails(
-            gjkd_query_pairs(c, reserved.as_ptr(), 1, null(), o),
+            gjkd_query_pairs(c, reserved.as_ptr(), 1, o),
             GJKD_ERR_INVALID_ARGUMENT,
             "reserved 1 is not 0",
         );
         // A count of 0 does nothing, whatever the arrays.
-        ok(gjkd_query_pairs(c, null(), 0, null(), null_mut()));
+        ok(gjkd_query_pairs(c, null(), 0, null_mut()));
     }
     assert_eq!(out, [gjkd_result::default(); 2], "nothing written");
     assert_eq!(stats(c), before, "nothing sent");
@@ -358,14 +418,13 @@ fn whole_call_errors_are_reported_and_send_nothing() {
     let handle = c as usize;
     let status = std::thread::spawn(move || {
         let mut out = [gjkd_result::default()];
-        let row = [gjkd_pair_query_of(1, 2)];
+        let row = [base(1, 2)];
         // SAFETY: the handle is live; the call refuses this thread.
         unsafe {
             gjkd_query_pairs(
                 handle as *mut gjkd_client,
                 row.as_ptr(),
                 1,
-                null(),
                 out.as_mut_ptr(),
             )
         }

@@ -70,7 +70,7 @@ int main(int argc, char **argv) {
     }
     gjkd_pair_query rows[BATCH];
     gjkd_result results[BATCH];
-    for (int i = 0; i < BATCH; i++) rows[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1]);
+    for (int i = 0; i < BATCH; i++) rows[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1], NULL);
     gjkd_robot *robot = NULL;
     must(gjkd_register_robot_text(c, "leaky", URDF, NULL, NULL, NULL, NULL, &robot), "robot");
     for (int h = 0; h < HANDLES; h++) {
@@ -110,7 +110,7 @@ int main(int argc, char **argv) {
                     fprintf(stderr, "distance %.17g, expected 1\n", distance[0]);
                     return 4;
                 }
-                must(gjkd_query_pairs(c, rows, BATCH, NULL, results), "query_pairs");
+                must(gjkd_query_pairs(c, rows, BATCH, results), "query_pairs");
                 if (fabs(results[0].distance - 1.0) > 1e-9) {
                     fprintf(stderr, "row distance %.17g, expected 1\n", results[0].distance);
                     return 4;
@@ -124,7 +124,7 @@ int main(int argc, char **argv) {
         }
         switch (k % 6) {
         case 5:
-            must_fail(gjkd_query_pairs(c, rows, BATCH, NULL, NULL), GJKD_ERR_NULL_POINTER,
+            must_fail(gjkd_query_pairs(c, rows, BATCH, NULL), GJKD_ERR_NULL_POINTER,
                       "null rows out");
             break;
         case 3:

@@ -13,8 +13,8 @@
 //! Batch calls make their items straight into the request's shared memory
 //! and copy the answers straight from the response's into the caller's
 //! arrays, with no buffer in between (`Client::query_batch_with`);
-//! `gjkd_query_pairs` takes rows and gives rows laid out as the server's
-//! answers, so those are copied whole.
+//! `gjkd_query_pairs` takes rows laid out as the server's requests and
+//! gives rows laid out as its answers, so both are copied whole.
 //!
 //! The semantics are the Rust client's (`gjkd-client`) and the names follow
 //! the Python API's (`gjkd.Client`): `register_sphere`, `set_poses`,

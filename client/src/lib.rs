@@ -1297,6 +1297,22 @@ impl Client {
         )
     }
 
+    /// As [`Client::query_batch`], but the results are handed to `read`
+    /// straight from the response's shared memory (`read` is called once,
+    /// with `items.len()` results, if the request succeeds): for bindings
+    /// that keep results in layouts of their own but can make their items
+    /// as a slice first, which is copied into the request in one piece.
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`].
+    pub fn query_batch_read(
+        &mut self,
+        items: &[Item],
+        read: impl FnOnce(&[ItemResult]),
+    ) -> Result<(), ClientError> {
+        self.round_trip(items.len(), Source::<fn(usize) -> Item>::Slice(items), read)
+    }
+
     /// As [`Client::query_batch`], but item `i` of the `count` items is
     /// made by `item(i)` and written straight into the request's shared
     /// memory, and the results are handed to `read` straight from the

@@ -150,7 +150,11 @@ impl<'a> Steps<'a> {
     }
 
     /// Number of steps, or why the slices do not make whole steps.
-    fn count(&self) -> Result<usize, ClientError> {
+    ///
+    /// # Errors
+    /// [`ClientError::InvalidArgument`] when there is no moving object or
+    /// joint, or the slices do not make whole steps.
+    pub fn count(&self) -> Result<usize, ClientError> {
         let (per, len) = match *self {
             Steps::Poses { objects, poses } => (objects.len(), poses.len()),
             Steps::Joints {
@@ -165,16 +169,18 @@ impl<'a> Steps<'a> {
         Ok(len / per)
     }
 
-    /// Items of one step, its [`Item::step`] included.
-    fn items_per_step(&self) -> usize {
+    /// Items of one step, its [`Item::step`] included (for bindings that
+    /// lay out a path's items themselves; see [`Client::scene_with`]).
+    pub fn items_per_step(&self) -> usize {
         1 + match *self {
             Steps::Poses { objects, .. } => objects.len(),
             Steps::Joints { joints, .. } => joints.div_ceil(JOINTS_PER_ITEM),
         }
     }
 
-    /// Item `k` of step `s`.
-    fn item(&self, s: usize, k: usize) -> Item {
+    /// Item `k` (below [`Steps::items_per_step`]) of step `s` (below
+    /// [`Steps::count`]).
+    pub fn item(&self, s: usize, k: usize) -> Item {
         if k + 1 == self.items_per_step() {
             return Item::step();
         }

@@ -11,6 +11,9 @@
  *   single_p50_ns X     (gjkd_distance of pair 0 at stored poses)
  *   batch_ns_per_pair Y (median over BATCHES of gjkd_distances of all n
  *                        pairs, each with its own poses, divided by n)
+ *   rows_ns_per_pair Z  (the same through gjkd_query_pairs: a
+ *                        gjkd_pair_query row per pair in, a gjkd_result
+ *                        row out)
  */
 #define _POSIX_C_SOURCE 199309L /* clock_gettime under -std=c99 */
 #include <stdio.h>
@@ -110,7 +113,26 @@ int main(int argc, char **argv) {
         must(s, "distances");
     }
     printf("batch_ns_per_pair %.1f\n", median(t, batches));
-    printf("checksum %.17g\n", distance[n - 1]);
+
+    gjkd_pair_query *queries = malloc(n * sizeof *queries);
+    gjkd_result *results = malloc(n * sizeof *results);
+    for (size_t i = 0; i < n; i++) {
+        queries[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1], NULL);
+        queries[i].pose_a = poses_a[i];
+        queries[i].pose_b = poses_b[i];
+        queries[i].flags |= GJKD_POSE_A | GJKD_POSE_B;
+    }
+    for (size_t k = 0; k < 20; k++) {
+        must(gjkd_query_pairs(c, queries, n, results), "warm-up rows");
+    }
+    for (size_t k = 0; k < batches; k++) {
+        double start = now_ns();
+        gjkd_status s = gjkd_query_pairs(c, queries, n, results);
+        t[k] = (now_ns() - start) / (double)n;
+        must(s, "query_pairs");
+    }
+    printf("rows_ns_per_pair %.1f\n", median(t, batches));
+    printf("checksum %.17g %.17g\n", distance[n - 1], results[n - 1].distance);
 
     for (size_t i = 0; i < 2 * n; i++) must(gjkd_remove(c, pairs[i]), "remove");
     must(gjkd_close(c), "close");

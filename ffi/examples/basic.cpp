@@ -69,6 +69,17 @@ int main(int argc, char **argv) {
         std::printf("unknown pair           %s\n", gjkd_error_code_name(out.error[5]));
         failures += out.error[5] != GJKD_CODE_UNKNOWN_OBJECT;
 
+        // The same pairs as rows, poses given per row: the fastest batch.
+        std::vector<gjkd::PairQuery> rows = {
+            gjkd::pair(box, ball),
+            gjkd::pair_at(box, gjkd::identity(), ball, gjkd::at(0, 0, -5)),
+            gjkd::pair(box, 0xdead)};
+        std::vector<gjkd::Result> answers;
+        client.query_pairs(rows, answers);
+        expect("rows box-sphere", answers[0].distance, 1.5);
+        expect("rows box-sphere below", answers[1].distance, 3.5);
+        failures += answers[2].error != GJKD_CODE_UNKNOWN_OBJECT;
+
         // One pair at a pose given for this query only.
         gjkd::Pose above = gjkd::at(0, 0, 4);
         expect("box-sphere above", client.distance(box, ball, nullptr, &above).distance, 2.5);
@@ -94,6 +105,17 @@ int main(int argc, char **argv) {
         expect("rod hanging", client.distance(pendulum.link("rod"), floor_ball).distance, 1.5);
         client.set_joints(pendulum, {std::acos(0.0)});
         expect("rod swung level", client.distance(pendulum.link("rod"), floor_ball).distance, 2.4);
+        // The swing back as a candidate motion: the clearance at each step
+        // of joint positions, nothing moved on the server.
+        gjkd::Group arm;
+        arm.id = pendulum.id();
+        std::vector<gjkd::SceneRow> steps(4);
+        gjkd::SceneSummary swing = client.path_joints(arm, GJKD_PATH_CLEARANCE, 0.0, pendulum,
+                                                      {std::acos(0.0), 0.0}, steps);
+        failures += swing.steps != 2 || swing.written != 2;
+        expect("path: level", steps[0].answer.distance, 2.4);
+        expect("path: hanging", steps[1].answer.distance, 1.5);
+        expect("rod still level", client.distance(pendulum.link("rod"), floor_ball).distance, 2.4);
         std::remove(urdf.c_str());
 
         // A refused call throws, with the status, the server's code and words.

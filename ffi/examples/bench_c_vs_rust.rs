@@ -12,14 +12,16 @@
 //! the same measurements in Rust: the p50 of a single-pair round trip
 //! (`gjkd_distance` / `Client::distance`, pair 0 at its stored poses) and
 //! the median per-pair cost of a batch of all pairs, each with its own
-//! poses (`gjkd_distances` / `Client::query_batch`, items built once).
-//! Which side goes first alternates by round. Prints each round, the
-//! medians over rounds, and the median of each round's batch ratio. Then,
-//! since whole rounds on a busy machine differ by more than the two
-//! sides do, the same batch through `gjkd_distances` called in this
-//! process (the C entry point itself, with the C structs) and through the
-//! Rust client, batch by batch, order alternating: the median of each
-//! adjacent pair's ratio.
+//! poses (`Client::query_batch`, items built once; in C both
+//! `gjkd_distances`, ids and poses in, a field per array out, and
+//! `gjkd_query_pairs`, prebuilt `gjkd_pair_query` rows in and whole
+//! `gjkd_result` rows out, which is what the Rust side does with its items
+//! and results). Which side goes first alternates by round. Prints each
+//! round, the medians over rounds, and the median of each round's batch
+//! ratios. Then, since whole rounds on a busy machine differ by more than
+//! the two sides do, the same batch through each C entry point called in
+//! this process (with the C structs) and through the Rust client, batch by
+//! batch, order alternating: the median of each adjacent pair's ratio.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -127,8 +129,15 @@ fn compile(profile: &Path, out: &Path) {
     assert!(status.success(), "compiling round_trip.c failed");
 }
 
-/// Runs the C side once: (single p50 ns, batch ns per pair).
-fn run_c(exe: &Path, service: &str, file: &Path, singles: usize, batches: usize) -> (f64, f64) {
+/// Runs the C side once: (single p50 ns, arrays batch ns per pair, rows
+/// batch ns per pair).
+fn run_c(
+    exe: &Path,
+    service: &str,
+    file: &Path,
+    singles: usize,
+    batches: usize,
+) -> (f64, f64, f64) {
     let out = Command::new(exe)
         .arg(service)
         .arg(file)
@@ -148,7 +157,11 @@ fn run_c(exe: &Path, service: &str, file: &Path, singles: usize, batches: usize)
             .and_then(|v| v.trim().parse().ok())
             .unwrap_or_else(|| panic!("no {key} in {text}"))
     };
-    (value("single_p50_ns"), value("batch_ns_per_pair"))
+    (
+        value("single_p50_ns"),
+        value("batch_ns_per_pair"),
+        value("rows_ns_per_pair"),
+    )
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -259,6 +272,13 @@ struct InProcessC {
     doubles: Vec<Vec<f64>>,
     /// status, iterations, error.
     words: Vec<Vec<u32>>,
+    /// The rows of `gjkd_query_pairs`, each pair with its own poses.
+    queries: Vec<gjkd_c::gjkd_pair_query>,
+    /// Its answers.
+    results: Vec<gjkd_c::gjkd_result>,
+    /// The same queries as Rust items, for the Rust client to ask of the
+    /// same objects.
+    twin_items: Vec<Item>,
 }
 
 impl InProcessC {
@@ -292,9 +312,39 @@ impl InProcessC {
                 }
             }
         }
+        let queries: Vec<gjkd_pair_query> = pairs
+            .chunks(2)
+            .zip(rows)
+            .map(|(ab, r)| {
+                // SAFETY: NULL options.
+                let row = unsafe { gjkd_pair_query_of(ab[0], ab[1], std::ptr::null()) };
+                gjkd_pair_query {
+                    pose_a: pose(&r[6..13]),
+                    pose_b: pose(&r[13..20]),
+                    flags: row.flags | GJKD_POSE_A | GJKD_POSE_B,
+                    ..row
+                }
+            })
+            .collect();
+        let twin_items = pairs
+            .chunks(2)
+            .zip(rows)
+            .map(|(ab, r)| {
+                Item::distance_at(
+                    ObjectId::from_raw(ab[0]),
+                    &isometry(&r[6..13]),
+                    ObjectId::from_raw(ab[1]),
+                    &isometry(&r[13..20]),
+                    &QueryOptions::default(),
+                )
+            })
+            .collect();
         InProcessC {
             client,
             pairs,
+            queries,
+            twin_items,
+            results: vec![gjkd_result::default(); n],
             poses_a: rows.iter().map(|r| pose(&r[6..13])).collect(),
             poses_b: rows.iter().map(|r| pose(&r[13..20])).collect(),
             doubles: [1, 1, 1, 3, 3, 3]
@@ -338,6 +388,20 @@ impl InProcessC {
         };
         assert_eq!(s, gjkd_c::gjkd_status::GJKD_OK, "distances");
     }
+
+    /// One `gjkd_query_pairs` of every pair.
+    fn rows(&mut self) {
+        // SAFETY: `results` has a row per query; a live handle.
+        let s = unsafe {
+            gjkd_c::gjkd_query_pairs(
+                self.client,
+                self.queries.as_ptr(),
+                self.queries.len(),
+                self.results.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, gjkd_c::gjkd_status::GJKD_OK, "query_pairs");
+    }
 }
 
 impl Drop for InProcessC {
@@ -347,27 +411,36 @@ impl Drop for InProcessC {
     }
 }
 
+/// One batch through a C entry point.
+type BatchCall = fn(&mut InProcessC);
+
 /// `batches` adjacent pairs of batches, C and Rust, their order
 /// alternating: (C median, Rust median, median of the pairs' ratios, C p10,
 /// Rust p10), in ns per pair.
-fn interleaved(c: &mut InProcessC, rust: &mut RustSide, batches: usize) -> [f64; 5] {
-    let per = rust.items.len() as f64;
+fn interleaved(
+    c: &mut InProcessC,
+    call: BatchCall,
+    rust: &mut RustSide,
+    items: &[Item],
+    batches: usize,
+) -> [f64; 5] {
+    let per = items.len() as f64;
     for _ in 0..20 {
-        c.batch();
+        call(c);
         rust.client
-            .query_batch(&rust.items, &mut rust.results)
+            .query_batch(items, &mut rust.results)
             .expect("warm-up");
     }
     let (mut tc, mut tr, mut ratio) = (vec![], vec![], vec![]);
     for k in 0..batches {
         let mut time_c = || {
             let start = Instant::now();
-            c.batch();
+            call(c);
             start.elapsed().as_nanos() as f64 / per
         };
         let mut time_rust = || {
             let start = Instant::now();
-            let r = rust.client.query_batch(&rust.items, &mut rust.results);
+            let r = rust.client.query_batch(items, &mut rust.results);
             let ns = start.elapsed().as_nanos() as f64 / per;
             r.expect("batch");
             ns
@@ -440,56 +513,86 @@ fn main() {
     println!(
         "{PAIRS} box pairs, {rounds} rounds of {singles} single round trips and {batches} batches; client on CPU 0, server on CPU 1: {pinned}"
     );
-    println!("round   C single p50  Rust single p50   C batch/pair  Rust batch/pair   (ns)");
-    let (mut cs, mut rs, mut cb, mut rb) = (vec![], vec![], vec![], vec![]);
-    let mut ratios = vec![];
+    println!(
+        "round   C single p50  Rust single p50  C arrays/pair    C rows/pair  Rust batch/pair   (ns)"
+    );
+    let mut columns: [Vec<f64>; 5] = Default::default();
+    let (mut arrays_ratios, mut rows_ratios) = (vec![], vec![]);
     for round in 0..rounds {
         // Which side goes first alternates, so that whatever the first or
         // second place in a round costs (a server cache, a clock ramping)
         // falls on both sides alike.
-        let (c_single, c_batch, r_single, r_batch) = if round % 2 == 0 {
-            let (cs, cb) = run_c(&exe, &service, &file, singles, batches);
-            (
-                cs,
-                cb,
-                rust.single_p50(singles),
-                rust.batch_per_pair(batches),
-            )
+        let (c_single, c_arrays, c_rows, r_single, r_batch) = if round % 2 == 0 {
+            let (cs, ca, cr) = run_c(&exe, &service, &file, singles, batches);
+            let rs = rust.single_p50(singles);
+            (cs, ca, cr, rs, rust.batch_per_pair(batches))
         } else {
             let (rs, rb) = (rust.single_p50(singles), rust.batch_per_pair(batches));
-            let (cs, cb) = run_c(&exe, &service, &file, singles, batches);
-            (cs, cb, rs, rb)
+            let (cs, ca, cr) = run_c(&exe, &service, &file, singles, batches);
+            (cs, ca, cr, rs, rb)
         };
-        println!("{round:>5} {c_single:>14.0} {r_single:>16.0} {c_batch:>14.1} {r_batch:>16.1}");
-        cs.push(c_single);
-        rs.push(r_single);
-        cb.push(c_batch);
-        rb.push(r_batch);
-        ratios.push(c_batch / r_batch);
+        println!(
+            "{round:>5} {c_single:>14.0} {r_single:>16.0} {c_arrays:>14.1} {c_rows:>14.1} {r_batch:>16.1}"
+        );
+        for (column, v) in columns
+            .iter_mut()
+            .zip([c_single, r_single, c_arrays, c_rows, r_batch])
+        {
+            column.push(v);
+        }
+        arrays_ratios.push(c_arrays / r_batch);
+        rows_ratios.push(c_rows / r_batch);
     }
-    let (cs, rs, cb, rb) = (
-        median(&mut cs),
-        median(&mut rs),
-        median(&mut cb),
-        median(&mut rb),
-    );
-    println!("median {cs:>13.0} {rs:>16.0} {cb:>14.1} {rb:>16.1}");
+    let [cs, rs, ca, cr, rb] = columns.map(|mut c| median(&mut c));
+    println!("median {cs:>13.0} {rs:>16.0} {ca:>14.1} {cr:>14.1} {rb:>16.1}");
     println!(
-        "single: C - Rust = {:+.0} ns (target <= +200); batch: C / Rust = {:.3} (target <= 1.1), \
-         median of the rounds' own ratios {:.3}",
+        "single: C - Rust = {:+.0} ns (target <= +200); batch C / Rust (target <= 1.1): \
+         gjkd_query_pairs {:.3} (median of the rounds' own ratios {:.3}), \
+         gjkd_distances {:.3} ({:.3})",
         cs - rs,
-        cb / rb,
-        median(&mut ratios)
+        cr / rb,
+        median(&mut rows_ratios),
+        ca / rb,
+        median(&mut arrays_ratios)
     );
     let mut in_process = InProcessC::new(&service, &rows);
-    let [c, r, ratio, c10, r10] = interleaved(&mut in_process, &mut rust, batches * rounds);
-    println!(
-        "in process, {} adjacent batch pairs: C {c:.1} ns/pair, Rust {r:.1} (p10 {c10:.1}, {r10:.1}); \
-         C / Rust = {:.3}, median of the pairs' ratios {ratio:.3}, of the p10s {:.3}",
-        batches * rounds,
-        c / r,
-        c10 / r10
-    );
+    // Like with like: the Rust client asks the same objects (the server's
+    // time differs from one set of objects to another), with its items
+    // built once, as the C rows are.
+    let twin = in_process.twin_items.clone();
+    let own = rust.items.clone();
+    let runs: [(&str, BatchCall, &[Item], &str); 3] = [
+        (
+            "gjkd_query_pairs",
+            InProcessC::rows,
+            &twin,
+            "the same objects",
+        ),
+        (
+            "gjkd_distances",
+            InProcessC::batch,
+            &twin,
+            "the same objects",
+        ),
+        (
+            "gjkd_query_pairs",
+            InProcessC::rows,
+            &own,
+            "Rust's own objects",
+        ),
+    ];
+    for (name, call, items, whose) in runs {
+        let [c, r, ratio, c10, r10] =
+            interleaved(&mut in_process, call, &mut rust, items, batches * rounds);
+        println!(
+            "in process, {name} beside Rust on {whose}, {} adjacent batch pairs: C {c:.1} \
+             ns/pair, Rust {r:.1} (p10 {c10:.1}, {r10:.1}); C / Rust = {:.3}, median of \
+             the pairs' ratios {ratio:.3}, of the p10s {:.3}",
+            batches * rounds,
+            c / r,
+            c10 / r10
+        );
+    }
     drop(in_process);
     drop(rust);
     let _ = server.kill();

@@ -6,7 +6,8 @@
  *
  * Use: connect with gjkd_connect(), register objects once (gjkd_register_*),
  * store poses (gjkd_set_pose(s)), ask distances one pair at a time
- * (gjkd_distance) or many per round trip (gjkd_distances), then
+ * (gjkd_distance) or many per round trip (gjkd_distances into an array per
+ * field, or gjkd_query_pairs, the fastest, rows in and rows out), then
  * gjkd_close(). Every function returns a gjkd_status; on failure,
  * gjkd_last_error() says why in words and, for GJKD_ERR_REJECTED,
  * gjkd_last_error_code() gives the server's gjkd_error_code. A handle
@@ -36,6 +37,22 @@
 
 // Longest object name, in bytes of UTF-8 (not counting the NUL).
 #define GJKD_MAX_NAME_LEN 64
+
+// `gjkd_pair_query::flags` bit: this row's `pose_a` replaces the stored
+// pose of `a`, for this query only.
+#define GJKD_POSE_A 1
+
+// `gjkd_pair_query::flags` bit: this row's `pose_b` replaces the stored
+// pose of `b`, for this query only.
+#define GJKD_POSE_B 2
+
+// `gjkd_result::flags` bit: the query started from the pair's last
+// simplex.
+#define GJKD_RESULT_WARM_STARTED 1
+
+// `gjkd_result::flags` bit: gjk's Backup Procedure ran (a numerically
+// hard case).
+#define GJKD_RESULT_BACKUP_USED 2
 
 // What a call returns. `GJKD_OK` (0) is success; every other value is a
 // failure, described in words by `gjkd_last_error()`.
@@ -445,6 +462,70 @@ typedef struct gjkd_results {
   // `count` flags: the query started warm.
   bool *warm_started;
 } gjkd_results;
+
+// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
+// server reads (so a batch of rows is copied into it in one piece). Make
+// it with `gjkd_pair_query_of()`, which sets `kind` and the options'
+// fields; then, for a pose given for this query only, set the pose and OR
+// its bit into `flags` (`row.flags |= GJKD_POSE_B`). Keep the rows from
+// call to call and rewrite only the poses that move.
+typedef struct gjkd_pair_query {
+  // What the row asks: set by `gjkd_pair_query_of()`, not to be changed.
+  uint32_t kind;
+  // `GJKD_POSE_A` and `GJKD_POSE_B`, ORed into the bits
+  // `gjkd_pair_query_of()` set from the options (keep those).
+  uint32_t flags;
+  // Object A.
+  gjkd_id a;
+  // Object B.
+  gjkd_id b;
+  // The pose of A for this query, used when `flags` has `GJKD_POSE_A`
+  // (the stored pose is then neither used nor changed).
+  struct gjkd_pose pose_a;
+  // The pose of B for this query, used when `flags` has `GJKD_POSE_B`.
+  struct gjkd_pose pose_b;
+  // The options' tolerance.
+  double tolerance;
+  // The options' margin.
+  double margin;
+  // The options' iteration cap.
+  uint32_t max_iterations;
+  // Zero.
+  uint32_t reserved;
+} gjkd_pair_query;
+
+// The answer row of one pair of a `gjkd_query_pairs()` batch, laid out
+// as the server writes it (so a batch's answers are copied into the
+// caller's array in one piece). Distances are after radii; points in world
+// coordinates. A pair that failed has its code in `error` and zeros
+// elsewhere.
+typedef struct gjkd_result {
+  // Distance between the (rounded) shapes, `>= 0`.
+  double distance;
+  // Certified lower bound on the distance.
+  double lower;
+  // Certified upper bound on the distance.
+  double upper;
+  // Lower bound on the penetration depth; 0 when separated.
+  double penetration;
+  // Nearest point on A.
+  double point_a[3];
+  // Nearest point on B.
+  double point_b[3];
+  // Unit vector from A's nearest point towards B's; zero when the cores
+  // touch or intersect.
+  double normal[3];
+  // A `gjkd_error_code` value, `GJKD_CODE_OK` (0) when answered.
+  uint32_t error;
+  // A `gjkd_query_status` value.
+  uint32_t status;
+  // Subalgorithm iterations (summed over piece pairs for compounds).
+  uint32_t iterations;
+  // `GJKD_RESULT_WARM_STARTED | GJKD_RESULT_BACKUP_USED` bits.
+  uint32_t flags;
+  // Pieces of A and B that realise the distance (0 for convex objects).
+  uint32_t pieces[2];
+} gjkd_result;
 
 // Options of a scene query; start from `gjkd_scene_options_default()`.
 typedef struct gjkd_scene_options {
@@ -1102,6 +1183,44 @@ enum gjkd_status gjkd_robot_link_poses(const struct gjkd_robot *robot,
                                        struct gjkd_pose *out_poses,
                                        size_t out_count);
 
+// A row asking the distance of `a` and `b` at their stored poses, with
+// `options` (NULL: the defaults). Options out of their domain (see
+// `gjkd_query_options`) make the row fail alone, with
+// `GJKD_CODE_INVALID_OPTIONS` in its result.
+//
+// # Safety
+// `options` is NULL or readable.
+struct gjkd_pair_query gjkd_pair_query_of(gjkd_id a,
+                                          gjkd_id b,
+                                          const struct gjkd_query_options *options);
+
+// The distances of `count` pairs in one call: `queries[i]` in, its answer
+// into `out[i]`. The fastest batch of this API: the rows are copied into
+// the request's shared memory in one piece, and the answers, whole, from
+// the response's into `out`, as the Rust client does with its items.
+//
+// A pair that fails (an unknown id, a bad pose given in its row, bad
+// options) has its `gjkd_error_code` in `out[i].error`, zeros elsewhere,
+// and the other pairs are answered: the call still returns `GJKD_OK`.
+// Batches larger than the server takes are split. A count of 0 does
+// nothing (`queries` and `out` may then be NULL).
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `queries`, `out`),
+// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
+// than any array; a row not made by `gjkd_pair_query_of()`, or whose
+// `flags` has bits other than those it set and `GJKD_POSE_A |
+// GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);
+// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks answered
+// before are written, the others left as they were).
+//
+// # Safety
+// `client` is NULL or a live handle; `queries` NULL or `count` readable
+// rows; `out` NULL or `count` writable rows.
+enum gjkd_status gjkd_query_pairs(struct gjkd_client *client,
+                                  const struct gjkd_pair_query *queries,
+                                  size_t count,
+                                  struct gjkd_result *out);
+
 // The default scene options: default tolerance and iteration cap, warm
 // starts and motion bounds on, no accepted accuracy, no cut-off.
 struct gjkd_scene_options gjkd_scene_options_default(void);
@@ -1192,6 +1311,39 @@ enum gjkd_status gjkd_path(struct gjkd_client *client,
                            struct gjkd_scene_row *rows,
                            size_t capacity,
                            struct gjkd_scene_summary *summary);
+
+// `gjkd_path()` along a motion given as joint positions of `robot`:
+// `positions` holds `step_count` steps of the robot's moving joints
+// (`dof` doubles each, in `gjkd_robot_joint()` order), `positions[s * dof
+// + j]` joint `j` at step `s`. The server places the links by forward
+// kinematics at each step and answers there; nothing moves on the server
+// (the robot's stored joints and link poses stay as they were). A position
+// outside its limits is refused, or moved to the nearest limit when
+// `options->clamp` is true. The group is usually the robot itself
+// (`group->id` its id, so that its allowed pairs apply).
+//
+// Errors: as `gjkd_path()` (`GJKD_ERR_NULL_POINTER` for `positions` and
+// `robot`), plus `GJKD_ERR_INVALID_ARGUMENT` for a robot without moving
+// joints, no step, or a position NaN or infinite (last error code
+// `GJKD_CODE_NON_FINITE_POSE`) or outside its limits without clamp
+// (`GJKD_CODE_OUT_OF_LIMITS`), the message naming the step and joint:
+// nothing is sent; `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`
+// when the robot is gone from the server.
+//
+// # Safety
+// As `gjkd_clearance()`; `robot` NULL or live; `positions` NULL or
+// `step_count * dof` doubles.
+enum gjkd_status gjkd_path_joints(struct gjkd_client *client,
+                                  const struct gjkd_group *group,
+                                  uint32_t question,
+                                  double margin,
+                                  const struct gjkd_robot *robot,
+                                  const double *positions,
+                                  size_t step_count,
+                                  const struct gjkd_scene_options *options,
+                                  struct gjkd_scene_row *rows,
+                                  size_t capacity,
+                                  struct gjkd_scene_summary *summary);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -4,7 +4,8 @@
 // every failed call into a gjkd::Error carrying the gjkd_status, the
 // server's gjkd_error_code (for GJKD_ERR_REJECTED) and the message. Batches
 // take pointer + count, std::vector, or (C++20) std::span, and write into
-// a gjkd::Distances the caller keeps and reuses. Like the handle it wraps,
+// a gjkd::Distances the caller keeps and reuses, or (query_pairs(), the
+// fastest) read PairQuery rows and write Result rows. Like the handle it wraps,
 // a Client belongs to the thread that created it.
 //
 //   gjkd::Client client("gjkd");
@@ -39,6 +40,10 @@ using Pose = gjkd_pose;
 using Answer = gjkd_answer;
 /// Query options; start from default_options().
 using Options = gjkd_query_options;
+/// A row of Client::query_pairs(): a pair, and poses for this query only.
+using PairQuery = gjkd_pair_query;
+/// An answer row of Client::query_pairs() (`error` 0 when answered).
+using Result = gjkd_result;
 /// A convex shape (see sphere(), capsule(), box(), polytope()).
 using Shape = gjkd_shape;
 /// A piece of a compound: an offset and a convex shape.
@@ -81,6 +86,22 @@ inline Pose identity() { return Pose{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}}; }
 /// A translation by (x, y, z), no rotation.
 inline Pose at(double x, double y, double z) {
     return Pose{{x, y, z}, {0.0, 0.0, 0.0, 1.0}};
+}
+
+/// A row asking the distance of `a` and `b` at their stored poses.
+inline PairQuery pair(Id a, Id b, const Options *options = nullptr) {
+    return gjkd_pair_query_of(a, b, options);
+}
+
+/// A row asking the distance of `a` at `pose_a` and `b` at `pose_b`, for
+/// this query only.
+inline PairQuery pair_at(Id a, const Pose &pose_a, Id b, const Pose &pose_b,
+                         const Options *options = nullptr) {
+    PairQuery q = gjkd_pair_query_of(a, b, options);
+    q.pose_a = pose_a;
+    q.pose_b = pose_b;
+    q.flags |= GJKD_POSE_A | GJKD_POSE_B;
+    return q;
 }
 
 /// The default query options.
@@ -392,7 +413,29 @@ public:
         distances(ids, pairs.size(), out, nullptr, nullptr, options);
     }
 
+    /// The answers of `count` rows (made by pair() or pair_at(), which
+    /// take the options) into `out[0..count)`: the fastest batch, copied in
+    /// one piece each way. Rows that fail carry their code in `error`.
+    void query_pairs(const PairQuery *queries, std::size_t count, Result *out) {
+        check(gjkd_query_pairs(handle_, queries, count, out));
+    }
+    /// The answers of `queries` into `out`, resized to match (allocates
+    /// only when growing).
+    void query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out) {
+        if (out.size() != queries.size()) out.resize(queries.size());
+        query_pairs(queries.data(), queries.size(), out.data());
+    }
+
 #ifdef GJKD_HAS_SPAN
+    /// The answers of `queries` into `out`, which must be as long (C++20).
+    void query_pairs(std::span<const PairQuery> queries, std::span<Result> out) {
+        if (out.size() != queries.size()) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "query_pairs: " + std::to_string(out.size()) + " result rows for " +
+                            std::to_string(queries.size()) + " queries");
+        }
+        query_pairs(queries.data(), queries.size(), out.data());
+    }
     /// Stores poses[i] for ids[i] (C++20).
     void set_poses(std::span<const Id> ids, std::span<const Pose> poses) {
         same_size(ids.size(), poses.size());
@@ -459,6 +502,29 @@ public:
         check(gjkd_path(handle_, &g, static_cast<uint32_t>(question), margin, moving.data(),
                         moving.size(), poses.data(), poses.size() / moving.size(), options,
                         rows.data(), rows.size(), &s));
+        return s;
+    }
+
+    /// `question` at every step of a motion of `robot` given as joint
+    /// positions: `positions` holds `positions.size() / robot.dof()` steps
+    /// of `dof` positions each (in Robot::joint_names() order). Nothing
+    /// moves on the server; `options->clamp` clamps positions outside
+    /// their limits instead of throwing.
+    SceneSummary path_joints(const Group &group, gjkd_path_question question, double margin,
+                             const Robot &robot, const std::vector<double> &positions,
+                             std::vector<SceneRow> &rows, const SceneOptions *options = nullptr) {
+        const std::size_t dof = robot.dof();
+        if (dof == 0 || positions.size() % dof != 0) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "path_joints: " + std::to_string(positions.size()) +
+                            " positions are no whole number of steps of " +
+                            std::to_string(dof) + " joints");
+        }
+        SceneSummary s{};
+        const gjkd_group g = group.view();
+        check(gjkd_path_joints(handle_, &g, static_cast<uint32_t>(question), margin,
+                               robot.native_handle(), positions.data(), positions.size() / dof,
+                               options, rows.data(), rows.size(), &s));
         return s;
     }
 

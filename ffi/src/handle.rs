@@ -20,6 +20,10 @@ pub struct gjkd_client {
     pub client: Client,
     /// The thread that created the handle (iceoryx2 ports are bound to it).
     owner: u64,
+    /// A chunk's items, made here and then copied into the request in one
+    /// piece (faster than writing shared memory item by item), kept from
+    /// call to call.
+    scratch: Vec<Item>,
 }
 
 /// A number per thread, for telling the owner thread from others without
@@ -43,6 +47,7 @@ impl gjkd_client {
         gjkd_client {
             client,
             owner: thread_token(),
+            scratch: Vec::new(),
         }
     }
 
@@ -54,8 +59,9 @@ impl gjkd_client {
     }
 
     /// Sends the `n` items `item(i)` in chunks the server takes, each
-    /// made straight into shared memory, and hands each chunk's results,
-    /// straight from shared memory, to `sink(first_index, results)`.
+    /// made in the handle's scratch buffer and copied into shared memory in
+    /// one piece, and hands each chunk's results, straight from shared
+    /// memory, to `sink(first_index, results)`.
     ///
     /// # Errors
     /// The first whole-request failure; chunks before it were answered.
@@ -69,13 +75,41 @@ impl gjkd_client {
         while start < n {
             let max = self.max_batch();
             let end = n.min(start + max);
-            let outcome =
-                self.client
-                    .query_batch_with(end - start, |k| item(start + k), |r| sink(start, r));
+            self.scratch.clear();
+            self.scratch.extend((start..end).map(&item));
+            let outcome = self
+                .client
+                .query_batch_read(&self.scratch, |r| sink(start, r));
             match outcome {
                 Ok(()) => start = end,
                 // The server may have restarted with a smaller limit: the
                 // client knows the new one after its reconnect.
+                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        Ok(())
+    }
+}
+
+impl gjkd_client {
+    /// Sends `items` in chunks the server takes, each copied into the
+    /// request in one piece, and copies each chunk's results, whole, into
+    /// the same rows of `out` (as long as `items`).
+    ///
+    /// # Errors
+    /// The first whole-request failure; chunks before it were answered.
+    pub fn run_slices(&mut self, items: &[Item], out: &mut [ItemResult]) -> Result<(), Failure> {
+        let mut start = 0;
+        while start < items.len() {
+            let max = self.max_batch();
+            let end = items.len().min(start + max);
+            let chunk = self
+                .client
+                .query_batch(&items[start..end], &mut out[start..end]);
+            match chunk {
+                Ok(()) => start = end,
+                // As in `run`.
                 Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
                 Err(e) => return Err(e.into()),
             }

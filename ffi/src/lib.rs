@@ -12,7 +12,9 @@
 //! The handle is bound to the thread that created it (iceoryx2 ports are).
 //! Batch calls make their items straight into the request's shared memory
 //! and copy the answers straight from the response's into the caller's
-//! arrays, with no buffer in between (`Client::query_batch_with`).
+//! arrays, with no buffer in between (`Client::query_batch_with`);
+//! `gjkd_query_pairs` takes rows laid out as the server's requests and
+//! gives rows laid out as its answers, so both are copied whole.
 //!
 //! The semantics are the Rust client's (`gjkd-client`) and the names follow
 //! the Python API's (`gjkd.Client`): `register_sphere`, `set_poses`,
@@ -29,6 +31,7 @@ mod meshes;
 mod objects;
 mod query;
 mod robots;
+mod rows;
 mod scene;
 mod status;
 mod types;
@@ -39,6 +42,7 @@ pub use meshes::*;
 pub use objects::*;
 pub use query::*;
 pub use robots::*;
+pub use rows::*;
 pub use scene::*;
 pub use status::gjkd_status;
 pub use types::*;

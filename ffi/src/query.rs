@@ -131,7 +131,7 @@ fn pair_item(
 ///
 /// # Safety
 /// `options` is NULL or readable.
-unsafe fn template(options: *const gjkd_query_options) -> Result<Item, Failure> {
+pub(crate) unsafe fn template(options: *const gjkd_query_options) -> Result<Item, Failure> {
     // SAFETY: the caller's promise.
     let options = unsafe { options.as_ref() }.copied().unwrap_or_default();
     let options = options.checked()?;

@@ -8,7 +8,7 @@ use std::ffi::{CString, c_char};
 use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
-use rust_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle};
+use rust_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle, Steps};
 
 use crate::args::{checked_pose, opt_str, out, req_str, required, slice, slice_mut};
 use crate::handle::{gjkd_client, with_client};
@@ -39,6 +39,11 @@ impl gjkd_robot {
             handle,
             base,
         }
+    }
+
+    /// Number of moving joints.
+    pub(crate) fn dof(&self) -> usize {
+        self.handle.positions.len()
     }
 }
 
@@ -372,6 +377,40 @@ pub unsafe extern "C" fn gjkd_robot_joint(
             Ok(())
         }
     })
+}
+
+/// The steps of a path of `r`'s joint positions, `dof` per step, each
+/// checked as the server would (finite; within limits unless `clamp`), so
+/// that a refusal names its step and joint before anything is sent.
+pub(crate) fn path_steps<'a>(
+    r: &gjkd_robot,
+    positions: &'a [f64],
+    clamp: bool,
+) -> Result<Steps<'a>, Failure> {
+    let dof = r.handle.positions.len();
+    if dof == 0 {
+        return Err(Failure::invalid("the robot has no moving joint"));
+    }
+    let mode = if clamp {
+        LimitMode::Clamp
+    } else {
+        LimitMode::Reject
+    };
+    let mut checked = vec![0.0; dof];
+    for (s, step) in positions.chunks_exact(dof).enumerate() {
+        checked.copy_from_slice(step);
+        r.handle
+            .kinematics
+            .check_positions(&mut checked, mode)
+            .map_err(|e| {
+                let f = joint_failure(e);
+                Failure {
+                    message: format!("positions of step {s}: {}", f.message),
+                    ..f
+                }
+            })?;
+    }
+    Ok(Steps::joints(&r.handle, positions))
 }
 
 /// The failure of positions refused before anything is sent.

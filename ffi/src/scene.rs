@@ -5,10 +5,11 @@
 #![allow(non_camel_case_types)]
 
 use gjkd_proto::{PathMode, SceneKind, SceneRequest, SceneRow, scene_flags};
-use rust_client::{Item, ObjectId, SceneSummary};
+use rust_client::{Item, ObjectId, SceneSummary, Steps};
 
 use crate::args::{checked_pose, out, slice, slice_mut};
 use crate::handle::{gjkd_client, with_client};
+use crate::robots::{gjkd_robot, path_steps};
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::{gjkd_answer, gjkd_id, gjkd_pose};
 
@@ -164,6 +165,8 @@ struct Call<'a> {
     allowed: &'a [[gjkd_id; 2]],
     moving: &'a [gjkd_id],
     poses: &'a [gjkd_pose],
+    /// A path of joint positions, instead of `moving` and `poses`.
+    joints: Option<Steps<'a>>,
 }
 
 impl<'a> Call<'a> {
@@ -217,6 +220,7 @@ impl<'a> Call<'a> {
             allowed,
             moving: &[],
             poses: &[],
+            joints: None,
         })
     }
 
@@ -244,14 +248,18 @@ impl<'a> Call<'a> {
         for (i, p) in self.poses.iter().enumerate() {
             checked_pose(p, &format!("poses[{i}]"))?;
         }
-        let per_step = self.moving.len() + 1;
-        let steps = if self.moving.is_empty() {
-            0
-        } else {
-            self.poses.len() / self.moving.len()
+        let (per_step, steps) = match self.joints {
+            Some(j) => (j.items_per_step(), j.count()?),
+            None if self.moving.is_empty() => (1, 0),
+            None => (self.moving.len() + 1, self.poses.len() / self.moving.len()),
         };
-        let (members, allowed, moving, poses) =
-            (self.members, self.allowed, self.moving, self.poses);
+        let (members, allowed, moving, poses, joints) = (
+            self.members,
+            self.allowed,
+            self.moving,
+            self.poses,
+            self.joints,
+        );
         let count = members.len() + allowed.len() + steps * per_step;
         self.request.max_rows = u32::try_from(capacity).unwrap_or(u32::MAX);
         let item = |i: usize| {
@@ -264,6 +272,9 @@ impl<'a> Call<'a> {
             }
             let i = i - allowed.len();
             let (s, k) = (i / per_step, i % per_step);
+            if let Some(j) = joints {
+                return j.item(s, k);
+            }
             match moving.get(k) {
                 Some(&id) => Item {
                     a: id,
@@ -434,12 +445,7 @@ pub unsafe extern "C" fn gjkd_path(
         // SAFETY: the caller's promises.
         unsafe {
             with_client(client, |c| {
-                let (kind, mode) = match question {
-                    0 => (SceneKind::Clearance, PathMode::EveryStep),
-                    1 => (SceneKind::Within, PathMode::EveryStep),
-                    2 => (SceneKind::Within, PathMode::FirstHit),
-                    _ => return Err(Failure::invalid("question is no gjkd_path_question")),
-                };
+                let (kind, mode) = path_question(question)?;
                 if moving_count == 0 || step_count == 0 {
                     return Err(Failure::invalid("a path needs a moving object and a step"));
                 }
@@ -459,4 +465,77 @@ pub unsafe extern "C" fn gjkd_path(
             })
         }
     })
+}
+
+/// `gjkd_path()` along a motion given as joint positions of `robot`:
+/// `positions` holds `step_count` steps of the robot's moving joints
+/// (`dof` doubles each, in `gjkd_robot_joint()` order), `positions[s * dof
+/// + j]` joint `j` at step `s`. The server places the links by forward
+/// kinematics at each step and answers there; nothing moves on the server
+/// (the robot's stored joints and link poses stay as they were). A position
+/// outside its limits is refused, or moved to the nearest limit when
+/// `options->clamp` is true. The group is usually the robot itself
+/// (`group->id` its id, so that its allowed pairs apply).
+///
+/// Errors: as `gjkd_path()` (`GJKD_ERR_NULL_POINTER` for `positions` and
+/// `robot`), plus `GJKD_ERR_INVALID_ARGUMENT` for a robot without moving
+/// joints, no step, or a position NaN or infinite (last error code
+/// `GJKD_CODE_NON_FINITE_POSE`) or outside its limits without clamp
+/// (`GJKD_CODE_OUT_OF_LIMITS`), the message naming the step and joint:
+/// nothing is sent; `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`
+/// when the robot is gone from the server.
+///
+/// # Safety
+/// As `gjkd_clearance()`; `robot` NULL or live; `positions` NULL or
+/// `step_count * dof` doubles.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gjkd_path_joints(
+    client: *mut gjkd_client,
+    group: *const gjkd_group,
+    question: u32,
+    margin: f64,
+    robot: *const gjkd_robot,
+    positions: *const f64,
+    step_count: usize,
+    options: *const gjkd_scene_options,
+    rows: *mut gjkd_scene_row,
+    capacity: usize,
+    summary: *mut gjkd_scene_summary,
+) -> gjkd_status {
+    guard("gjkd_path_joints", || {
+        // SAFETY: the caller's promises.
+        unsafe {
+            with_client(client, |c| {
+                let (kind, mode) = path_question(question)?;
+                let r = robot.as_ref().ok_or_else(|| Failure::null("robot"))?;
+                if step_count == 0 {
+                    return Err(Failure::invalid("a path needs a step"));
+                }
+                let total = r
+                    .dof()
+                    .checked_mul(step_count)
+                    .ok_or_else(|| Failure::invalid("step_count * dof overflows"))?;
+                let positions = slice(positions, total, "positions")?;
+                let mut call = Call::new(kind, group, options)?;
+                call.request.path = mode as u32;
+                if kind == SceneKind::Within {
+                    call.request.margin = margin;
+                }
+                let clamp = call.request.flags & scene_flags::CLAMP != 0;
+                call.joints = Some(path_steps(r, positions, clamp)?);
+                call.run(c, rows, capacity, summary)
+            })
+        }
+    })
+}
+
+/// The scene question and path mode of a `gjkd_path_question` value.
+fn path_question(question: u32) -> Result<(SceneKind, PathMode), Failure> {
+    match question {
+        0 => Ok((SceneKind::Clearance, PathMode::EveryStep)),
+        1 => Ok((SceneKind::Within, PathMode::EveryStep)),
+        2 => Ok((SceneKind::Within, PathMode::FirstHit)),
+        _ => Err(Failure::invalid("question is no gjkd_path_question")),
+    }
 }

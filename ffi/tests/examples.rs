@@ -40,6 +40,34 @@ fn cpp_example_answers_match_the_analytic_distances() {
     let stdout = common::run_ok(&exe, &[&server.service]);
     assert_answers(&stdout);
     assert!(stdout.contains("lookup gives the id    1.0"), "{stdout}");
+    for line in [
+        "rows box-sphere below  3.500000000000",
+        "path: hanging          1.500000000000",
+        "rod still level        2.400000000000",
+    ] {
+        assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
+    }
+}
+
+#[test]
+fn pair_rows_example_answers_match_the_analytic_distances() {
+    let exe = common::compile(&["examples/pair_rows.c"], "pair_rows", false);
+    let server = Server::start("ffi-rows", &["--no-persist"]);
+    let stdout = common::run_ok(&exe, &[&server.service]);
+    for line in [
+        "box-sphere             1.500000000000",
+        "box lifted-sphere      8.500000000000",
+        "box-capsule            2.750000000000",
+        "sphere-capsule         3.250000000000",
+        "box-sphere point_b.x   2.500000000000",
+        "ball at x = 6          4.500000000000",
+        "unknown pair           GJKD_CODE_UNKNOWN_OBJECT",
+        "undefined pose bit: GJKD_ERR_INVALID_ARGUMENT: gjkd_query_pairs: queries[0]: flags 0x2a",
+    ] {
+        assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
+    }
+    assert!(!stdout.contains("WRONG"), "{stdout}");
+    assert_eq!(stdout.lines().last(), Some("ok"), "{stdout}");
 }
 
 #[test]

@@ -83,6 +83,8 @@ fn find_package_and_pkg_config_find_the_installed_library() {
             "{stdout}"
         );
     }
+    let stdout = common::run_ok(&build.join("pair_rows"), &[&server.service]);
+    assert_eq!(stdout.lines().last(), Some("ok"), "pair_rows:\n{stdout}");
     // A version newer than the installed one is refused.
     let too_new = dir.join("too-new");
     std::fs::create_dir_all(&too_new).unwrap();

@@ -19,8 +19,10 @@ Scene queries ask about a group of objects against everything the server
 holds, in one round trip, into a :class:`SceneRows` you own:
 ``client.clearance(group, out=rows)`` (each member's nearest other object),
 ``client.within(group, margin, out=rows)`` (every pair within a margin),
-``client.nearest(object, k, out=rows)`` and ``client.path(group, objects,
-poses, out=rows)`` (a question at every step of a candidate motion).
+``client.nearest(object, k, out=rows)``, ``client.path(group, objects,
+poses, out=rows)`` (a question at every step of a candidate motion) and
+``client.path_joints(robot, robot, positions, out=rows)`` (the same along a
+robot's joint positions).
 
 Example::
 
@@ -62,6 +64,7 @@ from ._native import (
     Client,
     Distances,
     Local,
+    MeshInfo,
     Robot,
     SceneRows,
     SceneSummary,
@@ -85,6 +88,7 @@ __all__ = [
     "InvalidInput",
     "IpcError",
     "Local",
+    "MeshInfo",
     "NotFound",
     "ProtocolError",
     "Refused",

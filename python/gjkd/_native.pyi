@@ -17,6 +17,7 @@ __all__ = [
     "Local",
     "MAX_NAME_LEN",
     "MAX_PIECES",
+    "MeshInfo",
     "PROTOCOL_VERSION",
     "Robot",
     "SceneRows",
@@ -271,6 +272,18 @@ class SceneSummary:
     def candidates(self) -> int:
         """Pairs the broadphase could not rule out."""
 
+@final
+class MeshInfo:
+    """What a mesh registration made (``info=`` of ``register_mesh``)."""
+
+    def __new__(cls) -> MeshInfo: ...
+    @property
+    def pieces(self) -> int:
+        """Convex pieces: 1 for a hull."""
+    @property
+    def deviation(self) -> float:
+        """A decomposition's largest deviation found from the mesh; 0 for a hull."""
+
 class _Objects:
     """The methods ``Client`` and ``Local`` share."""
 
@@ -337,6 +350,7 @@ class _Objects:
         decompose: Optional[int] = None,
         name: Optional[str] = None,
         pose: Optional[_Pose] = None,
+        info: Optional[MeshInfo] = None,
     ) -> int:
         """Registers a triangle mesh (its hull, or decomposed); returns its id."""
     def register_mesh_file(
@@ -347,6 +361,7 @@ class _Objects:
         decompose: Optional[int] = None,
         name: Optional[str] = None,
         pose: Optional[_Pose] = None,
+        info: Optional[MeshInfo] = None,
     ) -> int:
         """Registers the mesh of an STL, OBJ or COLLADA file; returns its id."""
     def remove(self, id: int) -> None:
@@ -495,6 +510,26 @@ class Client(_Objects):
         accept_relative: float = 0.0,
     ) -> SceneSummary:
         """A question at every step of a candidate motion."""
+    def path_joints(
+        self,
+        group: Union[int, Robot, _ArrayLike],
+        robot: Robot,
+        positions: _ArrayLike,
+        *,
+        out: SceneRows,
+        question: str = "clearance",
+        margin: float = 0.0,
+        clamp: bool = False,
+        allow: Optional[_ArrayLike] = None,
+        cutoff: Optional[float] = None,
+        tolerance: float = ...,
+        max_iterations: int = ...,
+        warm_start: bool = True,
+        motion_bounds: bool = True,
+        accept_absolute: float = 0.0,
+        accept_relative: float = 0.0,
+    ) -> SceneSummary:
+        """A question at every step of a robot's motion given as ``(S, dof)`` joint positions."""
     def __enter__(self) -> Client: ...
     def __exit__(
         self,

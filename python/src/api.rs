@@ -386,9 +386,11 @@ macro_rules! backend_methods {
             /// `decompose=R` makes it a compound of convex pieces instead
             /// (V-HACD at resolution `R`, 64 is a fair start; at most
             /// `MAX_PIECES` pieces). `name` and `pose` as for `register`.
-            /// Returns its id.
+            /// `info`: a `gjkd.MeshInfo`, filled with the pieces made and,
+            /// for a decomposition, its largest deviation found from the
+            /// mesh. Returns its id.
             #[pyo3(signature = (vertices, triangles = None, *, scale = None,
-                decompose = None, name = None, pose = None))]
+                decompose = None, name = None, pose = None, info = None))]
             #[allow(clippy::too_many_arguments)]
             fn register_mesh(
                 &mut self,
@@ -399,17 +401,19 @@ macro_rules! backend_methods {
                 decompose: Option<u32>,
                 name: Option<&str>,
                 pose: Option<&Bound<'_, PyAny>>,
+                info: Option<&Bound<'_, crate::meshes::MeshInfo>>,
             ) -> PyResult<u64> {
-                let args = crate::meshes::MeshArgs { scale, decompose, name, pose };
+                let args = crate::meshes::MeshArgs { scale, decompose, name, pose, info };
                 crate::meshes::register_mesh(self, py, vertices, triangles, &args)
             }
 
             /// Registers the mesh in the file at `path` (binary or ASCII
-            /// STL, OBJ, COLLADA `.dae`); `scale`, `decompose`, `name` and
-            /// `pose` as for `register_mesh`. A file that is missing or not
+            /// STL, OBJ, COLLADA `.dae`); `scale`, `decompose`, `name`,
+            /// `pose` and `info` as for `register_mesh`. A file that is missing or not
             /// a mesh raises `InvalidInput` (`field="path"`). Returns its id.
             #[pyo3(signature = (path, *, scale = None, decompose = None, name = None,
-                pose = None))]
+                pose = None, info = None))]
+            #[allow(clippy::too_many_arguments)]
             fn register_mesh_file(
                 &mut self,
                 py: Python<'_>,
@@ -418,8 +422,9 @@ macro_rules! backend_methods {
                 decompose: Option<u32>,
                 name: Option<&str>,
                 pose: Option<&Bound<'_, PyAny>>,
+                info: Option<&Bound<'_, crate::meshes::MeshInfo>>,
             ) -> PyResult<u64> {
-                let args = crate::meshes::MeshArgs { scale, decompose, name, pose };
+                let args = crate::meshes::MeshArgs { scale, decompose, name, pose, info };
                 crate::meshes::register_mesh_file(self, py, path, &args)
             }
 

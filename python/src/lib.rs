@@ -48,6 +48,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<batch::Answer>()?;
     m.add_class::<scene::SceneRows>()?;
     m.add_class::<scene::Summary>()?;
+    m.add_class::<meshes::MeshInfo>()?;
     m.add_function(wrap_pyfunction!(serve, m)?)?;
     m.add_function(wrap_pyfunction!(error_codes, m)?)?;
     m.add("DEFAULT_TOLERANCE", gjkd_proto::DEFAULT_TOLERANCE)?;

@@ -27,6 +27,53 @@ pub struct MeshArgs<'a, 'py> {
     pub name: Option<&'a str>,
     /// Initial pose.
     pub pose: Option<&'a Bound<'py, PyAny>>,
+    /// Where to write what the registration made, if anywhere.
+    pub info: Option<&'a Bound<'py, MeshInfo>>,
+}
+
+/// What a mesh registration made: pass one as `info=` to `register_mesh`
+/// or `register_mesh_file`, and read it after the call (it is written only
+/// when the registration succeeds).
+///
+/// - `pieces`: convex pieces, 1 for a hull;
+/// - `deviation`: for a decomposition, the largest distance found by which
+///   the pieces reach beyond the mesh (so how much less distance they may
+///   report than the mesh itself); 0 for a hull, which never reports more
+///   distance than the mesh and never less than its convex hull.
+#[pyclass(module = "gjkd", name = "MeshInfo")]
+#[derive(Default)]
+pub struct MeshInfo {
+    pieces: usize,
+    deviation: f64,
+}
+
+#[pymethods]
+impl MeshInfo {
+    /// Zeroed, to be filled by a registration.
+    #[new]
+    fn new() -> Self {
+        MeshInfo::default()
+    }
+
+    /// Convex pieces: 1 for a hull.
+    #[getter]
+    fn pieces(&self) -> usize {
+        self.pieces
+    }
+
+    /// The largest deviation found of a decomposition from the mesh; 0 for
+    /// a hull.
+    #[getter]
+    fn deviation(&self) -> f64 {
+        self.deviation
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "gjkd.MeshInfo(pieces={}, deviation={:e})",
+            self.pieces, self.deviation
+        )
+    }
 }
 
 /// The scale argument: `None` (1), one float, or three.
@@ -121,16 +168,30 @@ fn shaped(py: Python<'_>, mesh: &Mesh, decompose: Option<u32>) -> PyResult<Shape
             ),
         ));
     }
-    Ok(Shaped::Pieces(Pieces {
-        offsets: vec![Pose::IDENTITY; parts.pieces.len()],
-        shapes: parts.pieces.into_iter().map(polytope).collect(),
-    }))
+    Ok(Shaped::Pieces(
+        Pieces {
+            offsets: vec![Pose::IDENTITY; parts.pieces.len()],
+            shapes: parts.pieces.into_iter().map(polytope).collect(),
+        },
+        parts.deviation,
+    ))
+}
+
+impl MeshInfo {
+    /// What a hull registration made.
+    fn default_hull() -> Self {
+        MeshInfo {
+            pieces: 1,
+            deviation: 0.0,
+        }
+    }
 }
 
 /// A mesh made ready to register.
 enum Shaped {
     Hull(Shape),
-    Pieces(Pieces),
+    /// The pieces and their largest deviation found from the mesh.
+    Pieces(Pieces, f64),
 }
 
 /// Registers `mesh` with `args`; returns its id.
@@ -145,12 +206,24 @@ fn register(
     let mesh = mesh
         .scaled(factors)
         .map_err(|e| invalid(py, "scale", None, e.to_string()))?;
-    match shaped(py, &mesh, args.decompose)? {
-        Shaped::Hull(shape) => backend.register(py, &Registration::Convex(&shape), args.name, pose),
-        Shaped::Pieces(pieces) => {
-            backend.register(py, &Registration::Compound(&pieces), args.name, pose)
+    let (id, made) = match shaped(py, &mesh, args.decompose)? {
+        Shaped::Hull(shape) => {
+            let id = backend.register(py, &Registration::Convex(&shape), args.name, pose)?;
+            (id, MeshInfo::default_hull())
         }
+        Shaped::Pieces(pieces, deviation) => {
+            let made = MeshInfo {
+                pieces: pieces.shapes.len(),
+                deviation,
+            };
+            let id = backend.register(py, &Registration::Compound(&pieces), args.name, pose)?;
+            (id, made)
+        }
+    };
+    if let Some(info) = args.info {
+        *info.borrow_mut() = made;
     }
+    Ok(id)
 }
 
 /// Registers the mesh of `vertices` (`(N, 3)` float64) and `triangles`

@@ -8,7 +8,7 @@ use numpy::{PyArray1, PyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gjkd_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle};
+use gjkd_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle, Steps};
 use nalgebra::Isometry3;
 
 use crate::api::checked_pose;
@@ -240,6 +240,52 @@ impl Robot {
         }
         Ok(slice(&a)?.to_vec())
     }
+}
+
+/// The steps of a path of `robot`'s joint positions, `dof` per step, each
+/// checked as the server would (finite; within limits unless `clamp`), so
+/// that a refusal names its step (`index`) and joint before anything is
+/// sent.
+pub fn path_steps<'a>(
+    py: Python<'_>,
+    robot: &Robot,
+    positions: &'a [f64],
+    clamp: bool,
+) -> PyResult<Steps<'a>> {
+    let dof = robot.handle.positions.len();
+    if dof == 0 {
+        return Err(invalid(
+            py,
+            "robot",
+            None,
+            "the robot has no moving joint".into(),
+        ));
+    }
+    let mode = if clamp {
+        LimitMode::Clamp
+    } else {
+        LimitMode::Reject
+    };
+    let mut checked = vec![0.0; dof];
+    for (step, q) in positions.chunks_exact(dof).enumerate() {
+        checked.copy_from_slice(q);
+        if let Err(e) = robot.handle.kinematics.check_positions(&mut checked, mode) {
+            let code = match e {
+                JointError::OutOfLimits { .. } => Some(ErrorCode::OutOfLimits),
+                JointError::NotFinite(_) => Some(ErrorCode::NonFinitePose),
+                _ => None,
+            };
+            return Err(Raise {
+                kind: Kind::InvalidInput,
+                message: format!("positions of step {step}: {e}"),
+                code,
+                field: Some("positions"),
+                index: Some(step),
+            }
+            .into_err(py));
+        }
+    }
+    Ok(Steps::joints(&robot.handle, positions))
 }
 
 /// `gjkd.NotFound` about `field`, without a server code.

@@ -2,17 +2,18 @@
 //! scene in one round trip (`clearance`, `within`, `nearest`, `path`), the
 //! rows written into a caller-owned `gjkd.SceneRows`.
 
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyAnyMethods;
 
-use gjkd_client::{ClientError, Item, ObjectId, SceneRow};
+use gjkd_client::{ClientError, Item, ObjectId, SceneRow, Steps};
 use gjkd_proto::{PathMode, SceneKind, SceneRequest, scene_flags};
 
-use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array, pose_array};
+use crate::arrays::{IdArray, Ids, PoseArray, Poses, f64_array, id_array, pose_array, slice};
 use crate::batch::Distances;
 use crate::client::Client;
 use crate::errors::{self, invalid};
+use crate::robots::{Robot, path_steps};
 
 /// Room for the rows of scene answers (`Client.clearance`, `within`,
 /// `nearest`, `path`): `SceneRows(n)` holds `n` rows, reused from call to
@@ -187,6 +188,8 @@ struct Options {
     accept_absolute: f64,
     accept_relative: f64,
     cutoff: Option<f64>,
+    /// Clamp a path's joint positions to their limits.
+    clamp: bool,
 }
 
 impl Options {
@@ -208,6 +211,9 @@ impl Options {
             r.flags |= scene_flags::CUTOFF;
             r.margin = c;
         }
+        if self.clamp {
+            r.flags |= scene_flags::CLAMP;
+        }
         r
     }
 }
@@ -221,6 +227,9 @@ enum GroupArg<'py> {
 fn group_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<GroupArg<'py>> {
     if let Ok(id) = obj.extract::<u64>() {
         return Ok(GroupArg::Id(id));
+    }
+    if let Ok(robot) = obj.cast::<Robot>() {
+        return Ok(GroupArg::Id(robot.borrow().handle.id.raw()));
     }
     let ids = id_array(obj, "group")?;
     if ids.shape().len() != 1 {
@@ -261,6 +270,8 @@ struct Inputs<'a> {
     allowed: Option<Ids<'a>>,
     moving: Option<Ids<'a>>,
     poses: Option<Poses<'a>>,
+    /// A path of joint positions, instead of `moving` and `poses`.
+    joints: Option<Steps<'a>>,
 }
 
 impl Inputs<'_> {
@@ -275,6 +286,9 @@ impl Inputs<'_> {
     /// Number of items.
     fn len(&self) -> usize {
         let (m, a, n, p) = self.counts();
+        if let Some(j) = self.joints {
+            return m + a + j.count().unwrap_or(0) * j.items_per_step();
+        }
         let steps = p.checked_div(n).unwrap_or(0);
         m + a + steps * (n + 1)
     }
@@ -294,6 +308,10 @@ impl Inputs<'_> {
             );
         }
         let i = i - a;
+        if let Some(j) = self.joints {
+            let per = j.items_per_step();
+            return j.item(i / per, i % per);
+        }
         let (s, k) = (i / (n + 1), i % (n + 1));
         match (self.moving, self.poses) {
             (Some(moving), Some(poses)) if k < n => {
@@ -376,6 +394,31 @@ fn run(
         .map_err(|e: ClientError| errors::client(py, e, None))
 }
 
+/// The scene question and path mode of a path's `question` argument.
+fn path_question(py: Python<'_>, question: &str) -> PyResult<(SceneKind, PathMode)> {
+    match question {
+        "clearance" => Ok((SceneKind::Clearance, PathMode::EveryStep)),
+        "within" => Ok((SceneKind::Within, PathMode::EveryStep)),
+        "first_hit" => Ok((SceneKind::Within, PathMode::FirstHit)),
+        other => Err(invalid(
+            py,
+            "question",
+            None,
+            format!("question must be 'clearance', 'within' or 'first_hit', not {other:?}"),
+        )),
+    }
+}
+
+/// The motion of a path question, if any.
+enum PathArg<'a, 'py> {
+    /// Not a path.
+    None,
+    /// Poses of the moving objects, step after step.
+    Poses(PathMode, IdArray<'py>, PoseArray<'py>),
+    /// A robot's joint positions, step after step, checked.
+    Joints(PathMode, Steps<'a>),
+}
+
 /// Reads the group and allowed pairs, then runs.
 #[allow(clippy::too_many_arguments)]
 fn ask<'py>(
@@ -384,7 +427,7 @@ fn ask<'py>(
     kind: SceneKind,
     group: &Bound<'py, PyAny>,
     allow: Option<&Bound<'py, PyAny>>,
-    path: Option<(PathMode, IdArray<'py>, PoseArray<'py>)>,
+    path: PathArg<'_, 'py>,
     options: &Options,
     edit: impl FnOnce(&mut SceneRequest),
     out: &Bound<'py, SceneRows>,
@@ -397,8 +440,9 @@ fn ask<'py>(
     };
     let mut request = options.request(kind, id);
     edit(&mut request);
+    let mut joints = None;
     let (moving, poses) = match &path {
-        Some((mode, moving, poses)) => {
+        PathArg::Poses(mode, moving, poses) => {
             request.path = *mode as u32;
             let (moving, poses) = (moving.slice()?, poses.poses()?);
             if moving.len() == 0 || poses.len() == 0 || poses.len() % moving.len() != 0 {
@@ -415,13 +459,19 @@ fn ask<'py>(
             }
             (Some(moving), Some(poses))
         }
-        None => (None, None),
+        PathArg::Joints(mode, steps) => {
+            request.path = *mode as u32;
+            joints = Some(*steps);
+            (None, None)
+        }
+        PathArg::None => (None, None),
     };
     let inputs = Inputs {
         members,
         allowed: allow.as_ref().map(|a| a.slice()).transpose()?,
         moving,
         poses,
+        joints,
     };
     run(py, client, request, inputs, out)
 }
@@ -464,6 +514,7 @@ impl Client {
             accept_absolute,
             accept_relative,
             cutoff,
+            clamp: false,
         };
         ask(
             py,
@@ -471,7 +522,7 @@ impl Client {
             SceneKind::Clearance,
             group,
             allow,
-            None,
+            PathArg::None,
             &options,
             |_| {},
             out,
@@ -506,6 +557,7 @@ impl Client {
             accept_absolute,
             accept_relative,
             cutoff: None,
+            clamp: false,
         };
         let edit = |r: &mut SceneRequest| {
             r.margin = margin;
@@ -519,7 +571,7 @@ impl Client {
             SceneKind::Within,
             group,
             allow,
-            None,
+            PathArg::None,
             &options,
             edit,
             out,
@@ -556,6 +608,7 @@ impl Client {
             accept_absolute,
             accept_relative,
             cutoff,
+            clamp: false,
         };
         let edit = |r: &mut SceneRequest| r.k = k;
         ask(
@@ -564,7 +617,7 @@ impl Client {
             SceneKind::Nearest,
             object,
             allow,
-            None,
+            PathArg::None,
             &options,
             edit,
             out,
@@ -599,19 +652,7 @@ impl Client {
         accept_absolute: f64,
         accept_relative: f64,
     ) -> PyResult<Summary> {
-        let (kind, mode) = match question {
-            "clearance" => (SceneKind::Clearance, PathMode::EveryStep),
-            "within" => (SceneKind::Within, PathMode::EveryStep),
-            "first_hit" => (SceneKind::Within, PathMode::FirstHit),
-            other => {
-                return Err(invalid(
-                    py,
-                    "question",
-                    None,
-                    format!("question must be 'clearance', 'within' or 'first_hit', not {other:?}"),
-                ));
-            }
-        };
+        let (kind, mode) = path_question(py, question)?;
         let moving = id_array(objects, "objects")?;
         if moving.shape().len() != 1 {
             return Err(invalid(
@@ -630,13 +671,81 @@ impl Client {
             accept_absolute,
             accept_relative,
             cutoff,
+            clamp: false,
         };
         let edit = |r: &mut SceneRequest| {
             if kind == SceneKind::Within {
                 r.margin = margin;
             }
         };
-        let path = Some((mode, moving, poses));
+        let path = PathArg::Poses(mode, moving, poses);
+        ask(py, self, kind, group, allow, path, &options, edit, out)
+    }
+
+    /// `path` along a motion of `robot` given as joint positions: `positions`
+    /// is `(S, dof)` float64 (or `(dof,)` for one step), row `s` the moving
+    /// joints' positions (in `robot.joint_names` order) at step `s`. The
+    /// server places the links by forward kinematics at each step and
+    /// answers there; nothing moves on the server (the robot keeps its
+    /// joints). A position outside its limits raises `InvalidInput`
+    /// (`OUT_OF_LIMITS`, `index` its step) unless `clamp`, which moves it
+    /// to the nearest limit; a NaN raises (`NON_FINITE_POSE`). `group` is
+    /// usually the robot (`robot.id`, or the `Robot` itself, so that its
+    /// allowed pairs apply). Other arguments as `path`.
+    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn path_joints<'py>(
+        &mut self,
+        py: Python<'py>,
+        group: &Bound<'py, PyAny>,
+        robot: PyRef<'py, Robot>,
+        positions: &Bound<'py, PyAny>,
+        out: &Bound<'py, SceneRows>,
+        question: &str,
+        margin: f64,
+        clamp: bool,
+        allow: Option<&Bound<'py, PyAny>>,
+        cutoff: Option<f64>,
+        tolerance: f64,
+        max_iterations: u32,
+        warm_start: bool,
+        motion_bounds: bool,
+        accept_absolute: f64,
+        accept_relative: f64,
+    ) -> PyResult<Summary> {
+        let (kind, mode) = path_question(py, question)?;
+        let array = f64_array(positions, "positions")?;
+        let dof = robot.handle.positions.len();
+        let shape = array.shape().to_vec();
+        if !matches!(shape.as_slice(), [d] | [_, d] if *d == dof) || shape.contains(&0) {
+            return Err(invalid(
+                py,
+                "positions",
+                None,
+                format!(
+                    "positions must have shape (S, {dof}) (a row of the robot's {dof} moving \
+                     joints per step, at least one step), got {:?}",
+                    shape
+                ),
+            ));
+        }
+        let steps = path_steps(py, &robot, slice(&array)?, clamp)?;
+        let options = Options {
+            tolerance,
+            max_iterations,
+            warm_start,
+            motion_bounds,
+            accept_absolute,
+            accept_relative,
+            cutoff,
+            clamp,
+        };
+        let edit = |r: &mut SceneRequest| {
+            if kind == SceneKind::Within {
+                r.margin = margin;
+            }
+        };
+        let path = PathArg::Joints(mode, steps);
         ask(py, self, kind, group, allow, path, &options, edit, out)
     }
 }

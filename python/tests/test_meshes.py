@@ -67,7 +67,9 @@ def test_mesh_file_hull_distance(objects: Any, tmp_path: pathlib.Path, fmt: str)
         path, v, t
     )
     # Scaled 2x along x: the cube spans x in [-1, 1].
-    mesh = objects.register_mesh_file(path, scale=[2.0, 1.0, 1.0])
+    info = gjkd.MeshInfo()
+    mesh = objects.register_mesh_file(path, scale=[2.0, 1.0, 1.0], info=info)
+    assert (info.pieces, info.deviation) == (1, 0.0)
     ball = objects.register_sphere(0.25, pose=at(3.0))
     assert abs(objects.distance(mesh, ball).distance - 1.75) < 1e-9
     # Along y the scale is 1: the face is at 0.5.
@@ -115,8 +117,22 @@ def l_shape() -> tuple[np.ndarray, np.ndarray]:
 
 def test_decomposition_follows_a_concave_mesh(objects: Any) -> None:
     v, t = l_shape()
-    hull = objects.register_mesh(v, t)
-    parts = objects.register_mesh(v, t, decompose=32)
+    hull_info, parts_info = gjkd.MeshInfo(), gjkd.MeshInfo()
+    assert (hull_info.pieces, hull_info.deviation) == (0, 0.0)
+    hull = objects.register_mesh(v, t, info=hull_info)
+    parts = objects.register_mesh(v, t, decompose=32, info=parts_info)
+    assert (hull_info.pieces, hull_info.deviation) == (1, 0.0)
+    # A concave L needs two pieces at least. The hull fills the notch up to
+    # x + y = 4, sqrt(2) beyond the mesh's inner corner: the pieces reach
+    # out less than that.
+    assert parts_info.pieces >= 2
+    assert 0.0 <= parts_info.deviation < math.sqrt(2.0)
+    # A failed registration leaves the info as it was.
+    before = (parts_info.pieces, parts_info.deviation)
+    with pytest.raises(gjkd.InvalidInput):
+        objects.register_mesh(v, t, decompose=0, info=parts_info)
+    assert (parts_info.pieces, parts_info.deviation) == before
+    assert "pieces=" in repr(parts_info)
     # A small ball in the notch: inside the hull, clear of the mesh.
     ball = objects.register_sphere(0.1, pose=at(1.8, 1.8, 0.5))
     assert objects.distance(hull, ball).distance == 0.0

@@ -115,3 +115,86 @@ def test_whole_request_errors_raise(client: gjkd.Client, scene) -> None:
     with pytest.raises(gjkd.InvalidInput):
         client.path(group, group, np.array([IDENTITY, IDENTITY]), out=rows, question="nope")
     assert gjkd.Status.BOUNDED == 6
+
+
+# A rod of radius 0.1 and length 1 hanging from the origin along -z, swung
+# about y by one joint limited to [-2, 2].
+PENDULUM = """<robot name="pendulum">
+  <link name="mount"/>
+  <link name="rod"><collision><origin xyz="0 0 -0.5"/>
+    <geometry><cylinder radius="0.1" length="1"/></geometry></collision></link>
+  <joint name="swing" type="revolute"><parent link="mount"/><child link="rod"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+</robot>"""
+
+BALL = np.array([0.0, 0.0, -3.0])
+
+
+def rod_to_ball(q: float) -> float:
+    """Closed form: the rod's axis is u = (-sin q, 0, -cos q) from the
+    origin; the ball (radius 0.5) is nearest its side or a cap's rim."""
+    u = np.array([-np.sin(q), 0.0, -np.cos(q)])
+    t = float(BALL @ u)
+    radial = float(np.linalg.norm(BALL - t * u))
+    axial = -t if t < 0.0 else max(t - 1.0, 0.0)
+    return float(np.hypot(axial, max(radial - 0.1, 0.0))) - 0.5
+
+
+@pytest.fixture()
+def pendulum(client: gjkd.Client) -> tuple[gjkd.Robot, int, int]:
+    robot = client.register_robot(unique_service("pendulum"), urdf_text=PENDULUM)
+    ball = client.register_sphere(0.5, pose=BALL.tolist() + [0.0, 0.0, 0.0, 1.0])
+    return robot, robot.link("rod"), ball
+
+
+def test_path_along_joint_positions_matches_the_closed_form(client: gjkd.Client, pendulum) -> None:
+    robot, rod, ball = pendulum
+    level = np.pi / 2
+    client.set_joints(robot, [level])
+    assert exact(client, rod, ball) == pytest.approx(2.4, abs=1e-9)
+    qs = np.array([[0.0], [0.5], [level], [-1.0], [2.0]])
+    rows = gjkd.SceneRows(8)
+    s = client.path_joints(robot, robot, qs, out=rows)
+    assert s.steps == 5 and s.written == 5
+    assert rod_to_ball(0.0) == pytest.approx(1.5, abs=1e-12)
+    for k, q in enumerate(qs[:, 0]):
+        assert (rows.a[k], rows.b[k], rows.step[k]) == (rod, ball, k)
+        assert rows.distance[k] == pytest.approx(rod_to_ball(q), abs=1e-9)
+        assert rows.lower[k] <= rows.distance[k] <= rows.upper[k]
+    # Nothing moved on the server: the rod is still level.
+    assert exact(client, rod, ball) == pytest.approx(2.4, abs=1e-9)
+    np.testing.assert_array_equal(robot.positions, [level])
+    # First hit within 1.6: at q = 0.2 (about 1.50 from the ball).
+    steps = np.array([[level], [1.0], [0.2], [0.0]])
+    assert rod_to_ball(1.0) > 1.6 > rod_to_ball(0.2)
+    hit = client.path_joints(robot.id, robot, steps, out=rows, question="first_hit", margin=1.6)
+    assert hit.first_hit == 2 and hit.written == 1
+    assert rows.distance[0] == pytest.approx(rod_to_ball(0.2), abs=1e-9)
+    # One step may be given as a (dof,) row; clamp moves 2.5 to the limit 2.
+    one = client.path_joints(robot, robot, np.array([2.5]), out=rows, clamp=True)
+    assert one.steps == 1
+    assert rows.distance[0] == pytest.approx(rod_to_ball(2.0), abs=1e-9)
+
+
+def test_path_along_joint_positions_refuses_bad_positions(client: gjkd.Client, pendulum) -> None:
+    robot, _, _ = pendulum
+    rows = gjkd.SceneRows(4)
+    with pytest.raises(gjkd.InvalidInput) as e:
+        client.path_joints(robot, robot, np.array([[0.0], [2.5]]), out=rows)
+    assert e.value.code == gjkd.ErrorCode.OUT_OF_LIMITS
+    assert e.value.field == "positions" and e.value.index == 1
+    assert "swing" in str(e.value)
+    with pytest.raises(gjkd.InvalidInput) as e:
+        client.path_joints(robot, robot, np.array([[np.nan]]), out=rows)
+    assert e.value.code == gjkd.ErrorCode.NON_FINITE_POSE and e.value.index == 0
+    for shape in [(3, 2), (0, 1), (2,)]:
+        with pytest.raises(gjkd.InvalidInput) as e:
+            client.path_joints(robot, robot, np.zeros(shape), out=rows)
+        assert e.value.field == "positions"
+    with pytest.raises(gjkd.InvalidInput):
+        client.path_joints(robot, robot, np.zeros((1, 1), dtype=np.float32), out=rows)
+    with pytest.raises(gjkd.InvalidInput) as e:
+        client.path_joints(robot, robot, [[0.0]], out=rows, question="nope")
+    assert e.value.field == "question"
+    with pytest.raises(TypeError):
+        client.path_joints(robot, robot.id, [[0.0]], out=rows)  # type: ignore[arg-type]

@@ -4,8 +4,8 @@
  *
  * Most calls fail before reaching the server (each failure builds a new
  * last-error message and frees the old one); one in ROUND_TRIP_EVERY is a
- * round trip (a set_poses batch, a distances batch, a failed lookup, a
- * robot's joints set), and a few client and robot handles are opened and
+ * round trip (a set_poses batch, a distances and a query_pairs batch, a
+ * failed lookup, a robot's joints set), and a few client and robot handles are opened and
  * closed.
  */
 #include <math.h>
@@ -68,6 +68,9 @@ int main(int argc, char **argv) {
         pairs[2 * i] = ids[i];
         pairs[2 * i + 1] = ids[(i + 1) % BATCH];
     }
+    gjkd_pair_query rows[BATCH];
+    gjkd_result results[BATCH];
+    for (int i = 0; i < BATCH; i++) rows[i] = gjkd_pair_query_of(pairs[2 * i], pairs[2 * i + 1], NULL);
     gjkd_robot *robot = NULL;
     must(gjkd_register_robot_text(c, "leaky", URDF, NULL, NULL, NULL, NULL, &robot), "robot");
     for (int h = 0; h < HANDLES; h++) {
@@ -107,6 +110,11 @@ int main(int argc, char **argv) {
                     fprintf(stderr, "distance %.17g, expected 1\n", distance[0]);
                     return 4;
                 }
+                must(gjkd_query_pairs(c, rows, BATCH, results), "query_pairs");
+                if (fabs(results[0].distance - 1.0) > 1e-9) {
+                    fprintf(stderr, "row distance %.17g, expected 1\n", results[0].distance);
+                    return 4;
+                }
                 break;
             default:
                 must_fail(gjkd_lookup(c, "absent", &found), GJKD_ERR_REJECTED, "lookup");
@@ -114,7 +122,11 @@ int main(int argc, char **argv) {
             round_trips++;
             continue;
         }
-        switch (k % 5) {
+        switch (k % 6) {
+        case 5:
+            must_fail(gjkd_query_pairs(c, rows, BATCH, NULL), GJKD_ERR_NULL_POINTER,
+                      "null rows out");
+            break;
         case 3:
             must_fail(gjkd_set_joints(c, robot, far, 1, NULL, false), GJKD_ERR_INVALID_ARGUMENT,
                       "out of limits");

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's tests: makes (or reuses) a virtual environment, installs
-# maturin, numpy, pytest and mypy, builds the package into it, then runs
-# pytest. Extra arguments go to pytest.
+# maturin, numpy, pytest, mypy and ruff, checks the Python sources' format and
+# lints, builds the package into it, then runs pytest. Extra arguments go to
+# pytest.
 #
 # By default the package is built by `maturin develop` in the dev profile,
 # in the workspace's target directory: it reuses what `cargo test` built, so
@@ -20,9 +21,14 @@ if [ ! -x "$venv/bin/python" ]; then
   echo "== creating $venv"
   "$python" -m venv "$venv"
 fi
-echo "== installing maturin, numpy, pytest and mypy"
+echo "== installing maturin, numpy, pytest, mypy and ruff"
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet "maturin>=1.7,<2" "numpy>=1.21" "pytest>=7" "mypy>=1.10"
+"$venv/bin/python" -m pip install --quiet "maturin>=1.7,<2" "numpy>=1.21" "pytest>=7" "mypy>=1.10" \
+  "ruff==0.17.6"
+# Pinned: a newer ruff may format differently and fail a tree that was clean.
+echo "== ruff format --check, ruff check"
+"$venv/bin/ruff" format --quiet --check "$here"
+"$venv/bin/ruff" check --quiet "$here"
 if [ "${GJKD_PY_INSTALL:-develop}" = pip ]; then
   "$venv/bin/python" -m pip install --quiet "$here"
 else

@@ -7,9 +7,9 @@ from typing import Iterator
 
 import numpy as np
 import pytest
-from conftest import unique_service
 
 import gjkd
+from conftest import unique_service
 
 IDENTITY = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
 
@@ -62,9 +62,7 @@ def test_within_truncates_into_a_short_buffer(client: gjkd.Client, scene) -> Non
     group, boxes = scene
     rows = gjkd.SceneRows(16)
     s = client.within(group, 3.2, out=rows)
-    want = sorted(
-        (a, b) for a in group for b in boxes if exact(client, a, b) <= 3.2
-    )
+    want = sorted((a, b) for a in group for b in boxes if exact(client, a, b) <= 3.2)
     assert sorted(zip(rows.a[: s.written].tolist(), rows.b[: s.written].tolist())) == want
     short = gjkd.SceneRows(1)
     t = client.within(group, 3.2, out=short)

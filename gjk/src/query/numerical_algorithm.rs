@@ -146,6 +146,13 @@ impl ConvexPair<'_> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
+        // A warm start is near the answer already: seeded after its first
+        // iterate.
+        let seed_after = if warm.is_some() {
+            self.seed_after.min(1)
+        } else {
+            self.seed_after
+        };
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -219,8 +226,16 @@ impl ConvexPair<'_> {
                     None => continue,
                 }
             }
-            // Step (4).
+            // Step (4), or the seed in its place.
             state.lower = lower;
+            if state.iterations == seed_after
+                && let Some((pairs, len)) = self.newton_seed(&solution.v)
+            {
+                let (points, len) = self.seed_vertices(&pairs[..len]);
+                reset_simplex::<AVX2>(simplex, &points[..len]);
+                state.previous = None;
+                continue;
+            }
             state.previous = Some((solution, v2));
             push_vertex::<AVX2>(simplex, solution.mask, support_point);
         }

@@ -33,7 +33,15 @@ pub(super) struct ConvexPair<'s> {
     /// How far below the true support value the f32 search may land, as a
     /// distance times `scale`: 0 in f64.
     pub(super) single_slack: f64,
+    /// The iteration after which the run is seeded by Newton's method on
+    /// the nearest points' direction (see `newton_seed`): 0 (never) unless
+    /// a piece is a cylinder.
+    pub(super) seed_after: u32,
 }
+
+/// The plain iterations a cold run of a pair with a cylinder takes before
+/// it is seeded: enough for a direction near the answer's.
+pub(super) const COLD_SEED_AFTER: u32 = 2;
 
 /// Whether `iso` is the identity, exactly.
 #[inline(always)]
@@ -171,6 +179,9 @@ impl<'s> ConvexPair<'s> {
             inv_scale,
             single_precision,
             single_slack,
+            seed_after: u32::from(
+                a.cylinder_dimensions().is_some() || b.cylinder_dimensions().is_some(),
+            ) * COLD_SEED_AFTER,
         }
     }
 

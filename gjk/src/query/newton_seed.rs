@@ -144,12 +144,39 @@ fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
     })
 }
 
-/// A running Newton solve: the direction, what each shape's kinks showed,
-/// and the constraints they impose.
+/// A running Newton solve: the direction, each shape's kinks (a
+/// cylinder's side, a polytope's vertices) and the edges they give.
+#[derive(Default)]
 struct Solve {
     u: Vector3<f64>,
+    /// Whether the direction is held on each cylinder's side kink, and
+    /// whether that kink was found not to hold the answer.
+    side: [bool; 2],
+    off_side: [bool; 2],
     kinks: [Kinks; 2],
-    constraints: Constraints,
+    /// Edges of the polytopes' kinks (differences of their vertices).
+    edges: [Vector3<f64>; 2],
+    edge_count: usize,
+    /// Where the answer met two held sides' face: each side's weight from
+    /// the cap it was found at (`this_top`) towards the other.
+    face_weights: Option<[f64; 2]>,
+    this_top: [bool; 2],
+}
+
+impl Solve {
+    /// The constraints: each held side's axis, then the polytope edges.
+    fn constraints(&self, touches: &[Touch; 2]) -> Constraints {
+        let mut out = Constraints::default();
+        for k in 0..2 {
+            if self.side[k] {
+                out.add(touches[k].axis);
+            }
+        }
+        for edge in &self.edges[..self.edge_count] {
+            out.add(*edge);
+        }
+        out
+    }
 }
 
 impl ConvexPair<'_> {
@@ -179,54 +206,117 @@ impl ConvexPair<'_> {
         }
         let mut solve = Solve {
             u: -v / norm,
-            kinks: [Kinks::default(); 2],
-            constraints: Constraints::default(),
+            ..Solve::default()
         };
         let mut last: Option<[Touch; 2]> = None;
         for _ in 0..MAX_STEPS {
             let touches = self.touches(&solve.u)?;
+            let constraints = solve.constraints(&touches);
             if let Some(previous) = last
-                && self.note_kinks(&mut solve, &previous, &touches)
+                && self.note_vertex_kinks(&mut solve, &previous, &touches)
             {
-                solve.u = solve.constraints.project(&solve.u)?;
+                solve.u = solve.constraints(&touches).project(&solve.u)?;
                 last = None;
                 continue;
             }
             last = Some(touches);
-            let step = newton_step(&solve, &touches)?;
-            let length = step.norm();
-            solve.u = solve.constraints.project(&(solve.u + step))?;
-            if length < CONVERGED_STEP || solve.constraints.len == 2 {
-                return self.seed_at(&solve);
+            let step = newton_step(&solve.u, &constraints, &touches);
+            if cfg!(test) && std::env::var("NEWTON_DEBUG").is_ok() {
+                let y = touches[0].point - touches[1].point;
+                eprintln!("u {:?} F {:e} keys {} {} side {:?} edges {} step {:?}", solve.u.as_slice(), -solve.u.dot(&y), touches[0].key, touches[1].key, solve.side, solve.edge_count, step.map(|s| s.norm()));
             }
+            let mut step = step?;
+            let landed = stop_at_side(&mut solve, &touches, &mut step);
+            let length = step.norm();
+            let moved = solve.u + step;
+            let held = if landed { solve.constraints(&touches) } else { constraints };
+            solve.u = held.project(&moved)?;
+            if landed || !(length < CONVERGED_STEP || held.len == 2) {
+                continue;
+            }
+            if self.leave_false_sides(&mut solve, &touches) {
+                last = None;
+                continue;
+            }
+            return self.seed_at(&solve);
         }
         None
     }
 
-    /// Records the kinks crossed between `previous` and `now`: a cylinder's
-    /// cap or a polytope's vertex changed, so the answer's direction is
-    /// perpendicular to the two support points' difference. Whether a new
+    /// Whether a held side kink does not hold the answer: the answer's
+    /// direction must meet the face of `K` that the held kinks span (each
+    /// side's segment, each polytope edge) within each side's segment; a
+    /// side whose coefficient falls outside it is a rim point's, so the
+    /// kink is let go and the direction moved off it towards that rim.
+    fn leave_false_sides(&self, solve: &mut Solve, touches: &[Touch; 2]) -> bool {
+        let u = solve.u;
+        let flat = |x: Vector3<f64>| x - u * u.dot(&x);
+        let y = flat(touches[0].point - touches[1].point);
+        // Each span: the shape whose side it is (2 for an edge), its
+        // vector in the tangent plane.
+        let mut spans = [(2usize, Vector3::zeros()); 2];
+        let mut count = 0;
+        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
+            if let (true, Some((_, h))) = (solve.side[k], shape.cylinder_dimensions())
+                && count < 2
+            {
+                // y at the other cap minus y here: A's point moves down
+                // from the top, B's move is subtracted.
+                let down = if touches[k].key == 1 { -1.0 } else { 1.0 };
+                let sign = if k == 0 { down } else { -down };
+                spans[count] = (k, flat(touches[k].axis * (2.0 * h * self.scale * sign)));
+                count += 1;
+            }
+        }
+        for edge in &solve.edges[..solve.edge_count] {
+            if count < 2 {
+                spans[count] = (2, flat(*edge));
+                count += 1;
+            }
+        }
+        let Some(alpha) = span_weights(&y, &spans[..count]) else {
+            return false;
+        };
+        solve.this_top = [touches[0].key == 1, touches[1].key == 1];
+        solve.face_weights = (count == 2 && spans[1].0 == 1).then_some(alpha);
+        for (j, &(k, _)) in spans[..count].iter().enumerate() {
+            if k == 2 || (-1e-9..=1.0 + 1e-9).contains(&alpha[j]) {
+                continue;
+            }
+            // Below 0 the nearest end is this cap, above 1 the other: turn
+            // towards the one (A's top faces +axis, B's top faces -axis).
+            let this_top = touches[k].key == 1;
+            let toward_top = (alpha[j] < 0.0) == this_top;
+            let facing = if (k == 0) == toward_top { 1.0 } else { -1.0 };
+            solve.side[k] = false;
+            solve.off_side[k] = true;
+            solve.u = (u + touches[k].axis * (1e-3 * facing)).normalize();
+            return true;
+        }
+        false
+    }
+
+    /// Records the vertex kinks crossed between `previous` and `now`: a
+    /// polytope's support vertex changed, so the answer's direction is
+    /// perpendicular to the two vertices' difference. Whether a new
     /// constraint was added.
-    fn note_kinks(&self, solve: &mut Solve, previous: &[Touch; 2], now: &[Touch; 2]) -> bool {
+    fn note_vertex_kinks(&self, solve: &mut Solve, previous: &[Touch; 2], now: &[Touch; 2]) -> bool {
         let mut added = false;
         for k in 0..2 {
             let (was, is) = (&previous[k], &now[k]);
-            if was.key == is.key {
+            if was.key == is.key || is.axis != Vector3::zeros() {
                 continue;
             }
             let kinks = &mut solve.kinks[k];
-            let fresh = kinks.len == 0 || !kinks.has(is.key) || !kinks.has(was.key);
-            if fresh {
-                kinks.add(was.key);
-                kinks.add(is.key);
-                let before = solve.constraints.len;
-                let edge = if is.axis == Vector3::zeros() {
-                    is.point - was.point
-                } else {
-                    is.axis
-                };
-                solve.constraints.add(edge);
-                added |= solve.constraints.len > before;
+            if kinks.has(is.key) && kinks.has(was.key) {
+                continue;
+            }
+            kinks.add(was.key);
+            kinks.add(is.key);
+            if solve.edge_count < 2 {
+                solve.edges[solve.edge_count] = is.point - was.point;
+                solve.edge_count += 1;
+                added = true;
             }
         }
         added
@@ -236,9 +326,27 @@ impl ConvexPair<'_> {
     /// kink's partners included, at most three.
     fn seed_at(&self, solve: &Solve) -> Option<([[u32; 2]; 3], usize)> {
         let u = solve.u;
-        let a = self.seed_indices(self.a, &u, &solve.kinks[0]);
-        let b = self.seed_indices(self.b, &-rotate_back(&self.rotation, &u), &solve.kinks[1]);
+        let a = self.seed_indices(self.a, &u, &solve.kinks[0], solve.side[0]);
+        let b = self.seed_indices(
+            self.b,
+            &-rotate_back(&self.rotation, &u),
+            &solve.kinks[1],
+            solve.side[1],
+        );
         let mut pairs = [[0; 2]; 3];
+        if let Some([wa, wb]) = solve.face_weights {
+            // Two sides: the triangle of their parallelogram that holds the
+            // answer (four coplanar points would leave the subalgorithm a
+            // flat tetrahedron).
+            let [a_this, a_other] = cap_pair(a.0[0], solve.this_top[0]);
+            let [b_this, b_other] = cap_pair(b.0[0], solve.this_top[1]);
+            pairs = if wa + wb <= 1.0 {
+                [[a_this, b_this], [a_other, b_this], [a_this, b_other]]
+            } else {
+                [[a_other, b_other], [a_other, b_this], [a_this, b_other]]
+            };
+            return Some((pairs, 3));
+        }
         let mut len = 0;
         for &ib in &b.0[..b.1] {
             for &ia in &a.0[..a.1] {
@@ -254,11 +362,17 @@ impl ConvexPair<'_> {
     /// The indices of `shape`'s support at body direction `d`: its code or
     /// vertex, then a cylinder's other cap at the same angle or a polytope's
     /// other kink vertices.
-    fn seed_indices(&self, shape: &Convex, d: &Vector3<f64>, kinks: &Kinks) -> ([u32; 3], usize) {
+    fn seed_indices(
+        &self,
+        shape: &Convex,
+        d: &Vector3<f64>,
+        kinks: &Kinks,
+        side: bool,
+    ) -> ([u32; 3], usize) {
         let mut out = ([0; 3], 1);
         if shape.cylinder_dimensions().is_some() {
             out.0[0] = cylinder::support_code(d);
-            if kinks.len > 0 {
+            if side {
                 out.0[1] = cylinder::other_cap(out.0[0]);
                 out.1 = 2;
             }
@@ -289,8 +403,12 @@ impl ConvexPair<'_> {
 /// the projection on the directions perpendicular to `u` and to the
 /// constraints. `None` where the projections overlap (`F <= 0`).
 #[inline(always)]
-fn newton_step(solve: &Solve, touches: &[Touch; 2]) -> Option<Vector3<f64>> {
-    let u = solve.u;
+fn newton_step(
+    u: &Vector3<f64>,
+    constraints: &Constraints,
+    touches: &[Touch; 2],
+) -> Option<Vector3<f64>> {
+    let u = *u;
     let y = touches[0].point - touches[1].point;
     let f = -u.dot(&y);
     if !(f > 0.0 && f.is_finite()) {
@@ -302,7 +420,7 @@ fn newton_step(solve: &Solve, touches: &[Touch; 2]) -> Option<Vector3<f64>> {
             .map(|t| t.curvature * t.tangent.dot(e) * t.tangent.dot(g))
             .sum::<f64>()
     };
-    match solve.constraints.len {
+    match constraints.len {
         0 => {
             let e1 = perpendicular(&u);
             let e2 = u.cross(&e1);
@@ -317,7 +435,7 @@ fn newton_step(solve: &Solve, touches: &[Touch; 2]) -> Option<Vector3<f64>> {
             Some(e1 * x1 + e2 * x2)
         }
         1 => {
-            let e = u.cross(&solve.constraints.axes[0]);
+            let e = u.cross(&constraints.axes[0]);
             Some(e * (-e.dot(&y) / (hessian(&e, &e) + f)))
         }
         _ => Some(Vector3::zeros()),
@@ -330,6 +448,61 @@ fn newton_step(solve: &Solve, touches: &[Touch; 2]) -> Option<Vector3<f64>> {
     })
 }
 
+/// Cuts `step` where it would first cross a cylinder's side kink (the
+/// direction perpendicular to its axis, where its support changes cap) and
+/// holds the direction there: Newton's quadratic model knows nothing of the
+/// kink and would overshoot it. Whether it did.
+fn stop_at_side(solve: &mut Solve, touches: &[Touch; 2], step: &mut Vector3<f64>) -> bool {
+    let mut first: Option<(f64, usize)> = None;
+    for (k, touch) in touches.iter().enumerate() {
+        if touch.axis == Vector3::zeros() || solve.side[k] || solve.off_side[k] {
+            continue;
+        }
+        let (now, change) = (touch.axis.dot(&solve.u), touch.axis.dot(step));
+        let at = -now / change;
+        if at > 0.0 && at < 1.0 && first.is_none_or(|(best, _)| at < best) {
+            first = Some((at, k));
+        }
+    }
+    let Some((at, k)) = first else {
+        return false;
+    };
+    *step *= at;
+    solve.side[k] = true;
+    true
+}
+
+/// A cylinder's codes at `code`'s angle: on the cap named by `top` first,
+/// then on the other.
+fn cap_pair(code: u32, top: bool) -> [u32; 2] {
+    let other = cylinder::other_cap(code);
+    if cylinder::is_top(code) == top {
+        [code, other]
+    } else {
+        [other, code]
+    }
+}
+
+/// The weights `α` with `y + Σ α_j·span_j = 0` (least squares), for one
+/// or two spans; `None` when they are degenerate.
+fn span_weights(y: &Vector3<f64>, spans: &[(usize, Vector3<f64>)]) -> Option<[f64; 2]> {
+    match spans {
+        [(_, d)] => {
+            let dd = d.norm_squared();
+            (dd > 0.0).then(|| [-y.dot(d) / dd, 0.0])
+        }
+        [(_, d1), (_, d2)] => {
+            let (m11, m12, m22) = (d1.norm_squared(), d1.dot(d2), d2.norm_squared());
+            let det = m11 * m22 - m12 * m12;
+            let (r1, r2) = (-y.dot(d1), -y.dot(d2));
+            (det > 1e-12 * m11 * m22).then(|| {
+                [(r1 * m22 - r2 * m12) / det, (m11 * r2 - m12 * r1) / det]
+            })
+        }
+        _ => None,
+    }
+}
+
 /// A unit vector perpendicular to the unit `u`.
 #[inline(always)]
 fn perpendicular(u: &Vector3<f64>) -> Vector3<f64> {
@@ -339,4 +512,31 @@ fn perpendicular(u: &Vector3<f64>) -> Vector3<f64> {
         Vector3::new(-u.z, 0.0, u.x)
     };
     p / p.norm()
+}
+
+#[cfg(test)]
+mod debug_tests {
+    use crate::{Convex, Options, Shape, distance};
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+    #[test]
+    fn debug_side() {
+        let a: Shape = Convex::cylinder(0.5, 0.8, 0.0).unwrap().into();
+        let b: Shape = Convex::cylinder(0.3, 0.6, 0.0).unwrap().into();
+        let id = Isometry3::identity();
+        let mut rng = crate::shape::tests::Rng(0x5eed_c711_bea7_0001);
+        let mut shown = 0;
+        for k in 0..300 {
+            let reach = [4.0, 2.2, 1.2][k % 3];
+            let dir = Vector3::new(rng.next(), rng.next(), rng.next()).normalize();
+            let p = Isometry3::from_parts(Translation3::from(dir * reach), UnitQuaternion::from_euler_angles(rng.next() * 3.0, rng.next() * 3.0, rng.next() * 3.0));
+            let ans = distance(&a, &id, &b, &p, &Options::default(), None).unwrap();
+            if ans.distance > 0.0 && ans.normal.z.abs() < 1e-6 && ans.iterations > 8 && shown < 3 {
+                shown += 1;
+                eprintln!("CASE it {} normal {:?} nb {:?}", ans.iterations, ans.normal.as_slice(), (p.rotation.inverse() * ans.normal).as_slice());
+                unsafe { std::env::set_var("NEWTON_DEBUG", "1") };
+                let _ = distance(&a, &id, &b, &p, &Options::default(), None).unwrap();
+                unsafe { std::env::remove_var("NEWTON_DEBUG") };
+            }
+        }
+    }
 }

@@ -153,6 +153,7 @@ impl ConvexPair<'_> {
         } else {
             self.seed_after
         };
+        let mut seed_tried = false;
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -195,6 +196,7 @@ impl ConvexPair<'_> {
             let v_dot_support = solution.v.dot(&support_point.y);
             let lower = state.lower.max(v_dot_support / norm - self.single_slack);
             let g = v2 - v_dot_support;
+            if cfg!(test) && std::env::var("NEWTON_DEBUG").is_ok() { eprintln!("  it {} |v| {:e} g {:e} mask {} sup {} {}", state.iterations, norm, g, solution.mask, support_point.ia, support_point.ib); }
             if g <= stop_d * norm || norm <= eps_d {
                 return self.end_run(simplex, &state, Status::Converged, solution, lower);
             }
@@ -228,13 +230,18 @@ impl ConvexPair<'_> {
             }
             // Step (4), or the seed in its place.
             state.lower = lower;
-            if state.iterations == seed_after
-                && let Some((pairs, len)) = self.newton_seed(&solution.v)
-            {
+            // Seeded once, from the first iterate (past `seed_after`) whose
+            // direction separates the projections: from there Newton's
+            // steps converge.
+            if state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
+                seed_tried = true;
+                if let Some((pairs, len)) = self.newton_seed(&solution.v) {
                 let (points, len) = self.seed_vertices(&pairs[..len]);
-                reset_simplex::<AVX2>(simplex, &points[..len]);
-                state.previous = None;
-                continue;
+                    reset_simplex::<AVX2>(simplex, &points[..len]);
+                    if cfg!(test) && std::env::var("NEWTON_DEBUG").is_ok() { eprintln!("seeded at {} with {:?}", state.iterations, &pairs[..len]); }
+                    state.previous = None;
+                    continue;
+                }
             }
             state.previous = Some((solution, v2));
             push_vertex::<AVX2>(simplex, solution.mask, support_point);

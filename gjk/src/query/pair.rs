@@ -34,8 +34,8 @@ pub(super) struct ConvexPair<'s> {
     /// distance times `scale`: 0 in f64.
     pub(super) single_slack: f64,
     /// The iteration after which the run is seeded by Newton's method on
-    /// the nearest points' direction (see `newton_seed`): 0 (never) unless
-    /// a piece is a cylinder.
+    /// the nearest points' direction (see `newton_seed`): never (`u32::MAX`)
+    /// unless a piece is a cylinder.
     pub(super) seed_after: u32,
 }
 
@@ -179,9 +179,11 @@ impl<'s> ConvexPair<'s> {
             inv_scale,
             single_precision,
             single_slack,
-            seed_after: u32::from(
-                a.cylinder_dimensions().is_some() || b.cylinder_dimensions().is_some(),
-            ) * COLD_SEED_AFTER,
+            seed_after: if a.cylinder_dimensions().is_some() || b.cylinder_dimensions().is_some() {
+                COLD_SEED_AFTER
+            } else {
+                u32::MAX
+            },
         }
     }
 

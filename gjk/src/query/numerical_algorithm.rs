@@ -131,14 +131,22 @@ impl ConvexPair<'_> {
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> RunOutcome {
-        // Step (1): V0 from the warm start, else the single point s_K(z̄2 - z̄1).
+        // Step (1): V0 from the warm start (for a pair with a cylinder,
+        // the seed solved from it), else the single point s_K(z̄2 - z̄1).
+        let mut seed_tried = false;
         match warm {
             Some(pairs) => {
-                let mut points = [Vertex::default(); 4];
-                for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
-                    *point = self.difference_vertex(index_a as usize, index_b as usize);
-                }
-                reset_simplex::<AVX2>(simplex, &points[..pairs.len()]);
+                let seed = if self.seed_after == u32::MAX {
+                    None
+                } else {
+                    self.warm_seed(pairs)
+                };
+                seed_tried = seed.is_some();
+                let (points, len) = match seed {
+                    Some((seed_pairs, len)) => self.seed_vertices(&seed_pairs[..len]),
+                    None => self.seed_vertices(pairs),
+                };
+                reset_simplex::<AVX2>(simplex, &points[..len]);
             }
             None => simplex.start(self.support(&self.centroid_gap)),
         }
@@ -146,14 +154,7 @@ impl ConvexPair<'_> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
-        // A warm start is near the answer already: seeded after its first
-        // iterate.
-        let seed_after = if warm.is_some() {
-            self.seed_after.min(1)
-        } else {
-            self.seed_after
-        };
-        let mut seed_tried = false;
+        let seed_after = self.seed_after;
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -196,7 +197,6 @@ impl ConvexPair<'_> {
             let v_dot_support = solution.v.dot(&support_point.y);
             let lower = state.lower.max(v_dot_support / norm - self.single_slack);
             let g = v2 - v_dot_support;
-            if cfg!(test) && std::env::var("NEWTON_DEBUG").is_ok() { eprintln!("  it {} |v| {:e} g {:e} mask {} sup {} {}", state.iterations, norm, g, solution.mask, support_point.ia, support_point.ib); }
             if g <= stop_d * norm || norm <= eps_d {
                 return self.end_run(simplex, &state, Status::Converged, solution, lower);
             }
@@ -236,9 +236,8 @@ impl ConvexPair<'_> {
             if state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
                 seed_tried = true;
                 if let Some((pairs, len)) = self.newton_seed(&solution.v) {
-                let (points, len) = self.seed_vertices(&pairs[..len]);
+                    let (points, len) = self.seed_vertices(&pairs[..len]);
                     reset_simplex::<AVX2>(simplex, &points[..len]);
-                    if cfg!(test) && std::env::var("NEWTON_DEBUG").is_ok() { eprintln!("seeded at {} with {:?}", state.iterations, &pairs[..len]); }
                     state.previous = None;
                     continue;
                 }

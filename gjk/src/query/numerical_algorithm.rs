@@ -142,11 +142,15 @@ impl ConvexPair<'_> {
                     self.warm_seed(pairs)
                 };
                 seed_tried = seed.is_some();
-                let (points, len) = match seed {
-                    Some((seed_pairs, len)) => self.seed_vertices(&seed_pairs[..len]),
-                    None => self.seed_vertices(pairs),
+                let pairs = match &seed {
+                    Some((seed_pairs, len)) => &seed_pairs[..*len],
+                    None => pairs,
                 };
-                reset_simplex::<AVX2>(simplex, &points[..len]);
+                let mut points = [Vertex::default(); 4];
+                for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
+                    *point = self.difference_vertex(index_a as usize, index_b as usize);
+                }
+                reset_simplex::<AVX2>(simplex, &points[..pairs.len()]);
             }
             None => simplex.start(self.support(&self.centroid_gap)),
         }

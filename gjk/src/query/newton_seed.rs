@@ -91,6 +91,17 @@ struct Constraints {
 }
 
 impl Constraints {
+    /// Adds the unit `axis`: as [`add`](Self::add), with no normalisation
+    /// when it is the first.
+    fn add_axis(&mut self, axis: Vector3<f64>) {
+        if self.len == 0 {
+            self.axes[0] = axis;
+            self.len = 1;
+        } else {
+            self.add(axis);
+        }
+    }
+
     /// Adds `c` (any length) unless it is (nearly) in the span of those
     /// already held.
     fn add(&mut self, mut c: Vector3<f64>) {
@@ -108,16 +119,21 @@ impl Constraints {
     /// `u` moved onto the directions perpendicular to every constraint,
     /// unit; `None` if it has no such part.
     fn project(&self, u: &Vector3<f64>) -> Option<Vector3<f64>> {
-        let p = match self.len {
+        let p = self.project_unscaled(u);
+        let norm = p.norm();
+        (norm > 1e-12).then(|| p / norm)
+    }
+
+    /// [`project`](Self::project) without the normalisation.
+    fn project_unscaled(&self, u: &Vector3<f64>) -> Vector3<f64> {
+        match self.len {
             0 => *u,
             1 => u - self.axes[0] * self.axes[0].dot(u),
             _ => {
                 let n = self.axes[0].cross(&self.axes[1]);
                 n * n.dot(u).signum()
             }
-        };
-        let norm = p.norm();
-        (norm > 1e-12).then(|| p / norm)
+        }
     }
 }
 
@@ -181,7 +197,7 @@ impl Solve {
         let mut out = Constraints::default();
         for (held, touch) in self.side.iter().zip(touches) {
             if *held {
-                out.add(touch.axis);
+                out.add_axis(touch.axis);
             }
         }
         for edge in &self.edges[..self.edge_count] {
@@ -258,22 +274,22 @@ impl ConvexPair<'_> {
                 }
             }
         }
-        let norm = mean.norm();
-        if !(norm > 0.0 && norm.is_finite()) {
+        if !mean.iter().all(|x| x.is_finite()) {
             return None;
         }
-        solve.u = -mean / norm;
         let axes = [Vector3::z(), rotate(&self.rotation, &Vector3::z())];
         let mut held = Constraints::default();
         for (side, axis) in solve.side.iter().zip(axes) {
             if *side {
-                held.add(axis);
+                held.add_axis(axis);
             }
         }
         for edge in &solve.edges[..solve.edge_count] {
             held.add(*edge);
         }
-        solve.u = held.project(&solve.u)?;
+        // Projected first and normalised once: the mean's length is not
+        // needed.
+        solve.u = held.project(&-mean)?;
         solve.held = held;
         self.solve_from(solve)
     }
@@ -298,8 +314,14 @@ impl ConvexPair<'_> {
                 solve.held = solve.constraints(&touches);
             }
             let small = step.norm_squared() < CONVERGED_STEP * CONVERGED_STEP;
+            let converged = !landed && (small || solve.held.len == 2);
+            if converged && solve.side == [false; 2] {
+                // The seed's supports need the direction, not its length.
+                solve.u = solve.held.project_unscaled(&(solve.u + step));
+                return self.seed_at(&solve);
+            }
             solve.u = solve.held.project(&(solve.u + step))?;
-            if landed || !(small || solve.held.len == 2) {
+            if !converged {
                 continue;
             }
             if self.leave_false_sides(&mut solve, &touches) {
@@ -543,6 +565,9 @@ fn stop_at_side(solve: &mut Solve, touches: &[Touch; 2], step: &mut Vector3<f64>
             continue;
         }
         let (now, change) = (touch.axis.dot(&solve.u), touch.axis.dot(step));
+        if now * (now + change) >= 0.0 {
+            continue;
+        }
         let at = -now / change;
         if at > 0.0 && at < 1.0 && first.is_none_or(|(best, _)| at < best) {
             first = Some((at, k));

@@ -39,8 +39,9 @@ pub(super) struct ConvexPair<'s> {
     pub(super) seed_after: u32,
 }
 
-/// The plain iterations a cold run of a pair with a cylinder takes before
-/// it is seeded: enough for a direction near the answer's.
+/// The plain iterations a cold run of a cylinder against a polytope takes
+/// before it is seeded: from the single start point, Newton's vertex
+/// changes would name wrong edges. Two cylinders are seeded after one.
 pub(super) const COLD_SEED_AFTER: u32 = 2;
 
 /// Whether `iso` is the identity, exactly.
@@ -179,10 +180,10 @@ impl<'s> ConvexPair<'s> {
             inv_scale,
             single_precision,
             single_slack,
-            seed_after: if a.cylinder_dimensions().is_some() || b.cylinder_dimensions().is_some() {
-                COLD_SEED_AFTER
-            } else {
-                u32::MAX
+            seed_after: match (a.cylinder_dimensions(), b.cylinder_dimensions()) {
+                (Some(_), Some(_)) => 1,
+                (Some(_), None) | (None, Some(_)) => COLD_SEED_AFTER,
+                (None, None) => u32::MAX,
             },
         }
     }

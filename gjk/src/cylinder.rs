@@ -63,6 +63,18 @@ fn diamond_angle(x: f64, y: f64, sum: f64) -> f64 {
     }
 }
 
+/// The code of the point at the same angle on the other cap.
+#[inline(always)]
+pub(crate) fn other_cap(code: u32) -> u32 {
+    code ^ TOP
+}
+
+/// Whether `code` is a point of the top cap.
+#[inline(always)]
+pub(crate) fn is_top(code: u32) -> bool {
+    code & TOP != 0
+}
+
 /// The point of `code` on the cylinder of radius `r`, half-height `h`
 /// (its body frame, centred at the origin).
 #[inline(always)]

@@ -4,6 +4,7 @@
 mod answer;
 mod compound;
 mod full_step;
+mod newton_seed;
 mod numerical_algorithm;
 mod options;
 mod pair;

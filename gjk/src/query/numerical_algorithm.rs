@@ -131,9 +131,21 @@ impl ConvexPair<'_> {
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> RunOutcome {
-        // Step (1): V0 from the warm start, else the single point s_K(z̄2 - z̄1).
+        // Step (1): V0 from the warm start (for a pair with a cylinder,
+        // the seed solved from it), else the single point s_K(z̄2 - z̄1).
+        let mut seed_tried = false;
         match warm {
             Some(pairs) => {
+                let seed = if self.seed_after == u32::MAX {
+                    None
+                } else {
+                    self.warm_seed(pairs)
+                };
+                seed_tried = seed.is_some();
+                let pairs = match &seed {
+                    Some((seed_pairs, len)) => &seed_pairs[..*len],
+                    None => pairs,
+                };
                 let mut points = [Vertex::default(); 4];
                 for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
                     *point = self.difference_vertex(index_a as usize, index_b as usize);
@@ -146,6 +158,7 @@ impl ConvexPair<'_> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
+        let seed_after = self.seed_after;
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -219,8 +232,20 @@ impl ConvexPair<'_> {
                     None => continue,
                 }
             }
-            // Step (4).
+            // Step (4), or the seed in its place.
             state.lower = lower;
+            // Seeded once, from the first iterate (past `seed_after`) whose
+            // direction separates the projections: from there Newton's
+            // steps converge.
+            if state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
+                seed_tried = true;
+                if let Some((pairs, len)) = self.newton_seed(&solution.v) {
+                    let (points, len) = self.seed_vertices(&pairs[..len]);
+                    reset_simplex::<AVX2>(simplex, &points[..len]);
+                    state.previous = None;
+                    continue;
+                }
+            }
             state.previous = Some((solution, v2));
             push_vertex::<AVX2>(simplex, solution.mask, support_point);
         }

@@ -33,7 +33,16 @@ pub(super) struct ConvexPair<'s> {
     /// How far below the true support value the f32 search may land, as a
     /// distance times `scale`: 0 in f64.
     pub(super) single_slack: f64,
+    /// The iteration after which the run is seeded by Newton's method on
+    /// the nearest points' direction (see `newton_seed`): never (`u32::MAX`)
+    /// unless a piece is a cylinder.
+    pub(super) seed_after: u32,
 }
+
+/// The plain iterations a cold run of a cylinder against a polytope takes
+/// before it is seeded: from the single start point, Newton's vertex
+/// changes would name wrong edges. Two cylinders are seeded after one.
+pub(super) const COLD_SEED_AFTER: u32 = 2;
 
 /// Whether `iso` is the identity, exactly.
 #[inline(always)]
@@ -171,6 +180,11 @@ impl<'s> ConvexPair<'s> {
             inv_scale,
             single_precision,
             single_slack,
+            seed_after: match (a.cylinder_dimensions(), b.cylinder_dimensions()) {
+                (Some(_), Some(_)) => 1,
+                (Some(_), None) | (None, Some(_)) => COLD_SEED_AFTER,
+                (None, None) => u32::MAX,
+            },
         }
     }
 

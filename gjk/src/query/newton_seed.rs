@@ -1,0 +1,856 @@
+//! A seed for the run of a pair with a cylinder: Newton's method on the
+//! direction between the nearest points.
+//!
+//! On a cylinder's curved rim the plain run converges linearly (about one
+//! iteration a decimal digit), where a polytope's ends at exact vertices in
+//! three or four. The distance is the largest separation of the two
+//! shapes' projections on a unit direction `u`,
+//! `F(u) = -h_K(u) = -u·s_K(u)`, whose gradient is `-s_K(u)` and whose
+//! Hessian is minus the sum of the shapes' support Hessians: a rim's is
+//! `k·t·tᵀ` (`t` the rim's tangent, `k = r / |u_xy|`), a vertex's zero.
+//! Newton's method on the unit sphere converges quadratically where `F` is
+//! smooth. Where the answer lies on a flat feature (a cylinder's side, a
+//! polytope's edge or face) `F` has a kink: a step that would cross a
+//! cylinder's (where its support changes cap) stops on it, and a step that
+//! changes a polytope's support vertex has crossed one. The difference of
+//! the two support points is then perpendicular to the answer's direction,
+//! and the steps go on in the directions perpendicular to it; a side whose
+//! segment's nearest point turns out to be an end is let go again. The
+//! support points at the final direction, with the partners of each kink,
+//! are the seed. A warm start names its features exactly, so its seed
+//! starts on them, from the direction of its points at the new pose.
+//!
+//! The seed only chooses where the ordinary run starts: the run certifies
+//! the bounds (Theorem 4.1) as for any start, so a seed on the wrong
+//! feature, or none when the steps do not converge, costs time, never
+//! exactness.
+
+use nalgebra::Vector3;
+
+use super::pair::{ConvexPair, rotate, rotate_back};
+use crate::cylinder;
+use crate::johnson::Vertex;
+use crate::shape::Convex;
+
+/// A seed: up to three index pairs, and how many.
+pub(super) type Seed = ([[u32; 2]; 3], usize);
+
+/// Newton steps before the seed is given up.
+const MAX_STEPS: u32 = 8;
+
+/// The step (in radians) below which the direction has converged: the next
+/// step would be of its square's order, and the run's stopping rule needs
+/// the direction to about 1e-7.
+const CONVERGED_STEP: f64 = 3e-5;
+
+/// One shape's support at a direction, in the pair frame (scaled).
+#[derive(Clone, Copy)]
+struct Touch {
+    /// The support point.
+    point: Vector3<f64>,
+    /// The vertex index, or for a cylinder its cap (0 or 1): a change is a
+    /// kink.
+    key: u32,
+    /// The support Hessian `k·t·tᵀ`: zero for a polytope.
+    curvature: f64,
+    tangent: Vector3<f64>,
+    /// A cylinder's axis (the difference of its caps): zero for a polytope,
+    /// whose kinks are the differences of its vertices.
+    axis: Vector3<f64>,
+}
+
+/// What one shape's kinks have shown: the support keys seen on either side
+/// of each (a cylinder's two caps, a polytope's vertices), at most three.
+#[derive(Clone, Copy, Default)]
+struct Kinks {
+    keys: [u32; 3],
+    len: usize,
+}
+
+impl Kinks {
+    fn has(&self, key: u32) -> bool {
+        self.keys[..self.len].contains(&key)
+    }
+
+    fn add(&mut self, key: u32) -> bool {
+        if self.has(key) || self.len == 3 {
+            return false;
+        }
+        self.keys[self.len] = key;
+        self.len += 1;
+        true
+    }
+}
+
+/// The directions the answer's direction is known to be perpendicular to,
+/// orthonormal, at most two.
+#[derive(Clone, Copy, Default)]
+struct Constraints {
+    axes: [Vector3<f64>; 2],
+    len: usize,
+}
+
+impl Constraints {
+    /// Adds the unit `axis`: as [`add`](Self::add), with no normalisation
+    /// when it is the first.
+    fn add_axis(&mut self, axis: Vector3<f64>) {
+        if self.len == 0 {
+            self.axes[0] = axis;
+            self.len = 1;
+        } else {
+            self.add(axis);
+        }
+    }
+
+    /// Adds `c` (any length) unless it is (nearly) in the span of those
+    /// already held.
+    fn add(&mut self, mut c: Vector3<f64>) {
+        let length = c.norm();
+        for axis in &self.axes[..self.len] {
+            c -= *axis * axis.dot(&c);
+        }
+        let norm = c.norm();
+        if self.len < 2 && norm > 1e-6 * length {
+            self.axes[self.len] = c / norm;
+            self.len += 1;
+        }
+    }
+
+    /// `u` moved onto the directions perpendicular to every constraint,
+    /// unit; `None` if it has no such part.
+    fn project(&self, u: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let p = self.project_unscaled(u);
+        let norm = p.norm();
+        (norm > 1e-12).then(|| p / norm)
+    }
+
+    /// [`project`](Self::project) without the normalisation.
+    fn project_unscaled(&self, u: &Vector3<f64>) -> Vector3<f64> {
+        match self.len {
+            0 => *u,
+            1 => u - self.axes[0] * self.axes[0].dot(u),
+            _ => {
+                let n = self.axes[0].cross(&self.axes[1]);
+                n * n.dot(u).signum()
+            }
+        }
+    }
+}
+
+/// The support of `shape` (a body frame's centroid-relative coordinates)
+/// at the body direction `d` (unit), by the cylinder's closed form with its
+/// curvature, or the polytope's support search. `None` at a cylinder's
+/// axis, where the curvature is unbounded.
+#[inline(always)]
+fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
+    let Some((r, h)) = shape.cylinder_dimensions() else {
+        let (index, point) = shape.support_point(d);
+        return Some(Touch {
+            point,
+            key: index as u32,
+            curvature: 0.0,
+            tangent: Vector3::zeros(),
+            axis: Vector3::zeros(),
+        });
+    };
+    // |d| = 1: the squares neither overflow nor lose the direction.
+    let rho = (d.x * d.x + d.y * d.y).sqrt();
+    if rho.is_nan() || rho <= 1e-9 {
+        return None;
+    }
+    let inv = 1.0 / rho;
+    let (cx, sy) = (d.x * inv, d.y * inv);
+    let top = d.z > 0.0;
+    Some(Touch {
+        point: Vector3::new(r * cx, r * sy, if top { h } else { -h }),
+        key: u32::from(top),
+        curvature: r * inv,
+        tangent: Vector3::new(-sy, cx, 0.0),
+        axis: Vector3::z(),
+    })
+}
+
+/// A running Newton solve: the direction, each shape's kinks (a
+/// cylinder's side, a polytope's vertices) and the edges they give.
+#[derive(Default)]
+struct Solve {
+    u: Vector3<f64>,
+    /// Whether the direction is held on each cylinder's side kink, and
+    /// whether that kink was found not to hold the answer.
+    side: [bool; 2],
+    off_side: [bool; 2],
+    kinks: [Kinks; 2],
+    /// Edges of the polytopes' kinks (differences of their vertices).
+    edges: [Vector3<f64>; 2],
+    edge_count: usize,
+    /// Where the answer met two held sides' face: each side's weight from
+    /// the cap it was found at (`this_top`) towards the other.
+    face_weights: Option<[f64; 2]>,
+    this_top: [bool; 2],
+    /// The constraints of the held kinks, kept from one step to the next.
+    held: Constraints,
+}
+
+impl Solve {
+    /// The constraints: each held side's axis, then the polytope edges.
+    fn constraints(&self, touches: &[Touch; 2]) -> Constraints {
+        let mut out = Constraints::default();
+        for (held, touch) in self.side.iter().zip(touches) {
+            if *held {
+                out.add_axis(touch.axis);
+            }
+        }
+        for edge in &self.edges[..self.edge_count] {
+            out.add(*edge);
+        }
+        out
+    }
+}
+
+impl ConvexPair<'_> {
+    /// Both shapes' supports at `u` (pair frame, unit): A's at `u`, B's at
+    /// `-u`, B's moved into the pair frame.
+    #[inline(always)]
+    fn touches(&self, u: &Vector3<f64>) -> Option<[Touch; 2]> {
+        let mut a = body_touch(self.a, u)?;
+        let mut b = body_touch(self.b, &-rotate_back(&self.rotation, u))?;
+        a.point *= self.scale;
+        a.curvature *= self.scale;
+        b.point = rotate(&self.rotation, &b.point) * self.scale + self.centroid_gap;
+        b.curvature *= self.scale;
+        b.tangent = rotate(&self.rotation, &b.tangent);
+        b.axis = rotate(&self.rotation, &b.axis);
+        Some([a, b])
+    }
+
+    /// The seed of a pair with a cylinder, from the direction `-v` of an
+    /// iterate: at most three index pairs, or `None` when the solve fails
+    /// (the shapes overlap, a direction along a cylinder's axis, no
+    /// convergence).
+    pub(super) fn newton_seed(&self, v: &Vector3<f64>) -> Option<Seed> {
+        let norm = v.norm();
+        if !(norm > 0.0 && norm.is_finite()) {
+            return None;
+        }
+        self.solve_from(Solve {
+            u: -v / norm,
+            ..Solve::default()
+        })
+    }
+
+    /// The seed from a warm start's index pairs at the new pose: from the
+    /// direction of their points' mean, on the features they name (a
+    /// cylinder's side where both caps appear at one angle, a polytope's
+    /// edges between its distinct vertices), which a converged simplex
+    /// names exactly.
+    pub(super) fn warm_seed(&self, pairs: &[[u32; 2]]) -> Option<Seed> {
+        if pairs.is_empty() {
+            return None;
+        }
+        let mut mean = Vector3::zeros();
+        for &[ia, ib] in pairs {
+            mean += self.difference_vertex(ia as usize, ib as usize).y;
+        }
+        let mut solve = Solve::default();
+        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
+            let index = |pair: &[u32; 2]| pair[k];
+            let first = index(&pairs[0]);
+            if shape.cylinder_dimensions().is_some() {
+                solve.side[k] = pairs.iter().any(|p| index(p) == cylinder::other_cap(first));
+                continue;
+            }
+            for p in pairs {
+                let key = index(p);
+                if key != first && !solve.kinks[k].has(key) && solve.edge_count < 2 {
+                    solve.kinks[k].add(first);
+                    solve.kinks[k].add(key);
+                    let edge = shape.point(key as usize) - shape.point(first as usize);
+                    solve.edges[solve.edge_count] = if k == 0 {
+                        edge
+                    } else {
+                        rotate(&self.rotation, &edge)
+                    };
+                    solve.edge_count += 1;
+                }
+            }
+        }
+        if !mean.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let axes = [Vector3::z(), rotate(&self.rotation, &Vector3::z())];
+        let mut held = Constraints::default();
+        for (side, axis) in solve.side.iter().zip(axes) {
+            if *side {
+                held.add_axis(axis);
+            }
+        }
+        for edge in &solve.edges[..solve.edge_count] {
+            held.add(*edge);
+        }
+        // Projected first and normalised once: the mean's length is not
+        // needed.
+        solve.u = held.project(&-mean)?;
+        solve.held = held;
+        self.solve_from(solve)
+    }
+
+    /// Newton's steps from `solve` to the seed.
+    fn solve_from(&self, mut solve: Solve) -> Option<Seed> {
+        let mut last: Option<[Touch; 2]> = None;
+        for _ in 0..MAX_STEPS {
+            let touches = self.touches(&solve.u)?;
+            if let Some(previous) = last
+                && self.note_vertex_kinks(&mut solve, &previous, &touches)
+            {
+                solve.held = solve.constraints(&touches);
+                solve.u = solve.held.project(&solve.u)?;
+                last = None;
+                continue;
+            }
+            last = Some(touches);
+            let mut step = newton_step(&solve.u, &solve.held, &touches)?;
+            let landed = stop_at_side(&mut solve, &touches, &mut step);
+            if landed {
+                solve.held = solve.constraints(&touches);
+            }
+            let small = step.norm_squared() < CONVERGED_STEP * CONVERGED_STEP;
+            let converged = !landed && (small || solve.held.len == 2);
+            if converged && solve.side == [false; 2] {
+                // The seed's supports need the direction, not its length.
+                solve.u = solve.held.project_unscaled(&(solve.u + step));
+                return self.seed_at(&solve);
+            }
+            solve.u = solve.held.project(&(solve.u + step))?;
+            if !converged {
+                continue;
+            }
+            if self.leave_false_sides(&mut solve, &touches) {
+                solve.held = solve.constraints(&touches);
+                last = None;
+                continue;
+            }
+            return self.seed_at(&solve);
+        }
+        None
+    }
+
+    /// Whether a held side kink does not hold the answer: the answer's
+    /// direction must meet the face of `K` that the held kinks span (each
+    /// side's segment, each polytope edge) within each side's segment; a
+    /// side whose coefficient falls outside it is a rim point's, so the
+    /// kink is let go and the direction moved off it towards that rim.
+    fn leave_false_sides(&self, solve: &mut Solve, touches: &[Touch; 2]) -> bool {
+        let u = solve.u;
+        let flat = |x: Vector3<f64>| x - u * u.dot(&x);
+        let y = flat(touches[0].point - touches[1].point);
+        // Each span: the shape whose side it is (2 for an edge), its
+        // vector in the tangent plane.
+        let mut spans = [(2usize, Vector3::zeros()); 2];
+        let mut count = 0;
+        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
+            if let (true, Some((_, h))) = (solve.side[k], shape.cylinder_dimensions())
+                && count < 2
+            {
+                // y at the other cap minus y here: A's point moves down
+                // from the top, B's move is subtracted.
+                let down = if touches[k].key == 1 { -1.0 } else { 1.0 };
+                let sign = if k == 0 { down } else { -down };
+                spans[count] = (k, flat(touches[k].axis * (2.0 * h * self.scale * sign)));
+                count += 1;
+            }
+        }
+        for edge in &solve.edges[..solve.edge_count] {
+            if count < 2 {
+                spans[count] = (2, flat(*edge));
+                count += 1;
+            }
+        }
+        let Some(alpha) = span_weights(&y, &spans[..count]) else {
+            return false;
+        };
+        solve.this_top = [touches[0].key == 1, touches[1].key == 1];
+        solve.face_weights = (count == 2 && spans[1].0 == 1).then_some(alpha);
+        for (j, &(k, _)) in spans[..count].iter().enumerate() {
+            if k == 2 || (-1e-9..=1.0 + 1e-9).contains(&alpha[j]) {
+                continue;
+            }
+            // Below 0 the nearest end is this cap, above 1 the other: turn
+            // towards the one (A's top faces +axis, B's top faces -axis).
+            let this_top = touches[k].key == 1;
+            let toward_top = (alpha[j] < 0.0) == this_top;
+            let facing = if (k == 0) == toward_top { 1.0 } else { -1.0 };
+            solve.side[k] = false;
+            solve.off_side[k] = true;
+            solve.u = (u + touches[k].axis * (1e-3 * facing)).normalize();
+            return true;
+        }
+        false
+    }
+
+    /// Records the vertex kinks crossed between `previous` and `now`: a
+    /// polytope's support vertex changed, so the answer's direction is
+    /// perpendicular to the two vertices' difference. Whether a new
+    /// constraint was added.
+    fn note_vertex_kinks(
+        &self,
+        solve: &mut Solve,
+        previous: &[Touch; 2],
+        now: &[Touch; 2],
+    ) -> bool {
+        let mut added = false;
+        for k in 0..2 {
+            let (was, is) = (&previous[k], &now[k]);
+            if was.key == is.key || is.axis != Vector3::zeros() {
+                continue;
+            }
+            let kinks = &mut solve.kinks[k];
+            if kinks.has(is.key) && kinks.has(was.key) {
+                continue;
+            }
+            kinks.add(was.key);
+            kinks.add(is.key);
+            if solve.edge_count < 2 {
+                solve.edges[solve.edge_count] = is.point - was.point;
+                solve.edge_count += 1;
+                added = true;
+            }
+        }
+        added
+    }
+
+    /// The index pairs of the support points at the solved direction, each
+    /// kink's partners included, at most three.
+    fn seed_at(&self, solve: &Solve) -> Option<Seed> {
+        let u = solve.u;
+        let a = self.seed_indices(self.a, &u, &solve.kinks[0], solve.side[0]);
+        let b = self.seed_indices(
+            self.b,
+            &-rotate_back(&self.rotation, &u),
+            &solve.kinks[1],
+            solve.side[1],
+        );
+        let mut pairs = [[0; 2]; 3];
+        if let Some([wa, wb]) = solve.face_weights {
+            // Two sides: the triangle of their parallelogram that holds the
+            // answer (four coplanar points would leave the subalgorithm a
+            // flat tetrahedron).
+            let [a_this, a_other] = cap_pair(a.0[0], solve.this_top[0]);
+            let [b_this, b_other] = cap_pair(b.0[0], solve.this_top[1]);
+            pairs = if wa + wb <= 1.0 {
+                [[a_this, b_this], [a_other, b_this], [a_this, b_other]]
+            } else {
+                [[a_other, b_other], [a_other, b_this], [a_this, b_other]]
+            };
+            return Some((pairs, 3));
+        }
+        let mut len = 0;
+        for &ib in &b.0[..b.1] {
+            for &ia in &a.0[..a.1] {
+                if len < 3 {
+                    pairs[len] = [ia, ib];
+                    len += 1;
+                }
+            }
+        }
+        (len > 0).then_some((pairs, len))
+    }
+
+    /// The indices of `shape`'s support at body direction `d`: its code or
+    /// vertex, then a cylinder's other cap at the same angle or a polytope's
+    /// other kink vertices.
+    fn seed_indices(
+        &self,
+        shape: &Convex,
+        d: &Vector3<f64>,
+        kinks: &Kinks,
+        side: bool,
+    ) -> ([u32; 3], usize) {
+        let mut out = ([0; 3], 1);
+        if shape.cylinder_dimensions().is_some() {
+            out.0[0] = cylinder::support_code(d);
+            if side {
+                out.0[1] = cylinder::other_cap(out.0[0]);
+                out.1 = 2;
+            }
+            return out;
+        }
+        out.0[0] = shape.support_point(d).0 as u32;
+        for &key in &kinks.keys[..kinks.len] {
+            if key != out.0[0] && out.1 < 3 {
+                out.0[out.1] = key;
+                out.1 += 1;
+            }
+        }
+        out
+    }
+
+    /// The seed's points as simplex vertices.
+    pub(super) fn seed_vertices(&self, pairs: &[[u32; 2]]) -> ([Vertex; 4], usize) {
+        let mut points = [Vertex::default(); 4];
+        for (point, &[ia, ib]) in points.iter_mut().zip(pairs) {
+            *point = self.difference_vertex(ia as usize, ib as usize);
+        }
+        (points, pairs.len().min(4))
+    }
+}
+
+/// The Newton step at `solve.u` for the supports `touches`: the tangent
+/// vector `ξ` with `(P·H·P + F)·ξ = -P·y`, `y = a - b`, `F = -u·y > 0`, `P`
+/// the projection on the directions perpendicular to `u` and to the
+/// constraints. `None` where the projections overlap (`F <= 0`).
+#[inline(always)]
+fn newton_step(
+    u: &Vector3<f64>,
+    constraints: &Constraints,
+    touches: &[Touch; 2],
+) -> Option<Vector3<f64>> {
+    let u = *u;
+    let y = touches[0].point - touches[1].point;
+    let f = -u.dot(&y);
+    if !(f > 0.0 && f.is_finite()) {
+        return None;
+    }
+    let hessian = |e: &Vector3<f64>, g: &Vector3<f64>| {
+        touches
+            .iter()
+            .map(|t| t.curvature * t.tangent.dot(e) * t.tangent.dot(g))
+            .sum::<f64>()
+    };
+    match constraints.len {
+        0 => Some(free_step(&u, &y, f, touches)),
+        1 => {
+            let e = u.cross(&constraints.axes[0]);
+            Some(e * (-e.dot(&y) / (hessian(&e, &e) + f)))
+        }
+        _ => Some(Vector3::zeros()),
+    }
+    .map(|step: Vector3<f64>| {
+        // Far from the answer the quadratic model is poor: no step turns
+        // the direction by more than about half a radian.
+        let squared = step.norm_squared();
+        if squared > 0.25 {
+            step * (0.5 / squared.sqrt())
+        } else {
+            step
+        }
+    })
+}
+
+/// The unconstrained step: `(F + Σ k_i·p_i·p_iᵀ)·ξ = g`, `g = -P·y`,
+/// `p_i = P·t_i`, by the Woodbury identity: a 2×2 solve for `α_i = p_i·ξ`,
+/// then `ξ = (g - Σ k_i·α_i·p_i) / F`. No basis of the tangent plane, so
+/// no square root.
+#[inline(always)]
+fn free_step(u: &Vector3<f64>, y: &Vector3<f64>, f: f64, touches: &[Touch; 2]) -> Vector3<f64> {
+    let flat = |x: &Vector3<f64>| x - u * u.dot(x);
+    let g = -flat(y);
+    let (p1, p2) = (flat(&touches[0].tangent), flat(&touches[1].tangent));
+    let (k1, k2) = (touches[0].curvature, touches[1].curvature);
+    let (p11, p12, p22) = (p1.dot(&p1), p1.dot(&p2), p2.dot(&p2));
+    let (m11, m12, m21, m22) = (f + k1 * p11, k2 * p12, k1 * p12, f + k2 * p22);
+    let (r1, r2) = (p1.dot(&g), p2.dot(&g));
+    let det = m11 * m22 - m12 * m21;
+    let (a1, a2) = ((r1 * m22 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det);
+    (g - p1 * (k1 * a1) - p2 * (k2 * a2)) / f
+}
+
+/// Cuts `step` where it would first cross a cylinder's side kink (the
+/// direction perpendicular to its axis, where its support changes cap) and
+/// holds the direction there: Newton's quadratic model knows nothing of the
+/// kink and would overshoot it. Whether it did.
+fn stop_at_side(solve: &mut Solve, touches: &[Touch; 2], step: &mut Vector3<f64>) -> bool {
+    let mut first: Option<(f64, usize)> = None;
+    for (k, touch) in touches.iter().enumerate() {
+        if touch.axis == Vector3::zeros() || solve.side[k] || solve.off_side[k] {
+            continue;
+        }
+        let (now, change) = (touch.axis.dot(&solve.u), touch.axis.dot(step));
+        if now * (now + change) >= 0.0 {
+            continue;
+        }
+        let at = -now / change;
+        if at > 0.0 && at < 1.0 && first.is_none_or(|(best, _)| at < best) {
+            first = Some((at, k));
+        }
+    }
+    let Some((at, k)) = first else {
+        return false;
+    };
+    *step *= at;
+    solve.side[k] = true;
+    true
+}
+
+/// A cylinder's codes at `code`'s angle: on the cap named by `top` first,
+/// then on the other.
+fn cap_pair(code: u32, top: bool) -> [u32; 2] {
+    let other = cylinder::other_cap(code);
+    if cylinder::is_top(code) == top {
+        [code, other]
+    } else {
+        [other, code]
+    }
+}
+
+/// The weights `α` with `y + Σ α_j·span_j = 0` (least squares), for one
+/// or two spans; `None` when they are degenerate.
+fn span_weights(y: &Vector3<f64>, spans: &[(usize, Vector3<f64>)]) -> Option<[f64; 2]> {
+    match spans {
+        [(_, d)] => {
+            let dd = d.norm_squared();
+            (dd > 0.0).then(|| [-y.dot(d) / dd, 0.0])
+        }
+        [(_, d1), (_, d2)] => {
+            let (m11, m12, m22) = (d1.norm_squared(), d1.dot(d2), d2.norm_squared());
+            let det = m11 * m22 - m12 * m12;
+            let (r1, r2) = (-y.dot(d1), -y.dot(d2));
+            (det > 1e-12 * m11 * m22)
+                .then(|| [(r1 * m22 - r2 * m12) / det, (m11 * r2 - m12 * r1) / det])
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+    use super::super::numerical_algorithm::RunOutcome;
+    use super::super::pair::{ConvexPair, PiecePlacement};
+    use crate::johnson::Simplex;
+    use crate::shape::tests::Rng;
+    use crate::{Convex, Options, Precision};
+
+    /// The run of `a` at the identity against `b` at `pose`, seeded or
+    /// plain, cold or from `warm`.
+    fn run(
+        a: &Convex,
+        b: &Convex,
+        pose: &Isometry3<f64>,
+        seeded: bool,
+        warm: Option<&[[u32; 2]]>,
+    ) -> RunOutcome {
+        run_at(&Isometry3::identity(), a, b, pose, seeded, warm)
+    }
+
+    /// [`run`] with both shapes moved by `base`.
+    fn run_at(
+        base: &Isometry3<f64>,
+        a: &Convex,
+        b: &Convex,
+        pose: &Isometry3<f64>,
+        seeded: bool,
+        warm: Option<&[[u32; 2]]>,
+    ) -> RunOutcome {
+        let pose_b = base * pose;
+        let rel = base.inv_mul(&pose_b);
+        let place = |pose| PiecePlacement { pose, offset: None };
+        let mut pair =
+            ConvexPair::new(a, b, &rel, (place(base), place(&pose_b)), Precision::Double);
+        if !seeded {
+            pair.seed_after = u32::MAX;
+        }
+        let mut simplex = Simplex::empty();
+        pair.solve::<false>(&mut simplex, &Options::default(), warm, f64::INFINITY)
+    }
+
+    /// A random pose of B about A, `reach` from it (times `scale`), at
+    /// `offset` from the origin; `parallel` keeps B's axis along A's.
+    fn pose(rng: &mut Rng, reach: f64, scale: f64, parallel: bool) -> Isometry3<f64> {
+        let dir = Vector3::new(rng.next(), rng.next(), rng.next()).normalize();
+        let rotation = if parallel {
+            UnitQuaternion::from_euler_angles(0.0, 0.0, rng.next() * 3.0)
+        } else {
+            UnitQuaternion::from_euler_angles(rng.next() * 3.0, rng.next() * 3.0, rng.next() * 3.0)
+        };
+        Isometry3::from_parts(Translation3::from(dir * reach * scale), rotation)
+    }
+
+    /// The feature of a shape the unit normal `n` (body frame) meets: a
+    /// cylinder's rim, side or cap, a box's vertex, edge or face.
+    fn feature(shape: &Convex, n: &Vector3<f64>) -> &'static str {
+        let flat = |x: f64| x.abs() < 1e-7;
+        match shape.cylinder_dimensions() {
+            Some(_) if flat(n.z) => "side",
+            Some(_) if flat(n.x) && flat(n.y) => "cap",
+            Some(_) => "rim",
+            None => ["vertex", "edge", "face", "face"][n.iter().filter(|x| flat(**x)).count()],
+        }
+    }
+
+    /// Seeded and plain runs agree within the tolerance on every pose (their
+    /// certified intervals overlap), and the seed brings the runs on the
+    /// rim, the side and the polytope's edges and vertices (the features
+    /// Newton's steps switch between) to a few iterations, where the plain
+    /// run's are many: cylinder against cylinder and against a box, crossing
+    /// and parallel axes, from 1e-9 to 1e6 in size, near the origin and 1e6
+    /// from it.
+    #[test]
+    fn seeded_runs_agree_with_plain_runs_in_few_iterations() {
+        let mut rng = Rng(0x5eed_0e70_5eed_0001);
+        let mut by_feature = std::collections::BTreeMap::<String, (u32, u32, u32)>::new();
+        for scale in [1e-9, 1.0, 1e6] {
+            let a = Convex::cylinder(0.5 * scale, 0.8 * scale, 0.0).unwrap();
+            let cylinder = Convex::cylinder(0.3 * scale, 0.6 * scale, 0.0).unwrap();
+            let cuboid = Convex::cuboid(Vector3::new(0.4, 0.3, 0.5) * scale, 0.0).unwrap();
+            for k in 0..600 {
+                let b = if k % 2 == 0 { &cylinder } else { &cuboid };
+                let p = pose(&mut rng, [1.6, 2.2, 4.0][k % 3], scale, k % 5 == 0);
+                // Every seventh pair 1e6 of its size from the origin.
+                let shift = if k % 7 == 0 { 1e6 * scale } else { 0.0 };
+                let base = Isometry3::translation(shift, -shift, shift);
+                let (seeded, plain) = (
+                    run_at(&base, &a, b, &p, true, None),
+                    run_at(&base, &a, b, &p, false, None),
+                );
+                let tol = 1e-12 * scale;
+                assert!(
+                    seeded.lower <= plain.norm + tol && plain.lower <= seeded.norm + tol,
+                    "scale {scale:e} pose {k}: seeded [{:e}, {:e}] plain [{:e}, {:e}]",
+                    seeded.lower,
+                    seeded.norm,
+                    plain.lower,
+                    plain.norm
+                );
+                assert!((seeded.norm - plain.norm).abs() <= 1e-9 * scale);
+                if plain.norm <= 1e-6 * scale {
+                    continue;
+                }
+                let n = plain.solution.v / -plain.norm;
+                let nb = p.rotation.inverse() * -n;
+                let key = format!("{}-{}", feature(&a, &n), feature(b, &nb));
+                let entry = by_feature.entry(key).or_default();
+                entry.0 += 1;
+                entry.1 += seeded.iterations;
+                entry.2 += plain.iterations;
+            }
+        }
+        for key in [
+            "rim-rim",
+            "rim-side",
+            "side-rim",
+            "side-side",
+            "rim-vertex",
+            "rim-edge",
+            "side-vertex",
+        ] {
+            let (count, seeded, plain) = by_feature[key];
+            let (seeded, plain) = (
+                f64::from(seeded) / f64::from(count),
+                f64::from(plain) / f64::from(count),
+            );
+            assert!(count >= 10, "{key}: {count} poses");
+            // A box edge against the rim is found by the support vertex
+            // changing between steps, which far from the answer can name
+            // the wrong edge: the seed helps there, but less.
+            let (most, share) = if key == "rim-edge" {
+                (15.0, 0.75)
+            } else {
+                (6.0, 0.5)
+            };
+            assert!(
+                seeded <= most && seeded < share * plain,
+                "{key}: {seeded} against {plain}"
+            );
+        }
+    }
+
+    /// The warm seed reads a converged simplex's features (a side where both
+    /// caps appear at one angle, a box edge between two vertices) and,
+    /// from the answer's own simplex, the run certifies in one iteration.
+    #[test]
+    fn warm_seeds_from_converged_simplexes_certify_at_once() {
+        let a = Convex::cylinder(0.5, 0.8, 0.0).unwrap();
+        let b = Convex::cylinder(0.3, 0.6, 0.0).unwrap();
+        let cuboid = Convex::cuboid(Vector3::new(0.4, 0.3, 0.5), 0.0).unwrap();
+        let mut rng = Rng(0x5eed_0e70_5eed_0002);
+        let (mut checked, mut box_iterations) = (0, 0);
+        for k in 0..300 {
+            let other = if k % 2 == 0 { &b } else { &cuboid };
+            let p = pose(&mut rng, [2.2, 4.0][k % 2], 1.0, k % 5 == 0);
+            let cold = run(&a, other, &p, true, None);
+            if cold.norm <= 1e-6 {
+                continue;
+            }
+            let id = Isometry3::identity();
+            let place = |pose| PiecePlacement { pose, offset: None };
+            let pair = ConvexPair::new(&a, other, &p, (place(&id), place(&p)), Precision::Double);
+            let mut simplex = Simplex::empty();
+            let answer =
+                pair.solve::<false>(&mut simplex, &Options::default(), None, f64::INFINITY);
+            let kept = super::super::warm_start::PieceSimplex::from_simplex(
+                &simplex,
+                answer.solution.mask,
+                [0, 0],
+            );
+            let warm = run(&a, other, &p, true, Some(kept.pairs()));
+            assert!((warm.norm - cold.norm).abs() <= 1e-12, "pose {k}");
+            // Cylinder pairs certify at once; a box's face can take the
+            // plain run a few more.
+            if k % 2 == 0 {
+                assert!(
+                    warm.iterations <= 2,
+                    "pose {k}: {} iterations",
+                    warm.iterations
+                );
+            }
+            box_iterations += if k % 2 == 1 { warm.iterations } else { 0 };
+            checked += 1;
+        }
+        assert!(checked > 150, "{checked}");
+        assert!(
+            f64::from(box_iterations) / f64::from(checked) < 1.5,
+            "{box_iterations}"
+        );
+    }
+
+    /// Where Newton's method cannot start (the shapes overlap, so no
+    /// direction separates them; a direction along a cylinder's axis, whose
+    /// rim curvature is unbounded) it gives no seed, and the plain run
+    /// answers: coaxial caps 0.5 apart, and overlapping cylinders.
+    #[test]
+    fn no_seed_where_newton_cannot_start_and_the_plain_run_answers() {
+        let a = Convex::cylinder(0.5, 0.8, 0.0).unwrap();
+        let b = Convex::cylinder(0.3, 0.6, 0.0).unwrap();
+        let id = Isometry3::identity();
+        let place = |pose| PiecePlacement { pose, offset: None };
+        let above = Isometry3::translation(0.0, 0.0, 1.9);
+        let pair = ConvexPair::new(
+            &a,
+            &b,
+            &above,
+            (place(&id), place(&above)),
+            Precision::Double,
+        );
+        assert!(pair.newton_seed(&Vector3::new(0.0, 0.0, -1.0)).is_none());
+        let coaxial = run(&a, &b, &above, true, None);
+        assert!((coaxial.norm - 0.5).abs() < 1e-12, "{}", coaxial.norm);
+        let inside = Isometry3::translation(0.2, 0.1, 0.3);
+        let pair = ConvexPair::new(
+            &a,
+            &b,
+            &inside,
+            (place(&id), place(&inside)),
+            Precision::Double,
+        );
+        for v in [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.3, -0.7, 0.2)] {
+            assert!(pair.newton_seed(&v).is_none(), "{v:?}");
+        }
+        assert_eq!(run(&a, &b, &inside, true, None).norm, 0.0);
+        // A seed that the run cannot use (codes far from the answer) costs
+        // iterations, never the answer.
+        let beside = Isometry3::from_parts(
+            Translation3::new(1.3, 0.4, 0.2),
+            UnitQuaternion::from_euler_angles(0.3, 1.2, 0.1),
+        );
+        let plain = run(&a, &b, &beside, false, None);
+        let far = run(
+            &a,
+            &b,
+            &beside,
+            true,
+            Some(&[[7, 1 << 31], [1 << 30, 12345]]),
+        );
+        assert!((far.norm - plain.norm).abs() <= 1e-12);
+    }
+}

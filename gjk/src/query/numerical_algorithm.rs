@@ -104,7 +104,13 @@ impl ConvexPair<'_> {
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> RunOutcome {
-        let mut run = self.solve_scaled::<AVX2>(simplex, options, warm, cutoff);
+        // Two copies of the loop: pairs without a cylinder (never seeded)
+        // run one with no trace of the seed, which keeps their time.
+        let mut run = if self.seed_after == u32::MAX {
+            self.solve_scaled::<AVX2, false>(simplex, options, warm, cutoff)
+        } else {
+            self.solve_seeded::<AVX2>(simplex, options, warm, cutoff)
+        };
         if self.inv_scale != 1.0 {
             run.norm *= self.inv_scale;
             run.lower *= self.inv_scale;
@@ -112,6 +118,19 @@ impl ConvexPair<'_> {
             run.solution.v *= self.inv_scale;
         }
         run
+    }
+
+    /// [`solve_scaled`](Self::solve_scaled) with the seed, out of line:
+    /// inlined, its copy of the loop slowed the polytope pairs' beside it.
+    #[inline(never)]
+    fn solve_seeded<const AVX2: bool>(
+        &self,
+        simplex: &mut Simplex,
+        options: &Options,
+        warm: Option<&[[u32; 2]]>,
+        cutoff: f64,
+    ) -> RunOutcome {
+        self.solve_scaled::<AVX2, true>(simplex, options, warm, cutoff)
     }
 
     /// [`solve`](Self::solve) in the scaled frame: every length in the
@@ -124,7 +143,7 @@ impl ConvexPair<'_> {
     /// Both take the same decisions on the same values, so the split changes
     /// the time of a query, never its answer.
     #[inline(always)]
-    pub(super) fn solve_scaled<const AVX2: bool>(
+    pub(super) fn solve_scaled<const AVX2: bool, const SEED: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
@@ -136,11 +155,7 @@ impl ConvexPair<'_> {
         let mut seed_tried = false;
         match warm {
             Some(pairs) => {
-                let seed = if self.seed_after == u32::MAX {
-                    None
-                } else {
-                    self.warm_seed(pairs)
-                };
+                let seed = if !SEED { None } else { self.warm_seed(pairs) };
                 seed_tried = seed.is_some();
                 let pairs = match &seed {
                     Some((seed_pairs, len)) => &seed_pairs[..*len],
@@ -158,7 +173,7 @@ impl ConvexPair<'_> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
-        let seed_after = self.seed_after;
+        let seed_after = if SEED { self.seed_after } else { u32::MAX };
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -237,7 +252,7 @@ impl ConvexPair<'_> {
             // Seeded once, from the first iterate (past `seed_after`) whose
             // direction separates the projections: from there Newton's
             // steps converge.
-            if state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
+            if SEED && state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
                 seed_tried = true;
                 if let Some((pairs, len)) = self.newton_seed(&solution.v) {
                     let (points, len) = self.seed_vertices(&pairs[..len]);

@@ -47,8 +47,17 @@ pub(crate) fn support_code(d: &Vector3<f64>) -> u32 {
         return cap;
     }
     let t = diamond_angle(x, y, sum);
-    let q = (t * (f64::from(STEPS) / 4.0)).round() as u32;
+    let q = round_small(t * (f64::from(STEPS) / 4.0)) as u32;
     cap | (if q >= STEPS { 0 } else { q } + 1)
+}
+
+/// `x` (in `[0, 2^51)`) rounded to the nearest integer, ties to even: the
+/// addition of `2^52` leaves no fraction bits. `f64::round` is a call into
+/// libm on a target without SSE4.1, in the support of every iteration.
+#[inline(always)]
+fn round_small(x: f64) -> f64 {
+    const SHIFT: f64 = 4_503_599_627_370_496.0;
+    (x + SHIFT) - SHIFT
 }
 
 /// The diamond angle of `(x, y)` (not both zero, `sum = |x| + |y|` finite):
@@ -150,6 +159,22 @@ mod tests {
         for code in [u32::MAX, TOP + 1, TOP - 1, 1] {
             let p = point(code, 1.0, 2.0);
             assert!((p.x.hypot(p.y) - 1.0).abs() < 1e-15, "{code}");
+        }
+    }
+
+    /// The shifted rounding is `f64::round` but at ties (to even, not
+    /// away from zero), over the codes' whole range and its ends.
+    #[test]
+    fn shifted_rounding_matches_round_but_at_ties() {
+        let mut rng = Rng(0x5eed_c711_0000_0003);
+        let top = f64::from(STEPS);
+        let mut xs = vec![0.0, 0.25, 0.75, 1.0 - 1e-16, 1.0, top - 0.5 + 1e-6, top];
+        xs.extend((0..20_000).map(|_| (rng.next() * 0.5 + 0.5) * top));
+        for x in xs {
+            assert_eq!(round_small(x), x.round(), "{x}");
+        }
+        for (tie, even) in [(0.5, 0.0), (1.5, 2.0), (2.5, 2.0), (top - 0.5, top - 1.0)] {
+            assert_eq!(round_small(tie), even, "{tie}");
         }
     }
 }

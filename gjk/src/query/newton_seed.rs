@@ -36,7 +36,7 @@ use crate::shape::Convex;
 pub(super) type Seed = ([[u32; 2]; 3], usize);
 
 /// Newton steps before the seed is given up.
-const MAX_STEPS: u32 = 8;
+const MAX_STEPS: u32 = 12;
 
 /// The step (in radians) below which the direction has converged: the next
 /// step would be of its square's order, and the run's stopping rule needs

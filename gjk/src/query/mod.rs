@@ -2,6 +2,7 @@
 //! pair's relative frame, with certified bounds, margins and warm start.
 
 mod answer;
+mod cap_seed;
 mod compound;
 mod full_step;
 mod newton_seed;

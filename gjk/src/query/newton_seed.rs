@@ -38,6 +38,11 @@ pub(super) type Seed = ([[u32; 2]; 3], usize);
 /// Newton steps before the seed is given up.
 const MAX_STEPS: u32 = 12;
 
+/// The sine of the angle to a cylinder's axis below which a direction is
+/// tried against its cap (see `cap_seed`): Newton's steps close in on a
+/// cap's answer without reaching it.
+const CAP_NEAR: f64 = 0.25;
+
 /// The step (in radians) below which the direction has converged: the next
 /// step would be of its square's order, and the run's stopping rule needs
 /// the direction to about 1e-7.
@@ -57,6 +62,9 @@ struct Touch {
     /// A cylinder's axis (the difference of its caps): zero for a polytope,
     /// whose kinks are the differences of its vertices.
     axis: Vector3<f64>,
+    /// A cylinder's `|d_xy|` at the unit body direction `d` (the sine of
+    /// its angle to the axis): infinite for a polytope.
+    rho: f64,
 }
 
 /// What one shape's kinks have shown: the support keys seen on either side
@@ -151,6 +159,7 @@ fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
             curvature: 0.0,
             tangent: Vector3::zeros(),
             axis: Vector3::zeros(),
+            rho: f64::INFINITY,
         });
     };
     // |d| = 1: the squares neither overflow nor lose the direction.
@@ -167,6 +176,7 @@ fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
         curvature: r * inv,
         tangent: Vector3::new(-sy, cx, 0.0),
         axis: Vector3::z(),
+        rho,
     })
 }
 
@@ -247,6 +257,9 @@ impl ConvexPair<'_> {
         if pairs.is_empty() {
             return None;
         }
+        if let Some(seed) = self.warm_cap_seed(pairs) {
+            return Some(seed);
+        }
         let mut mean = Vector3::zeros();
         for &[ia, ib] in pairs {
             mean += self.difference_vertex(ia as usize, ib as usize).y;
@@ -294,11 +307,64 @@ impl ConvexPair<'_> {
         self.solve_from(solve)
     }
 
+    /// The cap seed (see `cap_seed`) of each cylinder whose `rho` is below
+    /// [`CAP_NEAR`] at `u`, each tried once.
+    fn try_caps(&self, u: &Vector3<f64>, tried: &mut [bool; 2], rho: [f64; 2]) -> Option<Seed> {
+        for k in 0..2 {
+            if !tried[k] && rho[k] < CAP_NEAR {
+                tried[k] = true;
+                if let Some(seed) = self.cap_seed(k, u) {
+                    return Some(seed);
+                }
+            }
+        }
+        None
+    }
+
+    /// The cap seed of a warm start whose pairs name a cap: two or more
+    /// points of a cylinder, all on one cap (a cap's answer keeps a
+    /// triangle of it).
+    fn warm_cap_seed(&self, pairs: &[[u32; 2]]) -> Option<Seed> {
+        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
+            if shape.cylinder_dimensions().is_none() {
+                continue;
+            }
+            let first = pairs[0][k];
+            let (mut distinct, mut one_cap) = (false, true);
+            for p in &pairs[1..] {
+                distinct |= p[k] != first;
+                one_cap &= cylinder::is_top(p[k]) == cylinder::is_top(first);
+            }
+            if !(distinct && one_cap) {
+                continue;
+            }
+            // A's support direction towards the cap's side.
+            let side = if cylinder::is_top(first) { 1.0 } else { -1.0 };
+            let u = if k == 0 {
+                Vector3::new(0.0, 0.0, side)
+            } else {
+                -rotate(&self.rotation, &Vector3::new(0.0, 0.0, side))
+            };
+            return self.cap_seed(k, &u);
+        }
+        None
+    }
+
     /// Newton's steps from `solve` to the seed.
     fn solve_from(&self, mut solve: Solve) -> Option<Seed> {
         let mut last: Option<[Touch; 2]> = None;
+        let mut cap_tried = [false; 2];
         for _ in 0..MAX_STEPS {
-            let touches = self.touches(&solve.u)?;
+            let Some(touches) = self.touches(&solve.u) else {
+                // Along an axis: only its cap can hold the answer.
+                return self.try_caps(&solve.u, &mut cap_tried, [0.0; 2]);
+            };
+            let rho = [touches[0].rho, touches[1].rho];
+            if rho.iter().any(|&rho| rho < CAP_NEAR)
+                && let Some(seed) = self.try_caps(&solve.u, &mut cap_tried, rho)
+            {
+                return Some(seed);
+            }
             if let Some(previous) = last
                 && self.note_vertex_kinks(&mut solve, &previous, &touches)
             {
@@ -313,7 +379,10 @@ impl ConvexPair<'_> {
             if landed {
                 solve.held = solve.constraints(&touches);
             }
-            let small = step.norm_squared() < CONVERGED_STEP * CONVERGED_STEP;
+            // Near a cylinder's axis a turn of the direction turns its rim
+            // point by that over `rho`: the test is on the rim point's.
+            let converged_step = CONVERGED_STEP * rho[0].min(rho[1]).min(1.0);
+            let small = step.norm_squared() < converged_step * converged_step;
             let converged = !landed && (small || solve.held.len == 2);
             if converged && solve.side == [false; 2] {
                 // The seed's supports need the direction, not its length.
@@ -525,6 +594,7 @@ fn newton_step(
         _ => Some(Vector3::zeros()),
     }
     .map(|step: Vector3<f64>| {
+        let step = toward_axes_by_half(step, touches);
         // Far from the answer the quadratic model is poor: no step turns
         // the direction by more than about half a radian.
         let squared = step.norm_squared();
@@ -534,6 +604,30 @@ fn newton_step(
             step
         }
     })
+}
+
+/// `step` with its part towards each cylinder's axis cut to half the
+/// direction's angle to it: near an axis the rim's curvature (`r / rho`)
+/// changes faster than the quadratic model knows, and a full step would
+/// cross the axis; the part along the rim is kept, so the rim point still
+/// turns to the answer's.
+#[inline(always)]
+fn toward_axes_by_half(mut step: Vector3<f64>, touches: &[Touch; 2]) -> Vector3<f64> {
+    for (k, touch) in touches.iter().enumerate() {
+        if touch.rho >= 1.0 {
+            continue;
+        }
+        // The direction in which the angle to the axis grows: A's support
+        // direction is `u`, B's `-u`.
+        let outward = touch.tangent.cross(&touch.axis);
+        let outward = if k == 0 { outward } else { -outward };
+        let along = step.dot(&outward);
+        let floor = -0.5 * touch.rho;
+        if along < floor {
+            step += outward * (floor - along);
+        }
+    }
+    step
 }
 
 /// The unconstrained step: `(F + Σ k_i·p_i·p_iᵀ)·ξ = g`, `g = -P·y`,
@@ -804,10 +898,10 @@ mod tests {
         );
     }
 
-    /// Where Newton's method cannot start (the shapes overlap, so no
-    /// direction separates them; a direction along a cylinder's axis, whose
-    /// rim curvature is unbounded) it gives no seed, and the plain run
-    /// answers: coaxial caps 0.5 apart, and overlapping cylinders.
+    /// Where Newton's method cannot start it gives no seed, and the plain
+    /// run answers: overlapping cylinders (no direction separates them).
+    /// A direction along a cylinder's axis, whose rim curvature is
+    /// unbounded, is seeded from the cap instead: coaxial caps 0.5 apart.
     #[test]
     fn no_seed_where_newton_cannot_start_and_the_plain_run_answers() {
         let a = Convex::cylinder(0.5, 0.8, 0.0).unwrap();
@@ -822,8 +916,12 @@ mod tests {
             (place(&id), place(&above)),
             Precision::Double,
         );
-        assert!(pair.newton_seed(&Vector3::new(0.0, 0.0, -1.0)).is_none());
-        let coaxial = run(&a, &b, &above, true, None);
+        let (pairs, len) = pair.newton_seed(&Vector3::new(0.0, 0.0, -1.0)).unwrap();
+        let coaxial = run(&a, &b, &above, true, Some(&pairs[..len]));
+        assert!((coaxial.norm - 0.5).abs() < 1e-12, "{}", coaxial.norm);
+        assert!((coaxial.lower - 0.5).abs() < 1e-12, "{}", coaxial.lower);
+        assert_eq!(coaxial.iterations, 1);
+        let coaxial = run(&a, &b, &above, false, None);
         assert!((coaxial.norm - 0.5).abs() < 1e-12, "{}", coaxial.norm);
         let inside = Isometry3::translation(0.2, 0.1, 0.3);
         let pair = ConvexPair::new(

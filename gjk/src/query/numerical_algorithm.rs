@@ -44,6 +44,12 @@ pub(super) fn push_vertex<const AVX2: bool>(simplex: &mut Simplex, keep: u8, poi
     simplex.push(keep, point);
 }
 
+/// Seeds a run may take (see `newton_seed`).
+const MAX_SEEDS: u32 = 2;
+
+/// Plain iterations after a seed before the next.
+const RESEED_AFTER: u32 = 2;
+
 /// One convex pair's run of the Numerical Algorithm.
 pub(super) struct RunOutcome {
     /// Lower bound on the cores' penetration depth (5.9), 0 unless they touch
@@ -152,11 +158,16 @@ impl ConvexPair<'_> {
     ) -> RunOutcome {
         // Step (1): V0 from the warm start (for a pair with a cylinder,
         // the seed solved from it), else the single point s_K(z̄2 - z̄1).
-        let mut seed_tried = false;
+        let seed_after = if SEED { self.seed_after } else { u32::MAX };
+        // The iteration from which the run is next seeded, and how many
+        // seeds it has left.
+        let (mut next_seed, mut seeds_left) = (seed_after, MAX_SEEDS);
         match warm {
             Some(pairs) => {
                 let seed = if !SEED { None } else { self.warm_seed(pairs) };
-                seed_tried = seed.is_some();
+                if seed.is_some() {
+                    (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS - 1);
+                }
                 let pairs = match &seed {
                     Some((seed_pairs, len)) => &seed_pairs[..*len],
                     None => pairs,
@@ -173,7 +184,6 @@ impl ConvexPair<'_> {
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
         let stop_d = eps_d + self.single_slack;
-        let seed_after = if SEED { self.seed_after } else { u32::MAX };
         let mut state = RunProgress {
             iterations: 0,
             previous: None,
@@ -249,11 +259,14 @@ impl ConvexPair<'_> {
             }
             // Step (4), or the seed in its place.
             state.lower = lower;
-            // Seeded once, from the first iterate (past `seed_after`) whose
+            // Seeded from the first iterate (past `seed_after`) whose
             // direction separates the projections: from there Newton's
-            // steps converge.
-            if SEED && state.iterations >= seed_after && !seed_tried && v_dot_support > 0.0 {
-                seed_tried = true;
+            // steps converge. A seed that named the wrong features (a box
+            // edge guessed far from the answer) is followed by another,
+            // from the nearer iterate the run has reached since.
+            if SEED && state.iterations >= next_seed && seeds_left > 0 && v_dot_support > 0.0 {
+                seeds_left -= 1;
+                next_seed = state.iterations + RESEED_AFTER;
                 if let Some((pairs, len)) = self.newton_seed(&solution.v) {
                     let (points, len) = self.seed_vertices(&pairs[..len]);
                     reset_simplex::<AVX2>(simplex, &points[..len]);

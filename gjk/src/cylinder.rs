@@ -61,15 +61,15 @@ fn round_small(x: f64) -> f64 {
 }
 
 /// The diamond angle of `(x, y)` (not both zero, `sum = |x| + |y|` finite):
-/// `t ∈ [0, 4]`, increasing with the angle, one unit a quadrant.
+/// `t ∈ [0, 4]`, increasing with the angle, one unit a quadrant. On the
+/// upper half (`y >= 0`) it is `1 - x/sum`, on the lower `3 + x/sum`
+/// (`|x| + |y| = sum` gives each quadrant's form from these): one division
+/// and one select, where a branch on the quadrant was mispredicted on
+/// every turn of the direction.
 #[inline(always)]
 fn diamond_angle(x: f64, y: f64, sum: f64) -> f64 {
-    match (x >= 0.0, y >= 0.0) {
-        (true, true) => y / sum,
-        (false, true) => 1.0 - x / sum,
-        (false, false) => 2.0 - y / sum,
-        (true, false) => 3.0 + x / sum,
-    }
+    let share = x / sum;
+    if y >= 0.0 { 1.0 - share } else { 3.0 + share }
 }
 
 /// The code of the point at the same angle on the other cap.
@@ -94,14 +94,11 @@ pub(crate) fn point(code: u32, r: f64, h: f64) -> Vector3<f64> {
         return Vector3::new(0.0, 0.0, z);
     }
     let t = f64::from(q - 1) * (4.0 / f64::from(STEPS));
-    let quadrant = (t as u32).min(3);
-    let f = t - f64::from(quadrant);
-    let (x, y) = match quadrant {
-        0 => (1.0 - f, f),
-        1 => (-f, 1.0 - f),
-        2 => (f - 1.0, -f),
-        _ => (f, f - 1.0),
-    };
+    // The inverse of `diamond_angle`, by halves as it is.
+    let upper = t <= 2.0;
+    let x = if upper { 1.0 - t } else { t - 3.0 };
+    let y = 1.0 - x.abs();
+    let y = if upper { y } else { -y };
     // |x| + |y| = 1: the length is in [1/√2, 1], no overflow, no underflow.
     let k = r / (x * x + y * y).sqrt();
     Vector3::new(x * k, y * k, z)

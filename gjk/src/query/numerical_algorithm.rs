@@ -50,6 +50,11 @@ const MAX_SEEDS: u32 = 2;
 /// Plain iterations after a seed before the next.
 const RESEED_AFTER: u32 = 2;
 
+/// The share of `|v|` an iterate's lower bound must reach for a seed
+/// after the first, and the multiple of the round-off allowance.
+const RESEED_SHARE: f64 = 0.5;
+const RESEED_SLACKS: f64 = 1e6;
+
 /// One convex pair's run of the Numerical Algorithm.
 pub(super) struct RunOutcome {
     /// Lower bound on the cores' penetration depth (5.9), 0 unless they touch
@@ -159,14 +164,17 @@ impl ConvexPair<'_> {
         // Step (1): V0 from the warm start (for a pair with a cylinder,
         // the seed solved from it), else the single point s_K(z̄2 - z̄1).
         let seed_after = if SEED { self.seed_after } else { u32::MAX };
-        // The iteration from which the run is next seeded, and how many
-        // seeds it has left.
+        // The iteration from which the run is next seeded, how many seeds
+        // it has left, and the share of `|v|` and the length its lower
+        // bound must reach.
         let (mut next_seed, mut seeds_left) = (seed_after, MAX_SEEDS);
+        let (mut seed_share, mut seed_floor) = (0.0, 0.0);
         match warm {
             Some(pairs) => {
                 let seed = if !SEED { None } else { self.warm_seed(pairs) };
                 if seed.is_some() {
                     (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS - 1);
+                    (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
                 }
                 let pairs = match &seed {
                     Some((seed_pairs, len)) => &seed_pairs[..*len],
@@ -263,10 +271,21 @@ impl ConvexPair<'_> {
             // direction separates the projections: from there Newton's
             // steps converge. A seed that named the wrong features (a box
             // edge guessed far from the answer) is followed by another,
-            // from the nearer iterate the run has reached since.
-            if SEED && state.iterations >= next_seed && seeds_left > 0 && v_dot_support > 0.0 {
+            // from the nearer iterate the run has reached since, unless the
+            // shapes nearly touch, relative to their distance or to the
+            // round-off allowance: there Newton's steps divide by a
+            // distance lost in round-off, and a fresh start would lose a
+            // slow run's progress (a touching contact 1e9 from the origin
+            // hit the iteration cap).
+            if SEED
+                && state.iterations >= next_seed
+                && seeds_left > 0
+                && v_dot_support > seed_share * v2
+                && v_dot_support > seed_floor * norm
+            {
                 seeds_left -= 1;
                 next_seed = state.iterations + RESEED_AFTER;
+                (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
                 if let Some((pairs, len)) = self.newton_seed(&solution.v) {
                     let (points, len) = self.seed_vertices(&pairs[..len]);
                     reset_simplex::<AVX2>(simplex, &points[..len]);

@@ -380,8 +380,9 @@ impl ConvexPair<'_> {
                 solve.held = solve.constraints(&touches);
             }
             // Near a cylinder's axis a turn of the direction turns its rim
-            // point by that over `rho`: the test is on the rim point's.
-            let converged_step = CONVERGED_STEP * rho[0].min(rho[1]).min(1.0);
+            // point by that over `rho`: there the test is on the rim
+            // point's turn.
+            let converged_step = CONVERGED_STEP * (rho[0].min(rho[1]) / CAP_NEAR).min(1.0);
             let small = step.norm_squared() < converged_step * converged_step;
             let converged = !landed && (small || solve.held.len == 2);
             if converged && solve.side == [false; 2] {
@@ -614,7 +615,7 @@ fn newton_step(
 #[inline(always)]
 fn toward_axes_by_half(mut step: Vector3<f64>, touches: &[Touch; 2]) -> Vector3<f64> {
     for (k, touch) in touches.iter().enumerate() {
-        if touch.rho >= 1.0 {
+        if touch.rho >= CAP_NEAR {
             continue;
         }
         // The direction in which the angle to the axis grows: A's support

@@ -171,7 +171,7 @@ fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
     let (cx, sy) = (d.x * inv, d.y * inv);
     let top = d.z > 0.0;
     Some(Touch {
-        point: Vector3::new(r * cx, r * sy, if top { h } else { -h }),
+        point: Vector3::new(r * cx, r * sy, cylinder::negate_if(h, !top)),
         key: u32::from(top),
         curvature: r * inv,
         tangent: Vector3::new(-sy, cx, 0.0),

@@ -19,6 +19,9 @@
 //! support points at the final direction, with the partners of each kink,
 //! are the seed. A warm start names its features exactly, so its seed
 //! starts on them, from the direction of its points at the new pose.
+//! Near a cylinder's axis, where the rim's curvature grows without bound
+//! and a cap may hold the answer, the cap is tried in closed form
+//! (`cap_seed`), and steps towards the axis are cut to half the angle.
 //!
 //! The seed only chooses where the ordinary run starts: the run certifies
 //! the bounds (Theorem 4.1) as for any start, so a seed on the wrong

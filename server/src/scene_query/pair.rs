@@ -15,6 +15,10 @@ use crate::requests::run_pair;
 use crate::store::ObjectStore;
 use gjk::WarmStart;
 
+/// Support points added to an overlapping pair's penetration bound when
+/// it is kept as a motion bound for a within question.
+const PENETRATION_EXPANSIONS: u32 = 4;
+
 /// What is asked of a pair.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Ask {
@@ -166,6 +170,12 @@ impl Ctx<'_> {
             Ask::Within(m) => Some(m),
             Ask::Below(_) | Ask::BelowExactly(_) => None,
         };
+        // A kept overlap settles the pair within the margin for as long as
+        // the motion since stays below its depth: a deeper bound is worth a
+        // few support searches then.
+        if q.motion && matches!(ask, Ask::Within(_)) {
+            options.penetration_expansions = PENETRATION_EXPANSIONS;
+        }
         let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;
         match run_pair(

@@ -146,6 +146,7 @@ fuzz_target!(|data: &[u8]| {
         margin: if b.u8() % 3 == 0 { Some(b.f64()) } else { None },
         warm_start: true,
         precision: if b.u8() % 2 == 0 { Precision::Double } else { Precision::Single },
+        penetration_expansions: u32::from(b.u8() % 3) * 8,
     };
     if debug {
         eprintln!("a = {sa:?}\nb = {sb:?}\npose_a = {pa:?}\npose_b = {pb:?}\noptions = {options:?}");

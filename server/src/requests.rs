@@ -88,6 +88,7 @@ impl State {
             } else {
                 gjk::Precision::Double
             },
+            penetration_expansions: 0,
         };
         if !(options.tolerance.is_finite() && options.tolerance >= 0.0)
             || options.max_iterations == 0

@@ -553,6 +553,7 @@ pub fn gjk_options(o: &gjkd_client::QueryOptions) -> gjk::Options {
             gjkd_client::Precision::Double => gjk::Precision::Double,
             gjkd_client::Precision::Single => gjk::Precision::Single,
         },
+        penetration_expansions: 0,
     }
 }
 

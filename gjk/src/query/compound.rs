@@ -192,7 +192,8 @@ pub(super) fn search_compound_body<const AVX2: bool>(
             precision,
         );
         let warm_pairs = warm.and_then(|w| w.for_pieces(pieces));
-        let run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, cutoff);
+        let mut run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, cutoff);
+        pair.deepen(&mut run, simplex, options);
         let (pair_lower, pair_upper, pair_distance) = pair.certified_bounds(&run);
         if pair_upper < two_nearest[1].0 {
             let kept = PieceSimplex::from_simplex(simplex, run.solution.mask, pieces);

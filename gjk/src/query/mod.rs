@@ -9,6 +9,7 @@ mod newton_seed;
 mod numerical_algorithm;
 mod options;
 mod pair;
+mod penetration;
 mod recovery;
 mod warm_start;
 
@@ -270,7 +271,9 @@ fn distance_body<const AVX2: bool>(
             );
             let simplex = &mut workspace.simplex;
             let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
+            let mut run =
+                pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
+            pair.deepen(&mut run, simplex, options);
             let stuck_width = if swapped {
                 f64::INFINITY
             } else {

@@ -180,6 +180,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
             } else {
                 gjk::Precision::Double
             },
+            penetration_expansions: 0,
         },
         accept_absolute: r.accept_absolute,
         accept_relative: r.accept_relative,

@@ -57,11 +57,6 @@ pub(crate) struct Widened {
     pub upper: f64,
 }
 
-/// `bound` widened to the index poses of `a` and `b`.
-pub(crate) fn widen(bound: &PairBound, a: &Entry, b: &Entry) -> Widened {
-    widen_by(bound, moved_since(bound, a, b))
-}
-
 /// The largest distance any point of `a` or `b` can have moved from the
 /// poses of `bound` to their index poses, rounded up (the sum of both).
 pub(crate) fn moved_since(bound: &PairBound, a: &Entry, b: &Entry) -> f64 {

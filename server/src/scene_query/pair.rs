@@ -4,16 +4,39 @@
 
 use gjkd_proto::{ErrorCode, ItemResult};
 
-use super::broadphase::Broadphase;
+use super::broadphase::{Broadphase, Entry};
 use super::groups::Group;
 use super::motion_bound::{
-    Widened, accepted, bound_of, bounded_result, carried, moved_since, widen, widen_by,
+    Widened, accepted, bound_of, bounded_result, carried, moved_since, widen_by,
 };
 use super::{Counters, Question};
 use crate::cache::{PairBound, PairKey, WarmCache};
 use crate::requests::run_pair;
 use crate::store::ObjectStore;
 use gjk::WarmStart;
+
+/// Support points added to an overlapping pair's penetration bound when
+/// it is kept as a motion bound for a within question.
+const PENETRATION_EXPANSIONS: u32 = 4;
+
+/// The motion bound kept for `key` (objects `ea`, `eb`), when motion
+/// bounds are on: the bound, how far any point of either object moved
+/// since ([`moved_since`]), and the bound widened by that.
+#[inline(always)]
+fn kept_bound<'c>(
+    q: &Question,
+    cache: &'c mut WarmCache,
+    key: &PairKey,
+    ea: &Entry,
+    eb: &Entry,
+) -> Option<(&'c PairBound, f64, Widened)> {
+    if !q.motion {
+        return None;
+    }
+    let bound = cache.bound(key)?;
+    let d = moved_since(bound, ea, eb);
+    Some((bound, d, widen_by(bound, d)))
+}
 
 /// What is asked of a pair.
 #[derive(Clone, Copy, Debug)]
@@ -72,14 +95,9 @@ impl Ctx<'_> {
     /// The pair's motion bound at the current poses, when motion bounds are
     /// on and one is kept: the cached answer and its widened interval.
     pub(crate) fn widened(&mut self, a: u32, b: u32) -> Option<(&PairBound, Widened)> {
-        if !self.q.motion {
-            return None;
-        }
         let key = self.key(a, b);
-        let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
-        let bound = self.cache.bound(&key)?;
-        let w = widen(bound, ea, eb);
-        Some((bound, w))
+        kept_bound(self.q, self.cache, &key, self.bp.entry(a), self.bp.entry(b))
+            .map(|(bound, _, w)| (bound, w))
     }
 
     fn key(&self, a: u32, b: u32) -> PairKey {
@@ -107,11 +125,8 @@ impl Ctx<'_> {
     ) -> Outcome {
         let q = self.q;
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
-        if q.motion
-            && let Some(bound) = self.cache.bound(&self.key(a, b))
-        {
-            let d = moved_since(bound, ea, eb);
-            let w = widen_by(bound, d);
+        let key = self.key(a, b);
+        if let Some((bound, d, w)) = kept_bound(q, self.cache, &key, ea, eb) {
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
                 Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
@@ -166,6 +181,12 @@ impl Ctx<'_> {
             Ask::Within(m) => Some(m),
             Ask::Below(_) | Ask::BelowExactly(_) => None,
         };
+        // A kept overlap settles the pair within the margin for as long as
+        // the motion since stays below its depth: a deeper bound is worth a
+        // few support searches then.
+        if q.motion && matches!(ask, Ask::Within(_)) {
+            options.penetration_expansions = PENETRATION_EXPANSIONS;
+        }
         let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;
         match run_pair(

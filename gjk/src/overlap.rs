@@ -141,7 +141,8 @@ fn face_distance(
     // The fourth point's side decides the outward normal: within the
     // round-off it is not decided, and neither is anything else.
     let opposite = n.dot(&(d - a)) * inverse;
-    if !(opposite.abs() > slack) {
+    // (A NaN, from a degenerate face, decides nothing either.)
+    if opposite.abs() <= slack || opposite.is_nan() || slack.is_nan() {
         return 0.0;
     }
     let outward = if opposite > 0.0 { -1.0 } else { 1.0 };

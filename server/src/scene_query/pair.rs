@@ -185,9 +185,9 @@ impl Ctx<'_> {
             return None;
         }
         let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
-        // The normal as it was in the world: the objects it separated
-        // moved apart along it, or not far across it, since.
-        let normal = bound.pose_a.rotation * bound.normal;
+        // The normal turned with A: right when A turns about it, or
+        // when the pair turns together.
+        let normal = ea.pose.rotation * bound.normal;
         let lower = gjk::separation_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &normal);
         let ruled = match ask {
             Ask::Within(m) => lower > m,
@@ -200,13 +200,7 @@ impl Ctx<'_> {
             lower: lower.max(w.lower),
             upper: w.upper.max(lower),
         };
-        let fresh = PairBound {
-            // The direction that proved it, in the world, stays the one
-            // tried next.
-            normal: ea.pose.rotation.inverse_transform_vector(&normal),
-            ..carried(bound, d, &w, ea, eb)
-        };
-        Some((fresh, Outcome::Ruled))
+        Some((carried(bound, d, &w, ea, eb), Outcome::Ruled))
     }
 
     /// The kept `bound` of an overlapping pair re-certified at the current
@@ -228,7 +222,7 @@ impl Ctx<'_> {
         let warm = self.cache.get(key)?;
         let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
         let depth = gjk::penetration_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &warm);
-        if !(depth > 0.0) {
+        if depth <= 0.0 {
             return None;
         }
         let w = Widened {

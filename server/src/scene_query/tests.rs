@@ -1134,19 +1134,21 @@ fn spinning_paths_recheck_kept_bounds_instead_of_running_gjk() {
             .unwrap()
         };
         let (mover, core) = (block(1.0), block(0.2));
-        // A lid tilted about x, its lower face 0.3 to 0.5 above the box
-        // whatever the spin (the box's support along its normal `n` is
-        // between 1.357 and 1.556), its own box reaching down past the
-        // box's.
+        // A lid tilted about x, its lower face 0.5 above the box (the
+        // box's support along its normal `n` is 1.357), its own box
+        // reaching down past the box's.
         let tilt = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -0.5);
         let n = tilt * Vector3::z();
+        // Spinning about the lid's normal, so that the box's support along
+        // it stays as it was.
+        let axis = nalgebra::Unit::new_normalize(n);
         let lid = s
             .insert(
                 NewObject {
                     shape: Convex::cuboid(Vector3::new(2.0, 2.0, 0.5), 0.0)
                         .unwrap()
                         .into(),
-                    pose: Isometry3::from_parts(Translation3::from(centre + n * 2.356), tilt),
+                    pose: Isometry3::from_parts(Translation3::from(centre + n * 2.357), tilt),
                     name: None,
                 },
                 Owner::Client(1),
@@ -1157,7 +1159,7 @@ fn spinning_paths_recheck_kept_bounds_instead_of_running_gjk() {
         let mut steps = Vec::new();
         let spins: u32 = 60;
         for i in 0..spins {
-            let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.3 * f64::from(i));
+            let turn = UnitQuaternion::from_axis_angle(&axis, 0.3 * f64::from(i));
             let at = if i == spins / 2 {
                 centre + Vector3::new(50.0, 0.0, 0.0)
             } else {
@@ -1176,8 +1178,8 @@ fn spinning_paths_recheck_kept_bounds_instead_of_running_gjk() {
         let hits = rows.iter().filter(|r| r.b == core).count();
         assert_eq!(hits, spins as usize - 1, "{reply:?}");
         assert!(rows.iter().all(|r| r.b == core), "{rows:?}");
-        // Each step moves points of the box by about 0.5, more than the
-        // lid's gap of 0.3: without the rechecks both pairs would run GJK
+        // Each step moves points of the box by about 0.5, as much as the
+        // lid's gap: without the rechecks both pairs would run GJK
         // at nearly every step.
         assert!(reply.gjk_runs <= 12, "{reply:?}");
         assert!(reply.bounded >= 2 * u64::from(spins) - 20, "{reply:?}");

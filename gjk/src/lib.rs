@@ -34,12 +34,16 @@ mod cones;
 mod cylinder;
 mod dd;
 mod johnson;
+mod overlap;
 mod query;
+mod separation;
 mod shape;
 
+pub use overlap::penetration_bound;
 #[doc(hidden)]
 pub use query::distance_in_baseline;
 pub use query::{Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_in};
+pub use separation::separation_bound;
 pub use shape::{Compound, Convex, Shape};
 
 /// Whether this CPU has AVX2 and FMA, what every vector path of the crate

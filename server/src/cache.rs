@@ -176,6 +176,15 @@ impl WarmCache {
         slot.bound.as_ref()
     }
 
+    /// Replaces the certified answer kept for `key`, if it has an entry
+    /// (a bound re-certified at newer poses; the simplex stays).
+    #[inline]
+    pub fn replace_bound(&mut self, key: &PairKey, bound: PairBound) {
+        if let Some(&i) = self.index.get(key) {
+            self.slots[i as usize].bound = Some(bound);
+        }
+    }
+
     /// Stores the simplex of `key`, evicting an entry that has not been used
     /// since the clock hand last passed it if the cache is full. A certified
     /// answer already kept stays (it holds at its own poses whatever the

@@ -147,9 +147,98 @@ impl Ctx<'_> {
                 self.counters.bounded += 1;
                 return outcome;
             }
+            let (bound, d) = (*bound, d);
+            let rechecked = if bound.penetration > 0.0 {
+                self.recheck_overlap(&bound, ea, eb, &key, ask)
+            } else {
+                self.recheck(&bound, d, &w, ea, eb, ask)
+            };
+            if let Some((fresh, outcome)) = rechecked {
+                self.cache.replace_bound(&key, fresh);
+                if let Some(keep) = keep {
+                    *keep = Some(fresh);
+                }
+                self.counters.bounded += 1;
+                return outcome;
+            }
         }
         let warm = self.warm(a, b);
         Outcome::Answer(self.run_keeping(a, b, ask, warm, keep))
+    }
+
+    /// The kept `bound` of a separated pair re-certified at the current
+    /// poses of `ea`, `eb` from its normal ([`gjk::separation_bound`]: two
+    /// support values), when that rules the pair out for `ask`: the bound
+    /// carried here (moved by at most `d`, widened to `w`) with the new
+    /// lower bound. `None` when the pair did not separate, or the
+    /// direction no longer proves enough.
+    fn recheck(
+        &self,
+        bound: &PairBound,
+        d: f64,
+        w: &Widened,
+        ea: &Entry,
+        eb: &Entry,
+        ask: Ask,
+    ) -> Option<(PairBound, Outcome)> {
+        if bound.lower <= 0.0 {
+            return None;
+        }
+        let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
+        // The normal turned with A: right when A turns about it, or
+        // when the pair turns together.
+        let normal = ea.pose.rotation * bound.normal;
+        let lower = gjk::separation_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &normal);
+        let ruled = match ask {
+            Ask::Within(m) => lower > m,
+            Ask::Below(best) | Ask::BelowExactly(best) => lower >= best,
+        };
+        if !ruled {
+            return None;
+        }
+        let w = Widened {
+            lower: lower.max(w.lower),
+            upper: w.upper.max(lower),
+        };
+        Some((carried(bound, d, &w, ea, eb), Outcome::Ruled))
+    }
+
+    /// The kept `bound` of an overlapping pair re-certified at the current
+    /// poses of `ea`, `eb` from its cached simplex
+    /// ([`gjk::penetration_bound`]: no support search), for a within ask:
+    /// the pair still overlaps, its distance is 0. `None` when the simplex
+    /// no longer proves it.
+    fn recheck_overlap(
+        &mut self,
+        bound: &PairBound,
+        ea: &Entry,
+        eb: &Entry,
+        key: &PairKey,
+        ask: Ask,
+    ) -> Option<(PairBound, Outcome)> {
+        if !matches!(ask, Ask::Within(_)) {
+            return None;
+        }
+        let warm = self.cache.get(key)?;
+        let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
+        let depth = gjk::penetration_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &warm);
+        if depth <= 0.0 {
+            return None;
+        }
+        let w = Widened {
+            lower: 0.0,
+            upper: 0.0,
+        };
+        let fresh = PairBound {
+            lower: 0.0,
+            upper: 0.0,
+            distance: 0.0,
+            penetration: depth,
+            pose_a: ea.pose,
+            pose_b: eb.pose,
+            ..*bound
+        };
+        Some((fresh, Outcome::Answer(bounded_result(bound, &w, ea, eb))))
     }
 
     /// Runs GJK on the pair of slots `a`, `b` (from `warm` if warm starts

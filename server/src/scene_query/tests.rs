@@ -1110,3 +1110,78 @@ fn overflowing_travel_searches_again() {
     let hits: Vec<(u32, u64)> = rows.iter().map(|r| (r.step, r.b)).collect();
     assert_eq!(hits, [(3, other), (4, other)]);
 }
+
+/// A box spinning fast in place, far from the origin or not, under a
+/// box it never reaches and around a small box inside it, with one
+/// teleport away and back: the travel and the poses' motion bound widen
+/// by more than the gap and the depth at every step, so the pairs are
+/// settled by re-certifying their kept bounds (the separated pair from its
+/// normal, the overlapping one from its simplex) instead of GJK, and
+/// every step still matches brute force.
+#[test]
+fn spinning_paths_recheck_kept_bounds_instead_of_running_gjk() {
+    for centre in [Vector3::zeros(), Vector3::new(1e6, -1e6, 5e5)] {
+        let mut s = State::new(Limits::default(), WaitMode::Spin, 3);
+        let mut block = |half: f64| {
+            s.insert(
+                NewObject {
+                    shape: Convex::cuboid(Vector3::repeat(half), 0.0).unwrap().into(),
+                    pose: Isometry3::translation(centre.x, centre.y, centre.z),
+                    name: None,
+                },
+                Owner::Client(1),
+            )
+            .unwrap()
+        };
+        let (mover, core) = (block(1.0), block(0.2));
+        // A lid tilted about x, its lower face 0.5 above the box (the
+        // box's support along its normal `n` is 1.357), its own box
+        // reaching down past the box's.
+        let tilt = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -0.5);
+        let n = tilt * Vector3::z();
+        // Spinning about the lid's normal, so that the box's support along
+        // it stays as it was.
+        let axis = nalgebra::Unit::new_normalize(n);
+        let lid = s
+            .insert(
+                NewObject {
+                    shape: Convex::cuboid(Vector3::new(2.0, 2.0, 0.5), 0.0)
+                        .unwrap()
+                        .into(),
+                    pose: Isometry3::from_parts(Translation3::from(centre + n * 2.357), tilt),
+                    name: None,
+                },
+                Owner::Client(1),
+            )
+            .unwrap();
+        let ids = [mover, lid, core];
+        let mut path = Vec::new();
+        let mut steps = Vec::new();
+        let spins: u32 = 60;
+        for i in 0..spins {
+            let turn = UnitQuaternion::from_axis_angle(&axis, 0.3 * f64::from(i));
+            let at = if i == spins / 2 {
+                centre + Vector3::new(50.0, 0.0, 0.0)
+            } else {
+                centre
+            };
+            let p = Isometry3::from_parts(Translation3::from(at), turn);
+            path.push(Item::set_pose(ObjectId::from_raw(mover), &p));
+            path.push(Item::step());
+            steps.push(vec![(mover, p)]);
+        }
+        let mut req = SceneRequest::new(SceneKind::Within, mover);
+        req.path = PathMode::EveryStep as u32;
+        let (reply, rows) = ask(&mut s, 1, &req, &path);
+        check_path_within(&s, &rows, &steps, &group_pairs(&[mover], &ids), 0.0, 0.0);
+        // The core is inside the box at every step but the teleport's.
+        let hits = rows.iter().filter(|r| r.b == core).count();
+        assert_eq!(hits, spins as usize - 1, "{reply:?}");
+        assert!(rows.iter().all(|r| r.b == core), "{rows:?}");
+        // Each step moves points of the box by about 0.5, as much as the
+        // lid's gap: without the rechecks both pairs would run GJK
+        // at nearly every step.
+        assert!(reply.gjk_runs <= 12, "{reply:?}");
+        assert!(reply.bounded >= 2 * u64::from(spins) - 20, "{reply:?}");
+    }
+}

@@ -27,7 +27,7 @@ use crate::stats::Csv;
 use crate::{BenchError, CommonArgs, io, out_dir, scene_call};
 
 /// Arguments of the servers the sweep runs through: a batch limit that
-/// holds a whole T = 1 000 path (two items per step) in one request.
+/// holds a whole T = 1 000 path in one request.
 pub const SERVER_ARGS: [&str; 5] = ["--wait", "spin", "--no-persist", "--max-batch", "8192"];
 
 /// Flags of `gjkd bench sweep`.
@@ -65,14 +65,14 @@ impl PathBuffers {
     /// Room for paths of up to `steps` steps.
     pub(crate) fn new(steps: usize) -> Self {
         PathBuffers {
-            items: Vec::with_capacity(2 * (steps + 1)),
+            items: Vec::with_capacity(steps + 1),
             rows: vec![SceneRow::default(); (steps + 1) * OBSTACLES],
         }
     }
 }
 
 /// The sweep of `steps` steps as one path request in `mode`: the moving
-/// object's pose and a step end per step, the obstacles within margin 0.
+/// object's pose per step, flagged to end it; the obstacles within margin 0.
 ///
 /// # Errors
 /// The client's, a scene error, or a truncated answer.
@@ -110,8 +110,8 @@ fn path_sweep_with(
         .collect();
     buf.items.clear();
     for pose in &poses {
-        buf.items.push(Item::set_pose(scene.moving, pose));
-        buf.items.push(Item::step());
+        buf.items
+            .push(Item::set_pose(scene.moving, pose).ending_step());
     }
     buf.rows
         .resize((steps + 1) * OBSTACLES, SceneRow::default());

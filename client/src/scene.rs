@@ -169,10 +169,11 @@ impl<'a> Steps<'a> {
         Ok(len / per)
     }
 
-    /// Items of one step, its [`Item::step`] included (for bindings that
-    /// lay out a path's items themselves; see [`Client::scene_with`]).
+    /// Items of one step (for bindings that lay out a path's items
+    /// themselves; see [`Client::scene_with`]): its pose or joint items,
+    /// the last of them flagged to end the step ([`Item::ending_step`]).
     pub fn items_per_step(&self) -> usize {
-        1 + match *self {
+        match *self {
             Steps::Poses { objects, .. } => objects.len(),
             Steps::Joints { joints, .. } => joints.div_ceil(JOINTS_PER_ITEM),
         }
@@ -181,10 +182,7 @@ impl<'a> Steps<'a> {
     /// Item `k` (below [`Steps::items_per_step`]) of step `s` (below
     /// [`Steps::count`]).
     pub fn item(&self, s: usize, k: usize) -> Item {
-        if k + 1 == self.items_per_step() {
-            return Item::step();
-        }
-        match *self {
+        let item = match *self {
             Steps::Poses { objects, poses } => {
                 Item::set_pose(objects[k], &poses[s * objects.len() + k])
             }
@@ -199,6 +197,11 @@ impl<'a> Steps<'a> {
                 let end = (first + JOINTS_PER_ITEM).min(joints);
                 Item::set_joints(robot, first as u32, &step[first..end], None, clamp)
             }
+        };
+        if k + 1 == self.items_per_step() {
+            item.ending_step()
+        } else {
+            item
         }
     }
 }
@@ -698,14 +701,17 @@ mod tests {
             clamp: true,
         };
         assert_eq!(steps.count(), Ok(2));
-        assert_eq!(steps.items_per_step(), 3);
+        assert_eq!(steps.items_per_step(), 2);
+        let first = steps.item(1, 0);
+        assert_eq!(first.flags & crate::item_flags::END_STEP, 0);
         let second = steps.item(1, 1);
         let (values, count) = second.joint_positions().expect("a joint item");
         assert_eq!(count, 2);
         assert_eq!(second.b, JOINTS_PER_ITEM as u64);
         assert_eq!(values[0], positions[joints + JOINTS_PER_ITEM]);
         assert_ne!(second.flags & crate::item_flags::CLAMP, 0);
-        assert_eq!(steps.item(1, 2).item_kind(), Some(crate::ItemKind::Step));
+        // The last item of a step ends it.
+        assert_ne!(second.flags & crate::item_flags::END_STEP, 0);
     }
 
     #[test]

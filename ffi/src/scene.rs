@@ -251,7 +251,7 @@ impl<'a> Call<'a> {
         let (per_step, steps) = match self.joints {
             Some(j) => (j.items_per_step(), j.count()?),
             None if self.moving.is_empty() => (1, 0),
-            None => (self.moving.len() + 1, self.poses.len() / self.moving.len()),
+            None => (self.moving.len(), self.poses.len() / self.moving.len()),
         };
         let (members, allowed, moving, poses, joints) = (
             self.members,
@@ -276,11 +276,19 @@ impl<'a> Call<'a> {
                 return j.item(s, k);
             }
             match moving.get(k) {
-                Some(&id) => Item {
-                    a: id,
-                    pose_a: poses[s * moving.len() + k].wire(),
-                    ..Item::set_pose(ObjectId::from_raw(id), &Default::default())
-                },
+                Some(&id) => {
+                    let item = Item {
+                        a: id,
+                        pose_a: poses[s * moving.len() + k].wire(),
+                        ..Item::set_pose(ObjectId::from_raw(id), &Default::default())
+                    };
+                    // The step's last pose ends it: one item fewer a step.
+                    if k + 1 == moving.len() {
+                        item.ending_step()
+                    } else {
+                        item
+                    }
+                }
                 None => Item::step(),
             }
         };

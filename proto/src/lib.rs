@@ -379,8 +379,16 @@ pub mod item_flags {
     /// limits instead of refusing the item. Added within v1, like
     /// `SINGLE_PRECISION`.
     pub const CLAMP: u32 = 1 << 5;
+    /// Scene paths only: a [`super::ItemKind::SetPose`] or
+    /// [`super::ItemKind::SetJoints`] item with this bit also ends its path
+    /// step, as a [`super::ItemKind::Step`] item after it would. A path's
+    /// steps then take one item fewer each, which is what a long path's
+    /// round trip is made of. Refused as malformed on any other item and
+    /// outside a path. Added within v1, like `SINGLE_PRECISION`.
+    pub const END_STEP: u32 = 1 << 6;
     /// Every bit this version knows; others are rejected as malformed.
-    pub const ALL: u32 = POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION | CLAMP;
+    pub const ALL: u32 =
+        POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION | CLAMP | END_STEP;
 }
 
 /// Bits of [`ItemResult::flags`].
@@ -689,6 +697,14 @@ impl Item {
             b: b.raw(),
             ..Item::member(a)
         }
+    }
+
+    /// This pose or joint item, also ending its path step (see
+    /// [`item_flags::END_STEP`]).
+    #[must_use]
+    pub fn ending_step(mut self) -> Self {
+        self.flags |= item_flags::END_STEP;
+        self
     }
 
     /// The end of a path step in a scene request (see [`ItemKind::Step`]).

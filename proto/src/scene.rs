@@ -7,7 +7,8 @@
 //! [`ItemKind::SetJoints`](crate::ItemKind::SetJoints)), the group's members
 //! ([`ItemKind::Member`](crate::ItemKind::Member)), pairs never to report
 //! ([`ItemKind::Allow`](crate::ItemKind::Allow)) and, for a path, the ends of
-//! its steps ([`ItemKind::Step`](crate::ItemKind::Step)). The answer is a
+//! its steps ([`ItemKind::Step`](crate::ItemKind::Step), or a pose item
+//! flagged [`item_flags::END_STEP`](crate::item_flags::END_STEP)). The answer is a
 //! [`SceneReply`] header and a slice of [`SceneRow`]s, at most
 //! [`SceneRequest::max_rows`] of them.
 //!
@@ -62,6 +63,7 @@ pub enum PathMode {
     /// question is asked once.
     Single = 0,
     /// A path: the items up to each [`ItemKind::Step`](crate::ItemKind::Step)
+    /// (or each pose item flagged [`END_STEP`](crate::item_flags::END_STEP))
     /// are one step's poses (a candidate motion: the stored poses are the
     /// same after the request as before), and the question is answered at
     /// every step.

@@ -290,7 +290,7 @@ impl Inputs<'_> {
             return m + a + j.count().unwrap_or(0) * j.items_per_step();
         }
         let steps = p.checked_div(n).unwrap_or(0);
-        m + a + steps * (n + 1)
+        m + a + steps * n
     }
 
     fn item(&self, i: usize) -> Item {
@@ -312,15 +312,17 @@ impl Inputs<'_> {
             let per = j.items_per_step();
             return j.item(i / per, i % per);
         }
-        let (s, k) = (i / (n + 1), i % (n + 1));
+        // Each step is its poses, the last flagged to end it.
+        let (s, k) = (i / n.max(1), i % n.max(1));
         match (self.moving, self.poses) {
             (Some(moving), Some(poses)) if k < n => {
                 let id = moving.get(k);
-                Item {
+                let item = Item {
                     a: id,
                     pose_a: poses.get(s * n + k),
                     ..Item::set_pose(ObjectId::from_raw(id), &Default::default())
-                }
+                };
+                if k + 1 == n { item.ending_step() } else { item }
             }
             _ => Item::step(),
         }

@@ -76,11 +76,10 @@ fn main() {
     }
 
     // One path request.
-    let mut path = Vec::with_capacity(2 * poses.len());
-    for pose in &poses {
-        path.push(Item::set_pose(id(mover), pose));
-        path.push(Item::step());
-    }
+    let path: Vec<Item> = poses
+        .iter()
+        .map(|pose| Item::set_pose(id(mover), pose).ending_step())
+        .collect();
     let mut request = SceneRequest::new(SceneKind::Within, mover);
     request.path = PathMode::EveryStep as u32;
     let mut rows = vec![SceneRow::default(); 5 * poses.len()];

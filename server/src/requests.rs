@@ -46,7 +46,9 @@ impl State {
         // Unknown flag bits and a non-zero reserved word are refused rather
         // than ignored, so that a later protocol version can give them a
         // meaning without old servers silently answering something else.
-        if item.flags & !item_flags::ALL != 0 || item.reserved != 0 {
+        // A path step's end means something only in a scene request.
+        let known = item_flags::ALL & !item_flags::END_STEP;
+        if item.flags & !known != 0 || item.reserved != 0 {
             return ItemResult::error(ErrorCode::Malformed);
         }
         match ItemKind::from_raw(item.kind) {
@@ -743,9 +745,13 @@ mod tests {
         pose_flags.flags = 1 << 9;
         let mut pose_reserved = Item::set_pose(a, &Isometry3::identity());
         pose_reserved.reserved = 7;
-        for item in [reserved, pose_flags, pose_reserved] {
+        // A path step's end is a scene request's; here it moves nothing.
+        let ending_step = Item::set_pose(a, &Isometry3::translation(5.0, 0.0, 0.0)).ending_step();
+        let before = s.object(a.raw()).unwrap().pose;
+        for item in [reserved, pose_flags, pose_reserved, ending_step] {
             assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::Malformed);
         }
+        assert_eq!(s.object(a.raw()).unwrap().pose, before);
         let epoch_of_a = a.raw() & !0xFFFF_FFFF;
         for raw in [
             0,

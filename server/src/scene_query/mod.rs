@@ -192,8 +192,9 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
 ///
 /// # Errors
 /// [`ErrorCode::Malformed`] for unknown kinds or flags, a non-zero
-/// reserved word, a distance item, a step outside a path, a path with no
-/// step or with pose items after its last.
+/// reserved word, a distance item, a step (or a step's end flagged on
+/// anything but a pose item) outside a path, a path with no step or with
+/// pose items after its last.
 fn check_layout(q: &Question, items: &[Item]) -> Result<u32, ErrorCode> {
     let mut steps: u32 = 0;
     let mut pending = false;
@@ -201,7 +202,16 @@ fn check_layout(q: &Question, items: &[Item]) -> Result<u32, ErrorCode> {
         if item.flags & !item_flags::ALL != 0 || item.reserved != 0 {
             return Err(ErrorCode::Malformed);
         }
+        let ends = item.flags & item_flags::END_STEP != 0;
         match ItemKind::from_raw(item.kind) {
+            Some(ItemKind::SetPose | ItemKind::SetJoints) if ends => {
+                if q.mode == PathMode::Single {
+                    return Err(ErrorCode::Malformed);
+                }
+                steps = steps.checked_add(1).ok_or(ErrorCode::Malformed)?;
+                pending = false;
+            }
+            _ if ends => return Err(ErrorCode::Malformed),
             Some(ItemKind::SetPose | ItemKind::SetJoints) => pending = true,
             Some(ItemKind::Member | ItemKind::Allow) => {}
             Some(ItemKind::Step) if q.mode != PathMode::Single => {
@@ -348,7 +358,9 @@ impl State {
                         engine.plan.push((slot, pose));
                     }
                 }
-            } else if item.kind == ItemKind::Step as u32 {
+            }
+            // `check_layout` let the flag through on pose items only.
+            if item.kind == ItemKind::Step as u32 || item.flags & item_flags::END_STEP != 0 {
                 engine.plan_ends.push(engine.plan.len());
             }
         }

@@ -435,6 +435,44 @@ fn paths_leave_the_store_alone_and_clients_keep_their_own_bounds() {
 }
 
 #[test]
+fn a_pose_flagged_to_end_its_step_is_a_step_item_after_it() {
+    let (mut s, ids) = scene(60, Vector3::zeros(), 5.0, 33);
+    let (mover, other) = (ids[0], ids[1]);
+    let mut rng = Lcg(8);
+    let (mut with_items, mut with_flags) = (Vec::new(), Vec::new());
+    for _ in 0..25 {
+        // Two objects move per step: the flag is on the step's last pose.
+        let p = rng.pose(&Vector3::zeros(), 5.0);
+        let q = rng.pose(&Vector3::zeros(), 5.0);
+        let (first, last) = (
+            Item::set_pose(ObjectId::from_raw(mover), &p),
+            Item::set_pose(ObjectId::from_raw(other), &q),
+        );
+        with_items.extend([first, last, Item::step()]);
+        with_flags.extend([first, last.ending_step()]);
+    }
+    let mut req = SceneRequest::new(SceneKind::Within, 0);
+    req.path = PathMode::EveryStep as u32;
+    req.margin = 1.0;
+    let members = [mover, other].map(|id| Item::member(ObjectId::from_raw(id)));
+    let ask_path = |s: &mut State, client, steps: &[Item]| {
+        let items: Vec<Item> = members.iter().chain(steps).copied().collect();
+        ask(s, client, &req, &items)
+    };
+    // Separate clients, so that neither starts from the other's caches.
+    let (reply, rows) = ask_path(&mut s, 1, &with_items);
+    let (flagged, flagged_rows) = ask_path(&mut s, 2, &with_flags);
+    assert_eq!(reply.error, ErrorCode::Ok as u32);
+    assert_eq!((reply.steps, flagged.steps), (25, 25));
+    assert!(!rows.is_empty());
+    let key = |r: &SceneRow| (r.a, r.b, r.step, r.result.lower, r.result.upper);
+    assert_eq!(
+        rows.iter().map(key).collect::<Vec<_>>(),
+        flagged_rows.iter().map(key).collect::<Vec<_>>()
+    );
+}
+
+#[test]
 fn first_hit_stops_at_the_first_step_within_the_margin() {
     let mut s = State::new(Limits::default(), WaitMode::Spin, 3);
     let ball = |s: &mut State, x: f64| {
@@ -688,6 +726,23 @@ fn bad_requests_get_their_codes_and_change_nothing() {
         (
             with(&|r| r.path = PathMode::EveryStep as u32),
             vec![good_move],
+            ErrorCode::Malformed,
+        ),
+        // A step's end flagged outside a path, on a step item, or with
+        // poses after the last step.
+        (
+            with(&|_| {}),
+            vec![good_move.ending_step()],
+            ErrorCode::Malformed,
+        ),
+        (
+            with(&|r| r.path = PathMode::EveryStep as u32),
+            vec![good_move.ending_step(), Item::step().ending_step()],
+            ErrorCode::Malformed,
+        ),
+        (
+            with(&|r| r.path = PathMode::EveryStep as u32),
+            vec![good_joints.ending_step(), good_move],
             ErrorCode::Malformed,
         ),
         (

@@ -677,7 +677,11 @@ mod tests {
             poses: &poses,
         };
         assert_eq!(steps.count(), Ok(3));
-        assert_eq!(steps.items_per_step(), 3);
+        // Two poses a step, the second ending it.
+        assert_eq!(steps.items_per_step(), 2);
+        assert_eq!(steps.item(2, 0).flags & crate::item_flags::END_STEP, 0);
+        assert_ne!(steps.item(2, 1).flags & crate::item_flags::END_STEP, 0);
+        assert_eq!(steps.item(2, 1).a, ids[1].raw());
         let odd = Steps::Poses {
             objects: &ids,
             poses: &poses[..5],

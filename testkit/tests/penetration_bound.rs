@@ -3,27 +3,17 @@
 //! depth, never below the plain bound, nothing else of the answer changed;
 //! close to the depth on simple overlaps; ignored for cylinders.
 
+mod common;
+
 use gjk::{Compound, Convex, Options, Shape, distance};
 use gjkd_testkit::check::shape_distance;
 use gjkd_testkit::reference::{P, V, hull_distance, penetration_depth};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
-
-const CASES: u32 = 512;
+use proptest::test_runner::Config;
 
 fn config() -> Config {
-    let mut c = Config {
-        failure_persistence: None,
-        ..Config::default()
-    };
-    if std::env::var_os("PROPTEST_CASES").is_none() {
-        c.cases = CASES;
-    }
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = RngSeed::Fixed(0x6570_6120);
-    }
-    c
+    common::config(0x6570_6120)
 }
 
 fn grown(expansions: u32) -> Options {

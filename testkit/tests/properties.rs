@@ -2,28 +2,18 @@
 //! collinear, coplanar, single points), random radii and poses, compared with
 //! the brute force of `gjkd_testkit::reference`.
 
+mod common;
+
 use gjk::{Compound, Convex, Options, Precision, Shape, Status, WarmStart, distance};
 use gjkd_testkit::check::{RefShape, Tolerance, shape_distance, verify, verify_penetration};
 use gjkd_testkit::reference::{P, V, aabb_distance, hull_distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::Config;
 
-const CASES: u32 = 512;
-
-/// A fixed seed so that runs are reproducible; `PROPTEST_RNG_SEED` and
-/// `PROPTEST_CASES` in the environment override seed and case count.
+/// [`common::config`], with room for the rejected draws.
 fn config() -> Config {
-    let mut c = Config {
-        failure_persistence: None,
-        ..Config::default()
-    };
-    if std::env::var_os("PROPTEST_CASES").is_none() {
-        c.cases = CASES;
-    }
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = RngSeed::Fixed(0x676a_6b64);
-    }
+    let mut c = common::config(0x676a_6b64);
     // About 4 % of the nearly touching draws are rejected (cores not clearly
     // apart to begin with): long runs (PROPTEST_CASES=100000) need room.
     c.max_global_rejects = c.max_global_rejects.max(c.cases / 8);

@@ -5,6 +5,8 @@
 //! to the analytic answer where there is one, and proving nothing from
 //! bad input.
 
+mod common;
+
 use gjk::{
     Compound, Convex, Options, Shape, WarmStart, distance, penetration_bound, separation_bound,
 };
@@ -12,22 +14,10 @@ use gjkd_testkit::check::{shape_distance, world_pieces};
 use gjkd_testkit::reference::{P, V, hull_distance, penetration_depth};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
-
-const CASES: u32 = 512;
+use proptest::test_runner::Config;
 
 fn config() -> Config {
-    let mut c = Config {
-        failure_persistence: None,
-        ..Config::default()
-    };
-    if std::env::var_os("PROPTEST_CASES").is_none() {
-        c.cases = CASES;
-    }
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = RngSeed::Fixed(0x7265_6368);
-    }
-    c
+    common::config(0x7265_6368)
 }
 
 fn vec3() -> impl Strategy<Value = V> {
@@ -79,6 +69,44 @@ fn deepest_piece_pair(a: &Shape, pa: &Isometry3<f64>, b: &Shape, pb: &Isometry3<
     deepest
 }
 
+/// Point sets scaled by `s` and placed `off` sizes from the origin.
+struct Extreme {
+    s: f64,
+    shift: Vector3<f64>,
+    off: f64,
+}
+
+impl Extreme {
+    fn new(s: f64, off: f64) -> Self {
+        Extreme {
+            s,
+            shift: Vector3::new(off, -0.5 * off, 0.25 * off) * s,
+            off,
+        }
+    }
+
+    fn build(&self, pts: &[P]) -> Shape {
+        let scaled: Vec<P> = pts.iter().map(|p| P::from(p.coords * self.s)).collect();
+        Convex::new(scaled, 0.0).unwrap().into()
+    }
+
+    fn place(&self, p: &Isometry3<f64>) -> Isometry3<f64> {
+        let at = p.translation.vector * self.s + self.shift;
+        Isometry3::from_parts(Translation3::from(at), p.rotation)
+    }
+
+    /// The pose that [`Extreme::place`] takes to `p`.
+    fn unplace(&self, p: &Isometry3<f64>) -> Isometry3<f64> {
+        let at = (p.translation.vector - self.shift) / self.s;
+        Isometry3::from_parts(Translation3::from(at), p.rotation)
+    }
+
+    /// What coordinates this far out and this large round off.
+    fn tolerance(&self) -> f64 {
+        1e-12 * self.s + 64.0 * (1.0 + self.off) * self.s * f64::EPSILON
+    }
+}
+
 proptest! {
     #![proptest_config(config())]
 
@@ -110,14 +138,10 @@ proptest! {
         s in prop_oneof![Just(1e-9), Just(1.0), Just(1e9)],
         off in prop_oneof![Just(0.0), Just(1e6), Just(1e12)],
     ) {
-        let build = |pts: &[P]| -> Shape {
-            Convex::new(pts.iter().map(|p| P::from(p.coords * s)).collect::<Vec<_>>(), 0.0).unwrap().into()
-        };
-        let shift = Vector3::new(off, -0.5 * off, 0.25 * off) * s;
-        let place = |p: &Isometry3<f64>| Isometry3::from_parts(Translation3::from(p.translation.vector * s + shift), p.rotation);
-        let (a, b, pa, pb) = (build(&a), build(&b), place(&pa), place(&pb));
+        let x = Extreme::new(s, off);
+        let (a, b, pa, pb) = (x.build(&a), x.build(&b), x.place(&pa), x.place(&pb));
         let truth = shape_distance(&a, &pa, &b, &pb);
-        let tol = 1e-12 * s + 64.0 * (1.0 + off) * s * f64::EPSILON;
+        let tol = x.tolerance();
         for n in [direction, (pb.translation.vector - pa.translation.vector)] {
             let lower = separation_bound(&a, &pa, &b, &pb, &n);
             prop_assert!(lower <= truth.distance + tol,
@@ -157,18 +181,14 @@ proptest! {
         s in prop_oneof![Just(1e-9), Just(1.0), Just(1e9)],
         off in prop_oneof![Just(0.0), Just(1e6), Just(1e12)],
     ) {
-        let build = |pts: &[P]| -> Shape {
-            Convex::new(pts.iter().map(|p| P::from(p.coords * s)).collect::<Vec<_>>(), 0.0).unwrap().into()
-        };
-        let shift = Vector3::new(off, -0.5 * off, 0.25 * off) * s;
-        let place = |p: &Isometry3<f64>| Isometry3::from_parts(Translation3::from(p.translation.vector * s + shift), p.rotation);
-        let (a, b, pa, pb) = (build(&a), build(&b), place(&pa), place(&pb));
+        let x = Extreme::new(s, off);
+        let (a, b, pa, pb) = (x.build(&a), x.build(&b), x.place(&pa), x.place(&pb));
         let answer = distance(&a, &pa, &b, &pb, &Options::default(), None).unwrap();
-        let moved = place(&(db * Isometry3::from_parts(Translation3::from(pb.translation.vector / s - shift / s), pb.rotation)));
+        let moved = x.place(&(db * x.unplace(&pb)));
         let depth = penetration_bound(&a, &pa, &b, &moved, &answer.warm_start);
         if depth > 0.0 {
             let truth = deepest_piece_pair(&a, &pa, &b, &moved);
-            let tol = 1e-12 * s + 64.0 * (1.0 + off) * s * f64::EPSILON;
+            let tol = x.tolerance();
             prop_assert!(depth <= truth + tol,
                 "scale {s:e}, offset {off:e}: bound {depth} above the depth {truth}");
         }

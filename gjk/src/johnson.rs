@@ -1136,10 +1136,7 @@ impl Simplex {
         // origin inside such a tetrahedron by a hair; without this, a hunt
         // found a bound of 1.8e-18 on objects of size 1.7e-9 touching (depth
         // 0) edge to nearly parallel edge. M² from the kept |y|² products.
-        let m2 = self.largest_y2();
-        let m = m2.sqrt();
-        let shrink = delta * (3.0 * m2 + delta * (3.0 * m + delta));
-        let widen = 64.0 * delta * m2 * (m + delta);
+        let (shrink, widen) = face_round_off(delta, self.largest_y2());
         // The smallest squared distance over the faces, then one square
         // root: the four quotients are independent, and the one root rounds
         // as the four would have (the caller's slack covers both).
@@ -1318,6 +1315,20 @@ fn exact_volume_without(y: &[Vector3<f64>; 4], l: usize) -> f64 {
     let mut q = *y;
     q[l] = Vector3::zeros();
     robust::orient3d(point(q[1]), point(q[2]), point(q[3]), point(q[0]))
+}
+
+/// What round-off `delta` in each point of a face (`m2` the largest squared
+/// norm of the points) may do to its plane's distance `|n·p| / |n|` from
+/// the origin: `(shrink, widen)`, the most `|n·p|` may move and a bound on
+/// how far `|n|²` may grow (see [`Simplex::inner_radius`]), so that
+/// `(|n·p| - shrink)² / (|n|² + widen)` never exceeds the true squared
+/// distance.
+#[inline]
+pub(crate) fn face_round_off(delta: f64, m2: f64) -> (f64, f64) {
+    let m = m2.sqrt();
+    let shrink = delta * (3.0 * m2 + delta * (3.0 * m + delta));
+    let widen = 64.0 * delta * m2 * (m + delta);
+    (shrink, widen)
 }
 
 #[cfg(test)]

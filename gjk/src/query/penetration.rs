@@ -22,7 +22,7 @@ use nalgebra::Vector3;
 use super::Options;
 use super::numerical_algorithm::RunOutcome;
 use super::pair::ConvexPair;
-use crate::johnson::Simplex;
+use crate::johnson::{Simplex, face_round_off};
 
 /// At most this many points are added, whatever the options ask.
 pub(super) const MAX_EXPANSIONS: u32 = 12;
@@ -125,10 +125,7 @@ impl Polytope {
     /// points may move it (as [`Simplex::inner_radius`]); 0 unless every
     /// face has the origin on its inner side by more than that.
     fn certified2(&self, delta: f64) -> f64 {
-        let m2 = self.largest2;
-        let m = m2.sqrt();
-        let shrink = delta * (3.0 * m2 + delta * (3.0 * m + delta));
-        let widen = 64.0 * delta * m2 * (m + delta);
+        let (shrink, widen) = face_round_off(delta, self.largest2);
         let mut best = f64::INFINITY;
         for face in &self.faces {
             let h = face.offset - shrink;

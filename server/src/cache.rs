@@ -101,6 +101,12 @@ pub struct PairBound {
     pub pieces: [u32; 2],
 }
 
+/// Where an entry of a [`WarmCache`] is, from [`WarmCache::bound_entry`]:
+/// valid until the cache next stores or forgets an entry, which may move
+/// or drop it.
+#[derive(Clone, Copy, Debug)]
+pub struct EntryAt(u32);
+
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     key: PairKey,
@@ -167,22 +173,28 @@ impl WarmCache {
 
     /// The last certified answer kept for `key`, marking the entry as
     /// recently used (not counted as a hit or miss: a look-up for the
-    /// simplex follows when the answer does not do).
+    /// simplex follows when the answer does not do), and where the entry
+    /// is, so that the calls `_at` that follow need no second look-up.
     #[inline]
-    pub fn bound(&mut self, key: &PairKey) -> Option<&PairBound> {
+    pub fn bound_entry(&mut self, key: &PairKey) -> Option<(EntryAt, &PairBound)> {
         let &i = self.index.get(key)?;
         let slot = &mut self.slots[i as usize];
         slot.referenced = true;
-        slot.bound.as_ref()
+        slot.bound.as_ref().map(|bound| (EntryAt(i), bound))
     }
 
-    /// Replaces the certified answer kept for `key`, if it has an entry
-    /// (a bound re-certified at newer poses; the simplex stays).
+    /// The simplex of the entry `at` (as [`WarmCache::get`] counts it).
     #[inline]
-    pub fn replace_bound(&mut self, key: &PairKey, bound: PairBound) {
-        if let Some(&i) = self.index.get(key) {
-            self.slots[i as usize].bound = Some(bound);
-        }
+    pub fn get_at(&mut self, at: EntryAt) -> WarmStart {
+        self.stats.hits += 1;
+        self.slots[at.0 as usize].warm
+    }
+
+    /// Replaces the certified answer kept in the entry `at` (a bound
+    /// re-certified at newer poses; the simplex stays).
+    #[inline]
+    pub fn replace_bound_at(&mut self, at: EntryAt, bound: PairBound) {
+        self.slots[at.0 as usize].bound = Some(bound);
     }
 
     /// Stores the simplex of `key`, evicting an entry that has not been used

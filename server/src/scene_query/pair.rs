@@ -10,7 +10,7 @@ use super::motion_bound::{
     Widened, accepted, bound_of, bounded_result, carried, moved_since, widen_by,
 };
 use super::{Counters, Question};
-use crate::cache::{PairBound, PairKey, WarmCache};
+use crate::cache::{EntryAt, PairBound, PairKey, WarmCache};
 use crate::requests::run_pair;
 use crate::store::ObjectStore;
 use gjk::WarmStart;
@@ -29,13 +29,13 @@ fn kept_bound<'c>(
     key: &PairKey,
     ea: &Entry,
     eb: &Entry,
-) -> Option<(&'c PairBound, f64, Widened)> {
+) -> Option<(EntryAt, &'c PairBound, f64, Widened)> {
     if !q.motion {
         return None;
     }
-    let bound = cache.bound(key)?;
+    let (at, bound) = cache.bound_entry(key)?;
     let d = moved_since(bound, ea, eb);
-    Some((bound, d, widen_by(bound, d)))
+    Some((at, bound, d, widen_by(bound, d)))
 }
 
 /// What is asked of a pair.
@@ -97,7 +97,7 @@ impl Ctx<'_> {
     pub(crate) fn widened(&mut self, a: u32, b: u32) -> Option<(&PairBound, Widened)> {
         let key = self.key(a, b);
         kept_bound(self.q, self.cache, &key, self.bp.entry(a), self.bp.entry(b))
-            .map(|(bound, _, w)| (bound, w))
+            .map(|(_, bound, _, w)| (bound, w))
     }
 
     fn key(&self, a: u32, b: u32) -> PairKey {
@@ -126,7 +126,7 @@ impl Ctx<'_> {
         let q = self.q;
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         let key = self.key(a, b);
-        if let Some((bound, d, w)) = kept_bound(q, self.cache, &key, ea, eb) {
+        if let Some((at, bound, d, w)) = kept_bound(q, self.cache, &key, ea, eb) {
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
                 Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
@@ -149,12 +149,12 @@ impl Ctx<'_> {
             }
             let (bound, d) = (*bound, d);
             let rechecked = if bound.penetration > 0.0 {
-                self.recheck_overlap(&bound, ea, eb, &key, ask)
+                self.recheck_overlap(&bound, ea, eb, at, ask)
             } else {
                 self.recheck(&bound, d, &w, ea, eb, ask)
             };
             if let Some((fresh, outcome)) = rechecked {
-                self.cache.replace_bound(&key, fresh);
+                self.cache.replace_bound_at(at, fresh);
                 if let Some(keep) = keep {
                     *keep = Some(fresh);
                 }
@@ -213,13 +213,13 @@ impl Ctx<'_> {
         bound: &PairBound,
         ea: &Entry,
         eb: &Entry,
-        key: &PairKey,
+        at: EntryAt,
         ask: Ask,
     ) -> Option<(PairBound, Outcome)> {
         if !matches!(ask, Ask::Within(_)) {
             return None;
         }
-        let warm = self.cache.get(key)?;
+        let warm = self.cache.get_at(at);
         let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
         let depth = gjk::penetration_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &warm);
         if depth <= 0.0 {

@@ -36,6 +36,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod collada;
 pub mod kinematics;
 pub mod mesh;
 pub mod paths;

@@ -14,6 +14,8 @@ use gjk::{Compound, Convex};
 use nalgebra::{Isometry3, Point3};
 use parry3d_f64::math::Vector;
 
+use crate::collada;
+
 /// What can go wrong with a mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
@@ -89,7 +91,9 @@ pub struct Decomposition {
 impl Mesh {
     /// Reads a mesh file (binary or ASCII STL, OBJ, COLLADA `.dae`) and
     /// scales it by `scale` (per axis); all the file's meshes are merged,
-    /// COLLADA's unit and node transforms applied. Coordinates are read in
+    /// COLLADA's unit and node transforms applied (see `collada.rs`: the
+    /// geometries its scene places, each by its nodes' transforms composed
+    /// parent first; the up axis is ignored, as in ROS). Coordinates are read in
     /// single precision (binary STL's own; the `mesh-loader` crate reads
     /// OBJ and COLLADA text that way too), then widened and scaled.
     ///
@@ -101,6 +105,17 @@ impl Mesh {
             path: path.to_path_buf(),
             source,
         })?;
+        let is_collada = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("dae"));
+        let flat = is_collada
+            .then(|| {
+                std::str::from_utf8(&bytes)
+                    .ok()
+                    .and_then(collada::flatten_scene)
+            })
+            .flatten();
+        let bytes = flat.map_or(bytes, String::into_bytes);
         let loader = mesh_loader::Loader::default().merge_meshes(true);
         let scene = loader
             .load_from_slice(&bytes, path)

@@ -105,9 +105,7 @@ impl Mesh {
             path: path.to_path_buf(),
             source,
         })?;
-        let is_collada = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("dae"));
+        let is_collada = is_collada(path, &bytes);
         let flat = is_collada
             .then(|| {
                 std::str::from_utf8(&bytes)
@@ -324,6 +322,23 @@ impl Decomposition {
             .map(|p| Ok((Isometry3::identity(), Convex::new(p.clone(), 0.0)?)))
             .collect::<Result<Vec<_>, gjk::Error>>()?;
         Ok(Compound::new(pieces)?)
+    }
+}
+
+/// Whether `mesh-loader` reads `bytes` (from `path`) as COLLADA: by the
+/// `.dae` extension, or, with no extension it knows, by `<COLLADA` among
+/// the first kilobyte, as the crate tells formats apart.
+fn is_collada(path: &Path, bytes: &[u8]) -> bool {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("dae") => true,
+        Some("stl" | "obj") => false,
+        _ => bytes[..bytes.len().min(1024)]
+            .windows(8)
+            .any(|w| w == b"<COLLADA"),
     }
 }
 

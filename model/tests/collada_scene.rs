@@ -45,8 +45,13 @@ fn document(meter: f64, nodes: &str, library_nodes: &str, second: bool) -> Strin
 
 /// The vertices `Mesh::load` reads from `text`, sorted.
 fn load(tag: &str, text: &str) -> Vec<[f64; 3]> {
+    load_named(tag, "scene.dae", text)
+}
+
+/// [`load`] from a file named `name`.
+fn load_named(tag: &str, name: &str, text: &str) -> Vec<[f64; 3]> {
     let dir = files::scratch(tag);
-    let path = dir.join("scene.dae");
+    let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     let mut out: Vec<[f64; 3]> = Mesh::load(&path, [1.0; 3])
         .unwrap()
@@ -85,6 +90,22 @@ fn nested_nodes_compose_parent_first() {
         &[[0.0, 12.0, 0.0], [-2.0, 10.0, 0.0], [0.0, 10.0, 2.0]],
         12.0,
     );
+}
+
+#[test]
+fn a_collada_file_without_the_extension_is_placed_the_same() {
+    // Told apart by its content, as mesh-loader does.
+    let nodes = r##"<node id="outer"><rotate>0 0 1 90</rotate>
+        <node id="inner"><translate>10 0 0</translate><instance_geometry url="#tri"/></node></node>"##;
+    let text = document(1.0, nodes, "", false);
+    for name in ["scene.mesh", "scene"] {
+        let got = load_named("no-extension", name, &text);
+        assert_points(
+            &got,
+            &[[0.0, 11.0, 0.0], [-1.0, 10.0, 0.0], [0.0, 10.0, 1.0]],
+            11.0,
+        );
+    }
 }
 
 #[test]

@@ -241,6 +241,87 @@ fn sphere_against_side_cap_and_rim() {
     }
 }
 
+/// A rim touching a perpendicular cylinder's cap near its rim, found by
+/// `cylinder_stress` (bench/examples): the run's first separating
+/// direction came only after a hundred iterations, and the Newton seed
+/// taken from it, at a distance lost in round-off, restarted the run,
+/// which then hit the iteration cap a thousand judged bounds off (cold,
+/// and warm from both caps' centres). The truth is the stress reference's
+/// bracket (alternating projections and closed-form support functions),
+/// both ends within 1e-17 of it.
+#[test]
+fn rim_touching_a_perpendicular_cap_is_not_reseeded() {
+    let pose = |t: [f64; 3], q: [f64; 4]| {
+        Isometry3::from_parts(
+            Translation3::new(t[0], t[1], t[2]),
+            UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3])),
+        )
+    };
+    let cold_case = (
+        cyl(0.03910272096730396, 0.039577244213837626, 0.0),
+        pose(
+            [-115.18324912166604, 231.27114400726663, 23.913074181739383],
+            [
+                0.41051905424610213,
+                -0.9116566391037441,
+                -0.0016298462769313918,
+                -0.018804841931399054,
+            ],
+        ),
+        cyl(0.05053096488986053, 9.505416056180188e-8, 0.0),
+        pose(
+            [-115.22460045378655, 231.34572219962587, 23.902428758485044],
+            [
+                0.9333756214996974,
+                -0.3541460648892098,
+                0.006185773811807788,
+                -0.05789861929174282,
+            ],
+        ),
+        None,
+        4.345e-15,
+        0.03910272096730396f64.hypot(0.039577244213837626),
+    );
+    let warm_case = (
+        cyl(0.4618163061956477, 0.2902422242669282, 0.0),
+        pose(
+            [-9.761426453562613, 438.5069692938249, 78.11639897925818],
+            [
+                0.7912771848476325,
+                0.2319183859249886,
+                0.5445937974087482,
+                0.15333582371211407,
+            ],
+        ),
+        cyl(0.6430367782529866, 0.047543788989737046, 0.0),
+        pose(
+            [-9.467129866015124, 438.7653290770869, 78.95974629871141],
+            [
+                0.5994013419989748,
+                -0.40212134576332054,
+                0.4509074626628472,
+                0.5250703901442901,
+            ],
+        ),
+        WarmStart::new([0, 0], &[[0, 0]]),
+        1.883e-14,
+        0.6430367782529866f64.hypot(0.047543788989737046),
+    );
+    for (what, (a, pa, b, pb, warm, truth, size)) in [("cold", cold_case), ("warm", warm_case)] {
+        let ans = distance(&a, &pa, &b, &pb, &Options::default(), warm.as_ref()).unwrap();
+        assert!(
+            within(ans.distance, truth, size),
+            "{what}: {} ({:?}) vs {truth}",
+            ans.distance,
+            ans.status
+        );
+        assert!(
+            ans.lower <= truth + 1e-17 && truth <= ans.upper + 1e-17,
+            "{what}"
+        );
+    }
+}
+
 /// Two long cylinders whose axes cross at any angle, `D` apart along their
 /// common perpendicular: the nearest points lie on it, `D - r1 - r2` apart.
 #[test]

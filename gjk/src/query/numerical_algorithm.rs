@@ -168,7 +168,12 @@ impl ConvexPair<'_> {
         // it has left, and the share of `|v|` and the length its lower
         // bound must reach.
         let (mut next_seed, mut seeds_left) = (seed_after, MAX_SEEDS);
-        let (mut seed_share, mut seed_floor) = (0.0, 0.0);
+        // The first seed needs only a separating direction, but not one
+        // whose lower bound is lost in round-off: on a touching contact
+        // that direction comes late (a rim on a perpendicular cap after a
+        // hundred iterations), and the seed's restart then spent what was
+        // left of the iteration cap, ending a thousand bounds off.
+        let (mut seed_share, mut seed_floor) = (0.0, RESEED_SLACKS * self.slack);
         match warm {
             Some(pairs) => {
                 let seed = if !SEED { None } else { self.warm_seed(pairs) };

@@ -927,32 +927,24 @@ impl Hunt {
     /// answer, for a motion's next warm start.
     fn check(&mut self, case: &Case<'_>, start: Start) -> Option<gjk::Answer> {
         let key = format!("{:<8} {}", format!("{start:?}"), case.label);
-        let result = distance(
-            &case.a.shape,
-            &case.pa,
-            &case.b.shape,
-            &case.pb,
-            &Options {
-                margin: case.margin,
-                ..self.options
-            },
-            case.warm.as_ref(),
-        );
+        let options = Options {
+            margin: case.margin,
+            ..self.options
+        };
+        let (a, b, warm) = (&case.a.shape, &case.b.shape, case.warm.as_ref());
+        let result = distance(a, &case.pa, b, &case.pb, &options, warm);
         // The form compiled for any CPU must answer the same, bit for bit
         // (on a CPU with AVX2 and FMA `distance` runs the other form).
         self.asked += 1;
         if self.asked.is_multiple_of(8) {
             let baseline = distance_in_baseline(
                 &mut self.workspace,
-                &case.a.shape,
+                a,
                 &case.pa,
-                &case.b.shape,
+                b,
                 &case.pb,
-                &Options {
-                    margin: case.margin,
-                    ..self.options
-                },
-                case.warm.as_ref(),
+                &options,
+                warm,
             );
             if baseline != result {
                 let text = format!("baseline {baseline:?}\n  vs {result:?}");

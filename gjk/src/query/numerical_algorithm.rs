@@ -170,9 +170,9 @@ impl ConvexPair<'_> {
         let (mut next_seed, mut seeds_left) = (seed_after, MAX_SEEDS);
         // The first seed needs only a separating direction, but not one
         // whose lower bound is lost in round-off: on a touching contact
-        // that direction comes late (a rim on a perpendicular cap after a
-        // hundred iterations), and the seed's restart then spent what was
-        // left of the iteration cap, ending a thousand bounds off.
+        // (a rim on a perpendicular cap) that direction comes late in the
+        // run, and the seed's restart then spent what was left of the
+        // iteration cap, ending far outside the tolerance.
         let (mut seed_share, mut seed_floor) = (0.0, RESEED_SLACKS * self.slack);
         match warm {
             Some(pairs) => {

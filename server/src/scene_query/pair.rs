@@ -126,6 +126,9 @@ impl Ctx<'_> {
         let q = self.q;
         let (ea, eb) = (self.bp.entry(a), self.bp.entry(b));
         let key = self.key(a, b);
+        // Where the kept entry is, and its simplex once fetched: a GJK run
+        // after a failed recheck starts from it with no second look-up.
+        let mut kept: Option<(EntryAt, Option<WarmStart>)> = None;
         if let Some((at, bound, d, w)) = kept_bound(q, self.cache, &key, ea, eb) {
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
             let (ruled, settled) = match ask {
@@ -148,9 +151,12 @@ impl Ctx<'_> {
                 return outcome;
             }
             let (bound, d) = (*bound, d);
-            let rechecked = if bound.penetration > 0.0 {
-                self.recheck_overlap(&bound, ea, eb, at, ask)
+            let rechecked = if bound.penetration > 0.0 && matches!(ask, Ask::Within(_)) {
+                let warm = self.cache.get_at(at);
+                kept = Some((at, Some(warm)));
+                self.recheck_overlap(&bound, ea, eb, &warm)
             } else {
+                kept = Some((at, None));
                 self.recheck(&bound, d, &w, ea, eb, ask)
             };
             if let Some((fresh, outcome)) = rechecked {
@@ -162,7 +168,12 @@ impl Ctx<'_> {
                 return outcome;
             }
         }
-        let warm = self.warm(a, b);
+        let warm = match kept {
+            _ if !q.warm => None,
+            Some((_, Some(warm))) => Some(warm),
+            Some((at, None)) => Some(self.cache.get_at(at)),
+            None => self.warm(a, b),
+        };
         Outcome::Answer(self.run_keeping(a, b, ask, warm, keep))
     }
 
@@ -205,23 +216,18 @@ impl Ctx<'_> {
 
     /// The kept `bound` of an overlapping pair re-certified at the current
     /// poses of `ea`, `eb` from its cached simplex
-    /// ([`gjk::penetration_bound`]: no support search), for a within ask:
-    /// the pair still overlaps, its distance is 0. `None` when the simplex
-    /// no longer proves it.
+    /// (`warm`; [`gjk::penetration_bound`]: no support search), for a
+    /// within ask: the pair still overlaps, its distance is 0. `None` when
+    /// the simplex no longer proves it.
     fn recheck_overlap(
-        &mut self,
+        &self,
         bound: &PairBound,
         ea: &Entry,
         eb: &Entry,
-        at: EntryAt,
-        ask: Ask,
+        warm: &WarmStart,
     ) -> Option<(PairBound, Outcome)> {
-        if !matches!(ask, Ask::Within(_)) {
-            return None;
-        }
-        let warm = self.cache.get_at(at);
         let (oa, ob) = (self.store.object(ea.id)?, self.store.object(eb.id)?);
-        let depth = gjk::penetration_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, &warm);
+        let depth = gjk::penetration_bound(&oa.shape, &ea.pose, &ob.shape, &eb.pose, warm);
         if depth <= 0.0 {
             return None;
         }

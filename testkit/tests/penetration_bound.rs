@@ -5,9 +5,11 @@
 
 mod common;
 
+use common::{pose, vec3};
+
 use gjk::{Compound, Convex, Options, Shape, distance};
 use gjkd_testkit::check::shape_distance;
-use gjkd_testkit::reference::{P, V, hull_distance, penetration_depth};
+use gjkd_testkit::reference::{P, hull_distance, penetration_depth};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use proptest::test_runner::Config;
@@ -23,10 +25,6 @@ fn grown(expansions: u32) -> Options {
     }
 }
 
-fn vec3() -> impl Strategy<Value = V> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| V::new(x, y, z))
-}
-
 /// 4 to 12 points in general position (any set: the hull is what counts),
 /// or a few points on a plane (a flat piece).
 fn points() -> impl Strategy<Value = Vec<P>> {
@@ -39,15 +37,6 @@ fn points() -> impl Strategy<Value = Vec<P>> {
 
 fn radius() -> impl Strategy<Value = f64> {
     prop_oneof![3 => Just(0.0), 1 => 0.0..0.3f64]
-}
-
-fn pose(spread: f64) -> impl Strategy<Value = Isometry3<f64>> {
-    (vec3(), vec3()).prop_map(move |(t, w)| {
-        Isometry3::from_parts(
-            Translation3::from(t * spread),
-            UnitQuaternion::from_scaled_axis(w * std::f64::consts::PI),
-        )
-    })
 }
 
 /// Everything of `plain` but the penetration equals `deep`'s, and `deep`'s

@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::{pose, vec3};
+
 use gjk::{Compound, Convex, Options, Precision, Shape, Status, WarmStart, distance};
 use gjkd_testkit::check::{RefShape, Tolerance, shape_distance, verify, verify_penetration};
 use gjkd_testkit::reference::{P, V, aabb_distance, hull_distance};
@@ -22,10 +24,6 @@ fn config() -> Config {
 
 fn coord() -> impl Strategy<Value = f64> {
     -1.0..1.0f64
-}
-
-fn vec3() -> impl Strategy<Value = V> {
-    (coord(), coord(), coord()).prop_map(|(x, y, z)| V::new(x, y, z))
 }
 
 fn general(max: usize) -> impl Strategy<Value = Vec<P>> {
@@ -78,15 +76,6 @@ fn radius() -> impl Strategy<Value = f64> {
 
 fn convex(max: usize) -> impl Strategy<Value = Convex> {
     (point_set(max), radius()).prop_map(|(pts, r)| Convex::new(pts, r).unwrap())
-}
-
-fn pose(spread: f64) -> impl Strategy<Value = Isometry3<f64>> {
-    (vec3(), vec3()).prop_map(move |(t, w)| {
-        Isometry3::from_parts(
-            Translation3::from(t * spread),
-            UnitQuaternion::from_scaled_axis(w * std::f64::consts::PI),
-        )
-    })
 }
 
 fn compound(max_pieces: usize, max_points: usize) -> impl Strategy<Value = Shape> {

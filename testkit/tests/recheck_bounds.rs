@@ -7,11 +7,13 @@
 
 mod common;
 
+use common::{pose, vec3};
+
 use gjk::{
     Compound, Convex, Options, Shape, WarmStart, distance, penetration_bound, separation_bound,
 };
 use gjkd_testkit::check::{shape_distance, world_pieces};
-use gjkd_testkit::reference::{P, V, hull_distance, penetration_depth};
+use gjkd_testkit::reference::{P, hull_distance, penetration_depth};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use proptest::test_runner::Config;
@@ -20,25 +22,12 @@ fn config() -> Config {
     common::config(0x7265_6368)
 }
 
-fn vec3() -> impl Strategy<Value = V> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| V::new(x, y, z))
-}
-
 fn points() -> impl Strategy<Value = Vec<P>> {
     prop::collection::vec(vec3().prop_map(P::from), 4..=12)
 }
 
 fn radius() -> impl Strategy<Value = f64> {
     prop_oneof![2 => Just(0.0), 1 => 0.0..0.3f64]
-}
-
-fn pose(spread: f64) -> impl Strategy<Value = Isometry3<f64>> {
-    (vec3(), vec3()).prop_map(move |(t, w)| {
-        Isometry3::from_parts(
-            Translation3::from(t * spread),
-            UnitQuaternion::from_scaled_axis(w * std::f64::consts::PI),
-        )
-    })
 }
 
 /// A convex piece, or a union of one to three.

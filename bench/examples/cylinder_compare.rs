@@ -21,9 +21,10 @@
 //! `out` counts answers outside the judged bound (relative 1e-6,
 //! absolute 1e-9 of the size) of the bracket or whose bounds miss it.
 //! The `seeded` rows start each query from the final simplex of the same
-//! query at the same pose: a warm start at the answer itself, from which
-//! the cylinder's Newton seed (`gjk/src/query/newton_seed.rs`) takes one
-//! step to confirm it and the run one iteration to certify it.
+//! query at the same pose: a warm start at the answer itself, which the
+//! cylinder's Newton seed (`gjk/src/query/newton_seed.rs`) confirms from
+//! its first supports, and the run, where the answer lies on a flat
+//! feature, certifies in one iteration.
 
 use std::hint::black_box;
 

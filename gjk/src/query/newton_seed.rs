@@ -26,7 +26,12 @@
 //! The seed only chooses where the ordinary run starts: the run certifies
 //! the bounds (Theorem 4.1) as for any start, so a seed on the wrong
 //! feature, or none when the steps do not converge, costs time, never
-//! exactness.
+//! exactness. Two shortcuts use the same bounds: where the supports at the
+//! solved direction are themselves the nearest points (both on curved
+//! features), their distance and the direction's separation certify the
+//! answer with no run; otherwise the seed carries that separation, a lower
+//! bound from which the run's first iteration certifies without a support
+//! search of its own.
 
 use nalgebra::Vector3;
 
@@ -35,8 +40,34 @@ use crate::cylinder;
 use crate::johnson::Vertex;
 use crate::shape::Convex;
 
-/// A seed: up to three index pairs, and how many.
-pub(super) type Seed = ([[u32; 2]; 3], usize);
+/// A seed: the simplex the run starts from (up to three points of `K`,
+/// and how many), and a lower bound on the core distance (scaled; 0 when
+/// the seed has none) that lets the run's first iteration certify without
+/// a support search.
+#[derive(Clone, Copy)]
+pub(super) struct Seed {
+    pub(super) points: [Vertex; 3],
+    pub(super) len: usize,
+    pub(super) lower: f64,
+}
+
+/// What Newton's steps end with.
+pub(super) enum Seeding {
+    /// The seed the run starts from.
+    Start(Seed),
+    /// One pair of supports is the answer: no run is needed.
+    Certified(Certificate),
+}
+
+/// An answer certified by one pair of supports (see
+/// [`ConvexPair::certify`]): their difference, a point of `K` whose length
+/// is the upper bound, and the lower bound of the direction they were
+/// taken in (scaled).
+#[derive(Clone, Copy)]
+pub(super) struct Certificate {
+    pub(super) vertex: Vertex,
+    pub(super) lower: f64,
+}
 
 /// Newton steps before the seed is given up.
 const MAX_STEPS: u32 = 12;
@@ -50,6 +81,11 @@ const CAP_NEAR: f64 = 0.25;
 /// step would be of its square's order, and the run's stopping rule needs
 /// the direction to about 1e-7.
 const CONVERGED_STEP: f64 = 3e-5;
+
+/// The step (in radians) below which the supports at the next direction
+/// may certify the answer (see `certify`): after a larger one the next
+/// direction is too far off, and the test would only cost time.
+const NEAR_STEP: f64 = 1e-3;
 
 /// One shape's support at a direction, in the pair frame (scaled).
 #[derive(Clone, Copy)]
@@ -240,15 +276,18 @@ impl ConvexPair<'_> {
     /// iterate: at most three index pairs, or `None` when the solve fails
     /// (the shapes overlap, a direction along a cylinder's axis, no
     /// convergence).
-    pub(super) fn newton_seed(&self, v: &Vector3<f64>) -> Option<Seed> {
+    pub(super) fn newton_seed(&self, v: &Vector3<f64>, stop_d: f64) -> Option<Seeding> {
         let norm = v.norm();
         if !(norm > 0.0 && norm.is_finite()) {
             return None;
         }
-        self.solve_from(Solve {
-            u: -v / norm,
-            ..Solve::default()
-        })
+        self.solve_from(
+            Solve {
+                u: -v / norm,
+                ..Solve::default()
+            },
+            stop_d,
+        )
     }
 
     /// The seed from a warm start's index pairs at the new pose: from the
@@ -256,12 +295,12 @@ impl ConvexPair<'_> {
     /// cylinder's side where both caps appear at one angle, a polytope's
     /// edges between its distinct vertices), which a converged simplex
     /// names exactly.
-    pub(super) fn warm_seed(&self, pairs: &[[u32; 2]]) -> Option<Seed> {
+    pub(super) fn warm_seed(&self, pairs: &[[u32; 2]], stop_d: f64) -> Option<Seeding> {
         if pairs.is_empty() {
             return None;
         }
         if let Some(seed) = self.warm_cap_seed(pairs) {
-            return Some(seed);
+            return Some(Seeding::Start(seed));
         }
         let mut mean = Vector3::zeros();
         for &[ia, ib] in pairs {
@@ -307,17 +346,17 @@ impl ConvexPair<'_> {
         // needed.
         solve.u = held.project(&-mean)?;
         solve.held = held;
-        self.solve_from(solve)
+        self.solve_from(solve, stop_d)
     }
 
     /// The cap seed (see `cap_seed`) of each cylinder whose `rho` is below
     /// [`CAP_NEAR`] at `u`, each tried once.
-    fn try_caps(&self, u: &Vector3<f64>, tried: &mut [bool; 2], rho: [f64; 2]) -> Option<Seed> {
+    fn try_caps(&self, u: &Vector3<f64>, tried: &mut [bool; 2], rho: [f64; 2]) -> Option<Seeding> {
         for k in 0..2 {
             if !tried[k] && rho[k] < CAP_NEAR {
                 tried[k] = true;
-                if let Some(seed) = self.cap_seed(k, u) {
-                    return Some(seed);
+                if let Some(pairs) = self.cap_seed(k, u) {
+                    return Some(Seeding::Start(self.seed_of_pairs(&pairs)));
                 }
             }
         }
@@ -348,20 +387,37 @@ impl ConvexPair<'_> {
             } else {
                 -rotate(&self.rotation, &Vector3::new(0.0, 0.0, side))
             };
-            return self.cap_seed(k, &u);
+            return self.cap_seed(k, &u).map(|pairs| self.seed_of_pairs(&pairs));
         }
         None
     }
 
-    /// Newton's steps from `solve` to the seed.
-    fn solve_from(&self, mut solve: Solve) -> Option<Seed> {
+    /// Newton's steps from `solve` to the seed, or to the answer itself
+    /// where the supports at the solved direction certify it within
+    /// `stop_d` (the run's stopping rule, scaled).
+    fn solve_from(&self, mut solve: Solve, stop_d: f64) -> Option<Seeding> {
         let mut last: Option<[Touch; 2]> = None;
         let mut cap_tried = [false; 2];
+        // Whether the supports may be the answer: at the start (a warm
+        // start at the same pose) and after a step below `NEAR_STEP`.
+        let mut near = true;
         for _ in 0..MAX_STEPS {
             let Some(touches) = self.touches(&solve.u) else {
                 // Along an axis: only its cap can hold the answer.
                 return self.try_caps(&solve.u, &mut cap_tried, [0.0; 2]);
             };
+            // The supports here may already be the answer: a warm start at
+            // the same pose, or a step that landed on it. Checked on the
+            // closed forms' points; the certificate is taken from the
+            // support search, whose codes name the points the answer
+            // reports.
+            let y = touches[0].point - touches[1].point;
+            if near
+                && certifies(&solve.u, &y, -solve.u.dot(&y), self.slack, stop_d)
+                && let Some(done) = self.certify(&solve.u, self.support(&solve.u), stop_d)
+            {
+                return Some(Seeding::Certified(done));
+            }
             let rho = [touches[0].rho, touches[1].rho];
             if rho.iter().any(|&rho| rho < CAP_NEAR)
                 && let Some(seed) = self.try_caps(&solve.u, &mut cap_tried, rho)
@@ -387,11 +443,11 @@ impl ConvexPair<'_> {
             // point's turn.
             let converged_step = CONVERGED_STEP * (rho[0].min(rho[1]) / CAP_NEAR).min(1.0);
             let small = step.norm_squared() < converged_step * converged_step;
+            near = step.norm_squared() < NEAR_STEP * NEAR_STEP;
             let converged = !landed && (small || solve.held.len == 2);
             if converged && solve.side == [false; 2] {
-                // The seed's supports need the direction, not its length.
-                solve.u = solve.held.project_unscaled(&(solve.u + step));
-                return self.seed_at(&solve);
+                solve.u = solve.held.project(&(solve.u + step))?;
+                return self.seed_at(&solve, stop_d);
             }
             solve.u = solve.held.project(&(solve.u + step))?;
             if !converged {
@@ -402,9 +458,29 @@ impl ConvexPair<'_> {
                 last = None;
                 continue;
             }
-            return self.seed_at(&solve);
+            return self.seed_at(&solve, stop_d);
         }
         None
+    }
+
+    /// The support point `support` of `K` at the unit direction `u`
+    /// (A's at `u`, B's at `-u`) as the answer, when it is within `stop_d`
+    /// of it: `y` is a point of `K`, so `|y|` bounds the distance from
+    /// above, and `F = -u·y`, the separation of the shapes' projections on
+    /// `u`, from below (Theorem 4.1's bounds, from one support each). Their
+    /// gap `|y| - F` is `|y_⊥|² / (|y| + F)`, with `y_⊥` the part of `y`
+    /// across `u`, so `|y_⊥|² <= 2·F·stop_d` certifies it without a square
+    /// root. It holds where both supports lie on curved features (rims, a
+    /// polytope's vertex); on a flat one they are its corners, far across
+    /// `u`, and the test fails.
+    #[inline(always)]
+    fn certify(&self, u: &Vector3<f64>, support: Vertex, stop_d: f64) -> Option<Certificate> {
+        let f = -u.dot(&support.y);
+        // `u` is unit to a few ε: the error in `F` is within the slack.
+        certifies(u, &support.y, f, self.slack, stop_d).then_some(Certificate {
+            vertex: support,
+            lower: f,
+        })
     }
 
     /// Whether a held side kink does not hold the answer: the answer's
@@ -491,80 +567,107 @@ impl ConvexPair<'_> {
         added
     }
 
-    /// The index pairs of the support points at the solved direction, each
-    /// kink's partners included, at most three.
-    fn seed_at(&self, solve: &Solve) -> Option<Seed> {
+    /// The seed at the solved direction `solve.u` (unit): the support
+    /// points there, each kink's partners included (at most three pairs),
+    /// with the direction's lower bound, so that the run's first iteration
+    /// certifies without a support search of its own; or the answer itself
+    /// when the supports alone certify it (see [`certify`](Self::certify)).
+    fn seed_at(&self, solve: &Solve, stop_d: f64) -> Option<Seeding> {
         let u = solve.u;
-        let a = self.seed_indices(self.a, &u, &solve.kinks[0], solve.side[0]);
-        let b = self.seed_indices(
-            self.b,
-            &-rotate_back(&self.rotation, &u),
-            &solve.kinks[1],
-            solve.side[1],
-        );
-        let mut pairs = [[0; 2]; 3];
-        if let Some([wa, wb]) = solve.face_weights {
+        let d_b = -rotate_back(&self.rotation, &u);
+        let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
+        let support = self.difference_of(a, b);
+        let lower = -u.dot(&support.y);
+        // Kinks are flat features: there the supports never certify.
+        if solve.held.len == 0
+            && let Some(done) = self.certify(&u, support, stop_d)
+        {
+            return Some(Seeding::Certified(done));
+        }
+        let a = seed_features(self.a, a, &solve.kinks[0], solve.side[0]);
+        let b = seed_features(self.b, b, &solve.kinks[1], solve.side[1]);
+        let mut points = [Vertex::default(); 3];
+        let len = if let Some([wa, wb]) = solve.face_weights {
             // Two sides: the triangle of their parallelogram that holds the
             // answer (four coplanar points would leave the subalgorithm a
             // flat tetrahedron).
-            let [a_this, a_other] = cap_pair(a.0[0], solve.this_top[0]);
-            let [b_this, b_other] = cap_pair(b.0[0], solve.this_top[1]);
-            pairs = if wa + wb <= 1.0 {
-                [[a_this, b_this], [a_other, b_this], [a_this, b_other]]
+            let [a_this, a_other] = cap_pair(&a.0, solve.this_top[0]);
+            let [b_this, b_other] = cap_pair(&b.0, solve.this_top[1]);
+            let corners = if wa + wb <= 1.0 {
+                [(a_this, b_this), (a_other, b_this), (a_this, b_other)]
             } else {
-                [[a_other, b_other], [a_other, b_this], [a_this, b_other]]
+                [(a_other, b_other), (a_other, b_this), (a_this, b_other)]
             };
-            return Some((pairs, 3));
-        }
-        let mut len = 0;
-        for &ib in &b.0[..b.1] {
-            for &ia in &a.0[..a.1] {
-                if len < 3 {
-                    pairs[len] = [ia, ib];
-                    len += 1;
+            for (point, (fa, fb)) in points.iter_mut().zip(corners) {
+                *point = self.difference_of(fa, fb);
+            }
+            3
+        } else {
+            let mut len = 0;
+            for &fb in &b.0[..b.1] {
+                for &fa in &a.0[..a.1] {
+                    if len < 3 {
+                        points[len] = self.difference_of(fa, fb);
+                        len += 1;
+                    }
                 }
             }
-        }
-        (len > 0).then_some((pairs, len))
+            len
+        };
+        Some(Seeding::Start(Seed { points, len, lower }))
     }
 
-    /// The indices of `shape`'s support at body direction `d`: its code or
-    /// vertex, then a cylinder's other cap at the same angle or a polytope's
-    /// other kink vertices.
-    fn seed_indices(
-        &self,
-        shape: &Convex,
-        d: &Vector3<f64>,
-        kinks: &Kinks,
-        side: bool,
-    ) -> ([u32; 3], usize) {
-        let mut out = ([0; 3], 1);
-        if shape.cylinder_dimensions().is_some() {
-            out.0[0] = cylinder::support_code(d);
-            if side {
-                out.0[1] = cylinder::other_cap(out.0[0]);
-                out.1 = 2;
-            }
-            return out;
-        }
-        out.0[0] = shape.support_point(d).0 as u32;
-        for &key in &kinks.keys[..kinks.len] {
-            if key != out.0[0] && out.1 < 3 {
-                out.0[out.1] = key;
-                out.1 += 1;
-            }
-        }
-        out
-    }
-
-    /// The seed's points as simplex vertices.
-    pub(super) fn seed_vertices(&self, pairs: &[[u32; 2]]) -> ([Vertex; 4], usize) {
-        let mut points = [Vertex::default(); 4];
+    /// The seed of index pairs that another rule chose (a cap's), with no
+    /// lower bound of its own.
+    fn seed_of_pairs(&self, pairs: &[[u32; 2]; 3]) -> Seed {
+        let mut points = [Vertex::default(); 3];
         for (point, &[ia, ib]) in points.iter_mut().zip(pairs) {
             *point = self.difference_vertex(ia as usize, ib as usize);
         }
-        (points, pairs.len().min(4))
+        Seed {
+            points,
+            len: 3,
+            lower: 0.0,
+        }
     }
+}
+
+/// Whether the point `y` of `K`, with `F = -u·y` at the unit `u`, is within
+/// `stop_d` of the distance (see [`ConvexPair::certify`]), the shapes apart
+/// by more than `slack`.
+#[inline(always)]
+fn certifies(u: &Vector3<f64>, y: &Vector3<f64>, f: f64, slack: f64, stop_d: f64) -> bool {
+    let across = y + u * f;
+    f > slack && across.norm_squared() <= 2.0 * f * stop_d
+}
+
+/// A shape's support point `support` (index and body point) and the
+/// partners of its held kinks: a cylinder's other cap at the same angle,
+/// a polytope's other kink vertices. At most three.
+#[inline(always)]
+fn seed_features(
+    shape: &Convex,
+    support: (usize, Vector3<f64>),
+    kinks: &Kinks,
+    side: bool,
+) -> ([(usize, Vector3<f64>); 3], usize) {
+    let mut out = ([support; 3], 1);
+    if shape.cylinder_dimensions().is_some() {
+        if side {
+            let (code, point) = support;
+            let other = cylinder::other_cap(code as u32) as usize;
+            out.0[1] = (other, Vector3::new(point.x, point.y, -point.z));
+            out.1 = 2;
+        }
+        return out;
+    }
+    for &key in &kinks.keys[..kinks.len] {
+        if key as usize != support.0 && out.1 < 3 {
+            out.0[out.1] = (key as usize, shape.point(key as usize));
+            out.1 += 1;
+        }
+    }
+    out
 }
 
 /// The Newton step at `solve.u` for the supports `touches`: the tangent
@@ -679,14 +782,14 @@ fn stop_at_side(solve: &mut Solve, touches: &[Touch; 2], step: &mut Vector3<f64>
     true
 }
 
-/// A cylinder's codes at `code`'s angle: on the cap named by `top` first,
-/// then on the other.
-fn cap_pair(code: u32, top: bool) -> [u32; 2] {
-    let other = cylinder::other_cap(code);
-    if cylinder::is_top(code) == top {
-        [code, other]
+/// A cylinder's support point and its other cap's (`seed_features`), the
+/// one on the cap named by `top` first.
+fn cap_pair(features: &[(usize, Vector3<f64>); 3], top: bool) -> [(usize, Vector3<f64>); 2] {
+    let [this, other, _] = *features;
+    if cylinder::is_top(this.0 as u32) == top {
+        [this, other]
     } else {
-        [other, code]
+        [other, this]
     }
 }
 
@@ -715,6 +818,7 @@ mod tests {
 
     use super::super::numerical_algorithm::RunOutcome;
     use super::super::pair::{ConvexPair, PiecePlacement};
+    use super::Seeding;
     use crate::johnson::Simplex;
     use crate::shape::tests::Rng;
     use crate::{Convex, Options, Precision};
@@ -920,8 +1024,16 @@ mod tests {
             (place(&id), place(&above)),
             Precision::Double,
         );
-        let (pairs, len) = pair.newton_seed(&Vector3::new(0.0, 0.0, -1.0)).unwrap();
-        let coaxial = run(&a, &b, &above, true, Some(&pairs[..len]));
+        let stop_d = Options::default().tolerance * pair.size_bound;
+        let Some(Seeding::Start(seed)) = pair.newton_seed(&Vector3::new(0.0, 0.0, -1.0), stop_d)
+        else {
+            panic!("the cap seeds the coaxial pair");
+        };
+        let pairs: Vec<[u32; 2]> = seed.points[..seed.len]
+            .iter()
+            .map(|p| [p.ia, p.ib])
+            .collect();
+        let coaxial = run(&a, &b, &above, true, Some(&pairs));
         assert!((coaxial.norm - 0.5).abs() < 1e-12, "{}", coaxial.norm);
         assert!((coaxial.lower - 0.5).abs() < 1e-12, "{}", coaxial.lower);
         assert_eq!(coaxial.iterations, 1);
@@ -936,7 +1048,7 @@ mod tests {
             Precision::Double,
         );
         for v in [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.3, -0.7, 0.2)] {
-            assert!(pair.newton_seed(&v).is_none(), "{v:?}");
+            assert!(pair.newton_seed(&v, 0.0).is_none(), "{v:?}");
         }
         assert_eq!(run(&a, &b, &inside, true, None).norm, 0.0);
         // A seed that the run cannot use (codes far from the answer) costs

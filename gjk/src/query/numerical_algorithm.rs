@@ -1,6 +1,7 @@
 //! The paper's Numerical Algorithm (Section 6), steps (1) to (6), on one
 //! convex pair.
 
+use super::newton_seed::{Certificate, Seeding};
 use super::pair::ConvexPair;
 use super::{Options, Status};
 use crate::johnson::{Simplex, Solution, Vertex};
@@ -174,25 +175,6 @@ impl ConvexPair<'_> {
         // run, and the seed's restart then spent what was left of the
         // iteration cap, ending far outside the tolerance.
         let (mut seed_share, mut seed_floor) = (0.0, RESEED_SLACKS * self.slack);
-        match warm {
-            Some(pairs) => {
-                let seed = if !SEED { None } else { self.warm_seed(pairs) };
-                if seed.is_some() {
-                    (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS - 1);
-                    (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
-                }
-                let pairs = match &seed {
-                    Some((seed_pairs, len)) => &seed_pairs[..*len],
-                    None => pairs,
-                };
-                let mut points = [Vertex::default(); 4];
-                for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
-                    *point = self.difference_vertex(index_a as usize, index_b as usize);
-                }
-                reset_simplex::<AVX2>(simplex, &points[..pairs.len()]);
-            }
-            None => simplex.start(self.support(&self.centroid_gap)),
-        }
         let eps_d = options.tolerance * self.size_bound;
         // What the support search may miss is added to every test of g, so
         // that an f32 search stops where it can prove no more (0 in f64).
@@ -205,6 +187,32 @@ impl ConvexPair<'_> {
             flat_steps: 0,
             level_v2: f64::INFINITY,
         };
+        match warm {
+            Some(pairs) => match if SEED {
+                self.warm_seed(pairs, stop_d)
+            } else {
+                None
+            } {
+                Some(Seeding::Certified(done)) => {
+                    state.iterations = 1;
+                    return self.certified_run::<AVX2>(simplex, &state, done);
+                }
+                Some(Seeding::Start(seed)) => {
+                    (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS - 1);
+                    (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
+                    state.lower = seed.lower;
+                    reset_simplex::<AVX2>(simplex, &seed.points[..seed.len]);
+                }
+                None => {
+                    let mut points = [Vertex::default(); 4];
+                    for (point, &[index_a, index_b]) in points.iter_mut().zip(pairs) {
+                        *point = self.difference_vertex(index_a as usize, index_b as usize);
+                    }
+                    reset_simplex::<AVX2>(simplex, &points[..pairs.len()]);
+                }
+            },
+            None => simplex.start(self.support(&self.centroid_gap)),
+        }
         loop {
             state.iterations += 1;
             // Step (2).
@@ -233,6 +241,12 @@ impl ConvexPair<'_> {
                     Some(run) => return run,
                     None => continue,
                 }
+            }
+            // A seed's own lower bound, from the direction it was solved
+            // at, may already meet the stopping rule: then no support
+            // search is needed.
+            if SEED && norm - state.lower <= stop_d {
+                return self.end_run(simplex, &state, Status::Converged, solution, state.lower);
             }
             // Step (3).
             let support_point = self.support(&-solution.v);
@@ -291,11 +305,17 @@ impl ConvexPair<'_> {
                 seeds_left -= 1;
                 next_seed = state.iterations + RESEED_AFTER;
                 (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
-                if let Some((pairs, len)) = self.newton_seed(&solution.v) {
-                    let (points, len) = self.seed_vertices(&pairs[..len]);
-                    reset_simplex::<AVX2>(simplex, &points[..len]);
-                    state.previous = None;
-                    continue;
+                match self.newton_seed(&solution.v, stop_d) {
+                    Some(Seeding::Start(seed)) => {
+                        state.lower = state.lower.max(seed.lower);
+                        reset_simplex::<AVX2>(simplex, &seed.points[..seed.len]);
+                        state.previous = None;
+                        continue;
+                    }
+                    Some(Seeding::Certified(done)) => {
+                        return self.certified_run::<AVX2>(simplex, &state, done);
+                    }
+                    None => {}
                 }
             }
             state.previous = Some((solution, v2));
@@ -329,6 +349,26 @@ impl ConvexPair<'_> {
             return Some(Exit::Status(Status::Closer));
         }
         None
+    }
+
+    /// A run ended by Newton's certificate (see `newton_seed`): its point
+    /// is the simplex and the solution, its bound the larger of the run's
+    /// and its own.
+    #[inline(always)]
+    fn certified_run<const AVX2: bool>(
+        &self,
+        simplex: &mut Simplex,
+        state: &RunProgress,
+        done: Certificate,
+    ) -> RunOutcome {
+        reset_simplex::<AVX2>(simplex, &[done.vertex]);
+        let solution = Solution {
+            mask: 1,
+            v: done.vertex.y,
+            lambda: [1.0, 0.0, 0.0, 0.0],
+        };
+        let lower = state.lower.max(done.lower);
+        self.end_run(simplex, state, Status::Converged, solution, lower)
     }
 
     /// A run's end: its bounds and, when the cores touch or intersect, the

@@ -200,7 +200,7 @@ impl<'s> ConvexPair<'s> {
     /// `y = z1 - z2` for A's point `za` (index `ia`) and B's point `zb`
     /// (index `ib`), both relative to their centroids in their own frames.
     #[inline(always)]
-    fn difference_of(
+    pub(super) fn difference_of(
         &self,
         (ia, za): (usize, Vector3<f64>),
         (ib, zb): (usize, Vector3<f64>),

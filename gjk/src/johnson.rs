@@ -1252,7 +1252,9 @@ impl Simplex {
     /// the nearest points, `Σ λ_i a_i` and `Σ λ_i b_i`, that far apart. `None`
     /// when the sum is already within `floor` of the origin on every axis
     /// (the usual case, which then costs one weighted sum), when a weight
-    /// would leave `[0, 1]`, or when `E` is singular.
+    /// would leave `[0, 1]` and no face does better (see
+    /// [`face_weights_of_origin`](Self::face_weights_of_origin)), or when
+    /// `E` is singular.
     #[inline(never)]
     pub fn refine_origin(&self, lambda: [f64; 4], floor: f64) -> Option<[f64; 4]> {
         let y = self.vertices.map(|v| v.y);
@@ -1262,6 +1264,34 @@ impl Simplex {
         if r.amax() <= floor {
             return None;
         }
+        let miss = |w: &[f64; 4]| (y[0] + e1 * w[1] + e2 * w[2] + e3 * w[3]).norm_squared();
+        let (mut best, mut least) = (None, r.norm_squared());
+        if let Some(refined) = Self::refine_by_edges(lambda, r, (e1, e2, e3)) {
+            let m = miss(&refined);
+            if m <= floor * floor {
+                return Some(refined);
+            }
+            (best, least) = (Some(refined), least.min(m));
+        }
+        // The step did not reach the origin: the tetrahedron is too flat
+        // for its edges' system. A face's weights may.
+        if let Some((weights, m)) = self.face_weights_of_origin()
+            && m < least
+        {
+            best = Some(weights);
+        }
+        best
+    }
+
+    /// The one step of [`refine_origin`](Self::refine_origin): `λ - δ`
+    /// with `E δ = r`, `None` when a weight would leave `[0, 1]` or `E` is
+    /// singular.
+    #[inline(always)]
+    fn refine_by_edges(
+        lambda: [f64; 4],
+        r: Vector3<f64>,
+        (e1, e2, e3): (Vector3<f64>, Vector3<f64>, Vector3<f64>),
+    ) -> Option<[f64; 4]> {
         // Cramer's rule for E δ = r, the three cofactor vectors shared.
         let (c23, c31, c12) = (e2.cross(&e3), e3.cross(&e1), e1.cross(&e2));
         let det = e1.dot(&c23);
@@ -1277,6 +1307,49 @@ impl Simplex {
             lambda[3] - d3,
         ];
         out.iter().all(|l| (0.0..=1.0).contains(l)).then_some(out)
+    }
+
+    /// Weights for the origin from one face of a tetrahedron too flat for
+    /// its own (cores that cross, a needle through a segment): there the
+    /// 3×3 system of the whole is near singular, and its weights, though
+    /// they sum to 1, can put `Σ λ_i a_i` and `Σ λ_i b_i` far apart, off
+    /// the shape that the other is reported on. In the plane of a flat
+    /// tetrahedron its four faces cover its outline, so the origin's
+    /// projection lies in one of them, whose 2×2 system is well
+    /// conditioned. The face's weights (in their slots, 0 in the fourth)
+    /// whose point is nearest the origin, with that point's squared
+    /// distance; `None` if no face holds the projection.
+    #[cold]
+    fn face_weights_of_origin(&self) -> Option<([f64; 4], f64)> {
+        let y = self.vertices.map(|v| v.y);
+        let mut best: Option<([f64; 4], f64)> = None;
+        for skip in 0..4 {
+            let [i, j, k] = match skip {
+                0 => [1, 2, 3],
+                1 => [0, 2, 3],
+                2 => [0, 1, 3],
+                _ => [0, 1, 2],
+            };
+            let (p, e1, e2) = (y[i], y[j] - y[i], y[k] - y[i]);
+            let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+            let (b1, b2) = (-p.dot(&e1), -p.dot(&e2));
+            let det = g11 * g22 - g12 * g12;
+            // Also skips a NaN, which fails every comparison.
+            if det.is_nan() || det <= 1e-24 * g11 * g22 {
+                continue;
+            }
+            let (s, t) = ((b1 * g22 - b2 * g12) / det, (g11 * b2 - g12 * b1) / det);
+            if !(s >= 0.0 && t >= 0.0 && s + t <= 1.0) {
+                continue;
+            }
+            let miss = (p + e1 * s + e2 * t).norm_squared();
+            if best.is_none_or(|(_, least)| miss < least) {
+                let mut weights = [0.0; 4];
+                (weights[i], weights[j], weights[k]) = (1.0 - s - t, s, t);
+                best = Some((weights, miss));
+            }
+        }
+        best
     }
 
     /// Whether the vertex pair `(ia, ib)` is already in the subset `mask`.

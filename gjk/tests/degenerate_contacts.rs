@@ -21,6 +21,13 @@
 //! and a needle on a lattice's face whose run cycled between two of the face's
 //! points: see [`needle_on_a_lattice_face`]; and an ellipsoid beside a disk
 //! whose run ran out of level steps: see [`ellipsoid_beside_a_disk`].
+//!
+//! On 2026-11-26 the cylinder hunt (`bench/examples/cylinder_stress.rs`)
+//! found a capsule crossing a needle-thin cylinder whose reported points,
+//! equal as the cores cross, lay 2.4e-5 off the cylinder (6e-3 of the
+//! size): the final tetrahedron was flat, its weights far from the
+//! origin's, and the one-step refinement would have left `[0, 1]`. See
+//! [`crossing_cores_report_a_point_of_both`].
 
 // The cases' poses are data printed to the last bit, not approximations of
 // named constants.
@@ -358,6 +365,115 @@ fn needle_along_a_prism_edge_in_unions() {
         assert!(
             ((ans.point_b - alone.point_b).norm()) <= 1e-12 * size,
             "{ans:?}"
+        );
+    }
+}
+
+/// The distance from `p` to the segment `[a, b]`.
+fn to_segment(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+    (p - (a + ab * t)).norm()
+}
+
+/// Cores that cross (segments through a common point, a capsule through a
+/// needle-thin cylinder) leave a flat final tetrahedron. The two reported
+/// points are one point, and it must lie in both shapes, checked against
+/// the closed forms of a capsule (distance to its segment) and a cylinder
+/// (distance to its axis and its caps), at the pose the hunt found and at
+/// random crossings.
+#[test]
+fn crossing_cores_report_a_point_of_both() {
+    // The hunt's case, printed to the last bit.
+    let (a0, a1) = (
+        Point3::new(
+            -0.000_477_140_851_943_511_16,
+            -0.001_896_664_507_391_620_4,
+            6.947_564_625_484_928e-5,
+        ),
+        Point3::new(
+            0.000_477_140_851_943_511_16,
+            0.001_896_664_507_391_620_4,
+            -6.947_564_625_484_928e-5,
+        ),
+    );
+    let radius = 8.043_775_928_731_688e-6;
+    let (r, h) = (8.472_597_414_636_218e-13, 4.043_459_681_085_64e-6);
+    let a: Shape = Convex::capsule(a0, a1, radius).unwrap().into();
+    let b: Shape = Convex::cylinder(r, h, 0.0).unwrap().into();
+    let pose_a = Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_quaternion(Quaternion::new(
+            -0.985_649_425_928_224_2,
+            0.0,
+            0.0,
+            0.168_805_240_343_307_88,
+        )),
+    );
+    let pose_b = Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_quaternion(Quaternion::new(0.0, 1.0, 0.0, 0.0)),
+    );
+    let ans = distance(&a, &pose_a, &b, &pose_b, &Options::default(), None).unwrap();
+    assert_eq!(ans.distance, 0.0);
+    let size = (a1 - a0).norm();
+    let tol = 1e-9 * size;
+    let in_a = pose_a.inverse_transform_point(&ans.point_a);
+    assert!(to_segment(&in_a, &a0, &a1) <= radius + tol, "{in_a:?}");
+    let in_b = pose_b.inverse_transform_point(&ans.point_b);
+    assert!(in_b.x.hypot(in_b.y) <= r + tol, "{in_b:?} off the cylinder");
+    assert!(in_b.z.abs() <= h + tol, "{in_b:?} beyond a cap");
+
+    // Capsules through needle-thin cylinders, crossing at a random point,
+    // at random angles and sizes: K is all but flat.
+    let mut state = 0x5eed_c205_5000_0001u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let random_axis = |next: &mut dyn FnMut() -> f64| {
+        UnitQuaternion::from_euler_angles(next() * 3.2, next() * 3.2, next() * 3.2)
+    };
+    for k in 0..2000 {
+        let scale = 10f64.powf(3.0 * next());
+        let centre = Vector3::new(next(), next(), next()) * scale;
+        let turn_a = random_axis(&mut next);
+        let turn_b = random_axis(&mut next);
+        // A's segment along its body x, B's axis along its body z, each
+        // crossing the centre at a random share of its length. The
+        // needle is short beside the segment, as the hunt's was: the
+        // flattest tetrahedra, where a third of such crossings reported
+        // a point off the needle.
+        let (half, shift) = (scale, scale * 0.4 * next());
+        let seg = (
+            Point3::new(-half - shift, 0.0, 0.0),
+            Point3::new(half - shift, 0.0, 0.0),
+        );
+        let ra = 4e-3 * scale * next().abs();
+        let (r, h) = (
+            4e-10 * scale * next().abs(),
+            2e-3 * scale * (0.5 + next().abs()),
+        );
+        let lift = h * 0.8 * next();
+        let a: Shape = Convex::capsule(seg.0, seg.1, ra).unwrap().into();
+        let b: Shape = Convex::cylinder(r, h, 0.0).unwrap().into();
+        let pose_a = Isometry3::from_parts(Translation3::from(centre), turn_a);
+        let pose_b = Isometry3::from_parts(
+            Translation3::from(centre - turn_b * Vector3::new(0.0, 0.0, lift)),
+            turn_b,
+        );
+        let ans = distance(&a, &pose_a, &b, &pose_b, &Options::default(), None).unwrap();
+        assert_eq!(ans.distance, 0.0, "crossing {k}");
+        let tol = 1e-9 * scale;
+        let in_a = pose_a.inverse_transform_point(&ans.point_a);
+        let in_b = pose_b.inverse_transform_point(&ans.point_b);
+        let off_a = to_segment(&in_a, &seg.0, &seg.1) - ra;
+        let off_b = (in_b.x.hypot(in_b.y) - r).max(in_b.z.abs() - h);
+        assert!(
+            off_a <= tol && off_b <= tol,
+            "crossing {k}: points {off_a:e} and {off_b:e} off their shapes"
         );
     }
 }

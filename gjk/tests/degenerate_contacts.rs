@@ -424,6 +424,61 @@ fn crossing_cores_report_a_point_of_both() {
     assert!(in_b.x.hypot(in_b.y) <= r + tol, "{in_b:?} off the cylinder");
     assert!(in_b.z.abs() <= h + tol, "{in_b:?} beyond a cap");
 
+    // The hunt's second case: a needle of 1e-7 inside a capsule of
+    // radius 77 whose segment, 3 700 from the origin, runs through it.
+    let (a0, a1) = (
+        Point3::new(
+            -16.482_160_598_111_95,
+            5.545_978_834_266_783,
+            14.135_134_069_947_847,
+        ),
+        Point3::new(
+            16.482_160_598_111_95,
+            -5.545_978_834_266_783,
+            -14.135_134_069_947_847,
+        ),
+    );
+    let radius = 77.211_095_287_490_58;
+    let (r, h) = (9.673_582_019_314_42e-9, 1.090_038_436_277_928_4e-7);
+    let a: Shape = Convex::capsule(a0, a1, radius).unwrap().into();
+    let b: Shape = Convex::cylinder(r, h, 0.0).unwrap().into();
+    let pose_a = Isometry3::from_parts(
+        Translation3::new(
+            -1_833.691_903_783_756_3,
+            3_718.787_906_273_656_5,
+            761.249_521_094_285_6,
+        ),
+        UnitQuaternion::from_quaternion(Quaternion::new(
+            0.381_153_780_504_443_5,
+            -0.874_753_146_833_117_4,
+            -0.273_890_815_608_113_57,
+            -0.120_468_040_733_843_89,
+        )),
+    );
+    let pose_b = Isometry3::from_parts(
+        Translation3::new(
+            -1_833.691_903_786_470_7,
+            3_718.787_906_275_784_7,
+            761.249_521_084_224_9,
+        ),
+        UnitQuaternion::from_quaternion(Quaternion::new(
+            -0.065_611_726_517_308_7,
+            0.148_020_565_176_625_65,
+            -0.904_598_894_015_304_2,
+            -0.394_316_946_851_766,
+        )),
+    );
+    let ans = distance(&a, &pose_a, &b, &pose_b, &Options::default(), None).unwrap();
+    assert_eq!(ans.distance, 0.0);
+    // The judged bound, 1e-9 of the larger size, and the round-off of
+    // coordinates 4e3 from the origin.
+    let tol = 1e-9 * (a1 - a0).norm() + 64.0 * f64::EPSILON * 4e3;
+    let in_a = pose_a.inverse_transform_point(&ans.point_a);
+    assert!(to_segment(&in_a, &a0, &a1) <= radius + tol, "{in_a:?}");
+    let in_b = pose_b.inverse_transform_point(&ans.point_b);
+    assert!(in_b.x.hypot(in_b.y) <= r + tol, "{in_b:?} off the cylinder");
+    assert!(in_b.z.abs() <= h + tol, "{in_b:?} beyond a cap");
+
     // Capsules through needle-thin cylinders, crossing at a random point,
     // at random angles and sizes: K is all but flat.
     let mut state = 0x5eed_c205_5000_0001u64;

@@ -22,6 +22,9 @@ pub struct Answer {
     pub upper: f64,
     /// Nearest point on A. When the shapes overlap, the deepest point of A's
     /// surface along `normal` (so `point_b - point_a = -penetration·normal`).
+    /// When the cores touch or cross (`normal` zero), a point of A's core
+    /// where they meet; `point_b` is B's, equal to it up to the round-off
+    /// of the final simplex's weights.
     pub point_a: Point3<f64>,
     /// Nearest point on B, as `point_a`.
     pub point_b: Point3<f64>,
@@ -154,10 +157,26 @@ impl ConvexPair<'_> {
             _ => (pose_a.rotation, pose_a.translation.vector),
         };
         let core_a = Point3::from(rotation * (self.a.centroid().coords + nearest_a) + shift);
-        // b - a = -v, in world coordinates.
-        let gap = rotation * -run.solution.v;
-        let core_b = core_a + gap;
         let separated = run.norm > self.slack_world;
+        // b - a = -v, in world coordinates. Where the cores touch or cross,
+        // `v` is the origin by definition, and the weights' own sum
+        // `Σλ_i y_i` stands in for it: B's point is then B's weighted sum
+        // `Σλ_i b_i`, in B, however flat the final simplex (a needle
+        // through a segment leaves that sum 1e-7 of the size from the
+        // origin, which `-v` would have put between B's point and B).
+        let v = if separated {
+            run.solution.v
+        } else {
+            let mut sum = Vector3::zeros();
+            for (slot, (vertex, weight)) in simplex.vertices.iter().zip(lambda).enumerate() {
+                if run.solution.mask & (1 << slot) != 0 {
+                    sum += vertex.y * weight;
+                }
+            }
+            sum * self.inv_scale
+        };
+        let gap = rotation * -v;
+        let core_b = core_a + gap;
         let normal = if separated {
             gap * (1.0 / run.norm)
         } else {

@@ -376,6 +376,23 @@ fn to_segment(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
     (p - (a + ab * t)).norm()
 }
 
+/// How far outside its shape each of `answer`'s points lies (0 or less
+/// inside): A a capsule, its segment and radius, at `pose_a`; B a cylinder
+/// of radius `r` and half-height `h` at `pose_b`. By the closed forms:
+/// the distance to the segment, to the axis and past the caps.
+fn outside(
+    answer: &gjk::Answer,
+    (seg, radius, pose_a): ((Point3<f64>, Point3<f64>), f64, &Isometry3<f64>),
+    (r, h, pose_b): (f64, f64, &Isometry3<f64>),
+) -> (f64, f64) {
+    let in_a = pose_a.inverse_transform_point(&answer.point_a);
+    let in_b = pose_b.inverse_transform_point(&answer.point_b);
+    (
+        to_segment(&in_a, &seg.0, &seg.1) - radius,
+        (in_b.x.hypot(in_b.y) - r).max(in_b.z.abs() - h),
+    )
+}
+
 /// Cores that cross (segments through a common point, a capsule through a
 /// needle-thin cylinder) leave a flat final tetrahedron. The two reported
 /// points are one point, and it must lie in both shapes, checked against
@@ -417,12 +434,11 @@ fn crossing_cores_report_a_point_of_both() {
     let ans = distance(&a, &pose_a, &b, &pose_b, &Options::default(), None).unwrap();
     assert_eq!(ans.distance, 0.0);
     let size = (a1 - a0).norm();
-    let tol = 1e-9 * size;
-    let in_a = pose_a.inverse_transform_point(&ans.point_a);
-    assert!(to_segment(&in_a, &a0, &a1) <= radius + tol, "{in_a:?}");
-    let in_b = pose_b.inverse_transform_point(&ans.point_b);
-    assert!(in_b.x.hypot(in_b.y) <= r + tol, "{in_b:?} off the cylinder");
-    assert!(in_b.z.abs() <= h + tol, "{in_b:?} beyond a cap");
+    let (off_a, off_b) = outside(&ans, ((a0, a1), radius, &pose_a), (r, h, &pose_b));
+    assert!(
+        off_a <= 1e-9 * size && off_b <= 1e-9 * size,
+        "{off_a:e}, {off_b:e} off"
+    );
 
     // The hunt's second case: a needle of 1e-7 inside a capsule of
     // radius 77 whose segment, 3 700 from the origin, runs through it.
@@ -473,11 +489,8 @@ fn crossing_cores_report_a_point_of_both() {
     // The judged bound, 1e-9 of the larger size, and the round-off of
     // coordinates 4e3 from the origin.
     let tol = 1e-9 * (a1 - a0).norm() + 64.0 * f64::EPSILON * 4e3;
-    let in_a = pose_a.inverse_transform_point(&ans.point_a);
-    assert!(to_segment(&in_a, &a0, &a1) <= radius + tol, "{in_a:?}");
-    let in_b = pose_b.inverse_transform_point(&ans.point_b);
-    assert!(in_b.x.hypot(in_b.y) <= r + tol, "{in_b:?} off the cylinder");
-    assert!(in_b.z.abs() <= h + tol, "{in_b:?} beyond a cap");
+    let (off_a, off_b) = outside(&ans, ((a0, a1), radius, &pose_a), (r, h, &pose_b));
+    assert!(off_a <= tol && off_b <= tol, "{off_a:e}, {off_b:e} off");
 
     // Capsules through needle-thin cylinders, crossing at a random point,
     // at random angles and sizes: K is all but flat.
@@ -522,10 +535,7 @@ fn crossing_cores_report_a_point_of_both() {
         let ans = distance(&a, &pose_a, &b, &pose_b, &Options::default(), None).unwrap();
         assert_eq!(ans.distance, 0.0, "crossing {k}");
         let tol = 1e-9 * scale;
-        let in_a = pose_a.inverse_transform_point(&ans.point_a);
-        let in_b = pose_b.inverse_transform_point(&ans.point_b);
-        let off_a = to_segment(&in_a, &seg.0, &seg.1) - ra;
-        let off_b = (in_b.x.hypot(in_b.y) - r).max(in_b.z.abs() - h);
+        let (off_a, off_b) = outside(&ans, (seg, ra, &pose_a), (r, h, &pose_b));
         assert!(
             off_a <= tol && off_b <= tol,
             "crossing {k}: points {off_a:e} and {off_b:e} off their shapes"

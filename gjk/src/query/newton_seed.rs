@@ -87,6 +87,28 @@ const CONVERGED_STEP: f64 = 3e-5;
 /// direction is too far off, and the test would only cost time.
 const NEAR_STEP: f64 = 1e-3;
 
+/// The tilt (in radians) towards a seed face's projection at which its
+/// missing corner is sought (see `turn_face_triangle`): far above the
+/// round-off of the face's support values, far below the angle to a
+/// neighbouring face of any hull.
+const FACE_TILT: f64 = 1e-6;
+
+/// How far (in radians) a direction is turned off a face that does not
+/// hold the answer, towards the edge that does (see `let_go_of_face`), as
+/// `leave_false_sides` turns off a side.
+const FACE_LEAVE: f64 = 1e-3;
+
+/// How the steps close: with a seed (or the answer), or by finding that
+/// a held polytope face does not hold the answer (see `let_go_of_face`).
+enum Closing {
+    Seeded(Seeding),
+    OffFace {
+        face: usize,
+        keys: [u32; 2],
+        away: Vector3<f64>,
+    },
+}
+
 /// One shape's support at a direction, in the pair frame (scaled).
 #[derive(Clone, Copy)]
 struct Touch {
@@ -228,6 +250,9 @@ struct Solve {
     /// whether that kink was found not to hold the answer.
     side: [bool; 2],
     off_side: [bool; 2],
+    /// Whether each polytope's held face was found not to hold the
+    /// answer (see `let_go_of_face`): its vertex changes then add no edge.
+    off_face: [bool; 2],
     kinks: [Kinks; 2],
     /// Edges of the polytopes' kinks (differences of their vertices).
     edges: [Vector3<f64>; 2],
@@ -445,20 +470,23 @@ impl ConvexPair<'_> {
             let small = step.norm_squared() < converged_step * converged_step;
             near = step.norm_squared() < NEAR_STEP * NEAR_STEP;
             let converged = !landed && (small || solve.held.len == 2);
-            if converged && solve.side == [false; 2] {
-                solve.u = solve.held.project(&(solve.u + step))?;
-                return self.seed_at(&solve, stop_d);
-            }
             solve.u = solve.held.project(&(solve.u + step))?;
             if !converged {
                 continue;
             }
-            if self.leave_false_sides(&mut solve, &touches) {
+            if solve.side != [false; 2] && self.leave_false_sides(&mut solve, &touches) {
                 solve.held = solve.constraints(&touches);
                 last = None;
                 continue;
             }
-            return self.seed_at(&solve, stop_d);
+            match self.seed_at(&solve, stop_d) {
+                Closing::Seeded(seeding) => return Some(seeding),
+                Closing::OffFace { face, keys, away } => {
+                    self.let_go_of_face(&mut solve, face, keys, away);
+                    solve.u = solve.held.project(&solve.u)?;
+                    last = None;
+                }
+            }
         }
         None
     }
@@ -549,7 +577,7 @@ impl ConvexPair<'_> {
         let mut added = false;
         for k in 0..2 {
             let (was, is) = (&previous[k], &now[k]);
-            if was.key == is.key || is.axis != Vector3::zeros() {
+            if was.key == is.key || is.axis != Vector3::zeros() || solve.off_face[k] {
                 continue;
             }
             let kinks = &mut solve.kinks[k];
@@ -572,7 +600,7 @@ impl ConvexPair<'_> {
     /// with the direction's lower bound, so that the run's first iteration
     /// certifies without a support search of its own; or the answer itself
     /// when the supports alone certify it (see [`certify`](Self::certify)).
-    fn seed_at(&self, solve: &Solve, stop_d: f64) -> Option<Seeding> {
+    fn seed_at(&self, solve: &Solve, stop_d: f64) -> Closing {
         let u = solve.u;
         let d_b = -rotate_back(&self.rotation, &u);
         let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
@@ -582,7 +610,7 @@ impl ConvexPair<'_> {
         if solve.held.len == 0
             && let Some(done) = self.certify(&u, support, stop_d)
         {
-            return Some(Seeding::Certified(done));
+            return Closing::Seeded(Seeding::Certified(done));
         }
         let a = seed_features(self.a, a, &solve.kinks[0], solve.side[0]);
         let b = seed_features(self.b, b, &solve.kinks[1], solve.side[1]);
@@ -612,9 +640,92 @@ impl ConvexPair<'_> {
                     }
                 }
             }
+            // A polytope's face (its support and two kink vertices)
+            // against one point of the other shape.
+            let face = if len == 3 && a.1 == 1 && b.1 == 3 && !solve.side[0] {
+                Some((1, a.0[0]))
+            } else if len == 3 && a.1 == 3 && b.1 == 1 && !solve.side[1] {
+                Some((0, b.0[0]))
+            } else {
+                None
+            };
+            if let Some((face, other)) = face {
+                if let Some((keys, away)) = self.turn_face_triangle(&mut points, &u, face, other) {
+                    return Closing::OffFace { face, keys, away };
+                }
+            } else if len == 3 && a.1 == 2 && b.1 == 2 {
+                // A segment of each (a side, an edge): the points are three
+                // corners of their parallelogram, the first opposite the
+                // fourth.
+                let fourth = self.difference_of(a.0[1], b.0[1]);
+                // Past another edge the answer is off the parallelogram:
+                // the run finds it.
+                let _ = turn_triangle(&mut points, &u, |k, _| (k == 0).then_some(fourth));
+            }
             len
         };
-        Some(Seeding::Start(Seed { points, len, lower }))
+        Closing::Seeded(Seeding::Start(Seed { points, len, lower }))
+    }
+
+    /// Where a seed is a polytope's face against one point, the triangle
+    /// of the face that holds the point's projection: the face's known
+    /// vertices (the support and the kinks' partners) are three of its
+    /// corners, and when the projection lies beyond them the run would
+    /// start on the wrong half of the face and close in on a rim's point
+    /// linearly (a box face's other half cost warm queries 4 to 9
+    /// iterations). The missing corner is the support at the face's
+    /// direction tilted across the edge that the projection lies past.
+    /// Shape `face` (0 for A) holds the face; `other` is the other
+    /// shape's point; `u` the face's unit direction (A's support at `u`).
+    #[cold]
+    fn turn_face_triangle(
+        &self,
+        points: &mut [Vertex; 3],
+        u: &Vector3<f64>,
+        face: usize,
+        other: (usize, Vector3<f64>),
+    ) -> Option<([u32; 2], Vector3<f64>)> {
+        let index = |v: &Vertex| if face == 0 { v.ia } else { v.ib };
+        let known = points.map(|p| index(&p));
+        let (i, j, away) = turn_triangle(points, u, |_, away| {
+            // y = a - b: A's corner moves y with it, B's against it.
+            let tilt = away * FACE_TILT;
+            let corner = if face == 0 {
+                self.difference_of(self.a.support_point(&(u + tilt)), other)
+            } else {
+                let d_b = -rotate_back(&self.rotation, &(u + tilt));
+                self.difference_of(other, self.b.support_point(&d_b))
+            };
+            (!known.contains(&index(&corner))).then_some(corner)
+        })?;
+        Some(([known[i], known[j]], away))
+    }
+
+    /// Lets go of a held face of shape `face` that does not hold the
+    /// answer (the other shape's point projects beyond its edge between
+    /// vertices `keys`, past which it has no corner): Newton overshot the
+    /// face's normal from an answer on that edge, and took the vertex
+    /// change for a second kink. The edge alone is held again, the
+    /// direction turned off the face towards it (`away`, in the plane),
+    /// and the face's vertex changes are no longer kinks.
+    fn let_go_of_face(&self, solve: &mut Solve, face: usize, keys: [u32; 2], away: Vector3<f64>) {
+        let shape = if face == 0 { self.a } else { self.b };
+        let edge = shape.point(keys[1] as usize) - shape.point(keys[0] as usize);
+        let edge = if face == 0 {
+            edge
+        } else {
+            rotate(&self.rotation, &edge)
+        };
+        solve.off_face[face] = true;
+        solve.kinks[face] = Kinks {
+            keys: [keys[0], keys[1], 0],
+            len: 2,
+        };
+        solve.edges = [edge, Vector3::zeros()];
+        solve.edge_count = 1;
+        solve.held = Constraints::default();
+        solve.held.add(edge);
+        solve.u += away * FACE_LEAVE;
     }
 
     /// The seed of index pairs that another rule chose (a cap's), with no
@@ -639,6 +750,74 @@ impl ConvexPair<'_> {
 fn certifies(u: &Vector3<f64>, y: &Vector3<f64>, f: f64, slack: f64, stop_d: f64) -> bool {
     let across = y + u * f;
     f > slack && across.norm_squared() <= 2.0 * f * stop_d
+}
+
+/// The seed triangle `points` (normal `u`, unit) turned to hold the
+/// origin's projection on its plane: when the projection lies past one of
+/// its edges, the corner opposite that edge is replaced by
+/// `corner(opposite, away)` (`away` the unit direction across the edge,
+/// in the plane), if the new triangle holds the projection. Otherwise the
+/// seed stays as it is (the run certifies from any start); when `corner`
+/// gives none, the edge's corners and `away`.
+fn turn_triangle(
+    points: &mut [Vertex; 3],
+    u: &Vector3<f64>,
+    corner: impl FnOnce(usize, Vector3<f64>) -> Option<Vertex>,
+) -> Option<(usize, usize, Vector3<f64>)> {
+    let projection = u * u.dot(&points[0].y);
+    let weights = triangle_weights(points, &projection)?;
+    let (k, &least) = weights
+        .iter()
+        .enumerate()
+        .min_by(|x, y| x.1.total_cmp(y.1))
+        .expect("three weights");
+    if least >= -HOLDS_SLACK {
+        return None;
+    }
+    // Towards the edge from the corner opposite it, across the edge.
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let edge = points[j].y - points[i].y;
+    let out = points[i].y - points[k].y;
+    let away = out - edge * (edge.dot(&out) / edge.norm_squared());
+    let away = away - u * u.dot(&away);
+    let norm = away.norm();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return None;
+    }
+    let away = away / norm;
+    let Some(corner) = corner(k, away) else {
+        return Some((i, j, away));
+    };
+    let mut turned = *points;
+    turned[k] = corner;
+    if triangle_weights(&turned, &projection).is_some_and(|w| w.iter().all(|&x| x >= -HOLDS_SLACK))
+    {
+        *points = turned;
+    }
+    None
+}
+
+/// How far outside a seed face's triangle its point's projection may lie,
+/// in weights, and still count as held: round-off, not a wrong half.
+const HOLDS_SLACK: f64 = 1e-9;
+
+/// The barycentric weights of `q`, a point of the triangle `points`'s
+/// plane, from the 2×2 normal equations of its first corner's edges;
+/// `None` for a degenerate triangle.
+fn triangle_weights(points: &[Vertex; 3], q: &Vector3<f64>) -> Option<[f64; 3]> {
+    let (e1, e2, w) = (
+        points[1].y - points[0].y,
+        points[2].y - points[0].y,
+        q - points[0].y,
+    );
+    let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+    let det = g11 * g22 - g12 * g12;
+    if det.is_nan() || det <= 1e-24 * g11 * g22 {
+        return None;
+    }
+    let (r1, r2) = (w.dot(&e1), w.dot(&e2));
+    let (s, t) = ((r1 * g22 - r2 * g12) / det, (g11 * r2 - g12 * r1) / det);
+    Some([1.0 - s - t, s, t])
 }
 
 /// A shape's support point `support` (index and body point) and the

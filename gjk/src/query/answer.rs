@@ -162,8 +162,8 @@ impl ConvexPair<'_> {
         // `v` is the origin by definition, and the weights' own sum
         // `Σλ_i y_i` stands in for it: B's point is then B's weighted sum
         // `Σλ_i b_i`, in B, however flat the final simplex (a needle
-        // through a segment leaves that sum 1e-7 of the size from the
-        // origin, which `-v` would have put between B's point and B).
+        // through a segment can leave that sum far from the origin, a
+        // gap that `-v` would have put between B's point and B).
         let v = if separated {
             run.solution.v
         } else {

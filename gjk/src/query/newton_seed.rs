@@ -672,9 +672,9 @@ impl ConvexPair<'_> {
     /// vertices (the support and the kinks' partners) are three of its
     /// corners, and when the projection lies beyond them the run would
     /// start on the wrong half of the face and close in on a rim's point
-    /// linearly (a box face's other half cost warm queries 4 to 9
-    /// iterations). The missing corner is the support at the face's
-    /// direction tilted across the edge that the projection lies past.
+    /// linearly, an iteration a digit. The missing corner is the support
+    /// at the face's direction tilted across the edge that the projection
+    /// lies past.
     /// Shape `face` (0 for A) holds the face; `other` is the other
     /// shape's point; `u` the face's unit direction (A's support at `u`).
     #[cold]

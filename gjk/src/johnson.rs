@@ -1331,14 +1331,9 @@ impl Simplex {
                 _ => [0, 1, 2],
             };
             let (p, e1, e2) = (y[i], y[j] - y[i], y[k] - y[i]);
-            let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-            let (b1, b2) = (-p.dot(&e1), -p.dot(&e2));
-            let det = g11 * g22 - g12 * g12;
-            // Also skips a NaN, which fails every comparison.
-            if det.is_nan() || det <= 1e-24 * g11 * g22 {
+            let Some([_, s, t]) = triangle_weights([p, y[j], y[k]], &Vector3::zeros()) else {
                 continue;
-            }
-            let (s, t) = ((b1 * g22 - b2 * g12) / det, (g11 * b2 - g12 * b1) / det);
+            };
             if !(s >= 0.0 && t >= 0.0 && s + t <= 1.0) {
                 continue;
             }
@@ -1373,6 +1368,23 @@ impl Simplex {
         }
         hit
     }
+}
+
+/// The barycentric weights of `q` in the triangle `y` (`q` in its plane,
+/// or its projection otherwise: the 2×2 normal equations of the first
+/// corner's edges), `None` for a triangle too thin for them.
+#[inline]
+pub(crate) fn triangle_weights(y: [Vector3<f64>; 3], q: &Vector3<f64>) -> Option<[f64; 3]> {
+    let (e1, e2, w) = (y[1] - y[0], y[2] - y[0], q - y[0]);
+    let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+    let det = g11 * g22 - g12 * g12;
+    // Also refuses a NaN, which fails every comparison.
+    if det.is_nan() || det <= 1e-24 * g11 * g22 {
+        return None;
+    }
+    let (r1, r2) = (w.dot(&e1), w.dot(&e2));
+    let (s, t) = ((r1 * g22 - r2 * g12) / det, (g11 * r2 - g12 * r1) / det);
+    Some([1.0 - s - t, s, t])
 }
 
 /// The signed volume of the tetrahedron `y` with the origin in place of

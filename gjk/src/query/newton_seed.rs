@@ -37,7 +37,7 @@ use nalgebra::Vector3;
 
 use super::pair::{ConvexPair, rotate, rotate_back};
 use crate::cylinder;
-use crate::johnson::Vertex;
+use crate::johnson::{Vertex, triangle_weights};
 use crate::shape::Convex;
 
 /// A seed: the simplex the run starts from (up to three points of `K`,
@@ -765,7 +765,7 @@ fn turn_triangle(
     corner: impl FnOnce(usize, Vector3<f64>) -> Option<Vertex>,
 ) -> Option<(usize, usize, Vector3<f64>)> {
     let projection = u * u.dot(&points[0].y);
-    let weights = triangle_weights(points, &projection)?;
+    let weights = triangle_weights(points.map(|p| p.y), &projection)?;
     let (k, &least) = weights
         .iter()
         .enumerate()
@@ -790,7 +790,8 @@ fn turn_triangle(
     };
     let mut turned = *points;
     turned[k] = corner;
-    if triangle_weights(&turned, &projection).is_some_and(|w| w.iter().all(|&x| x >= -HOLDS_SLACK))
+    if triangle_weights(turned.map(|p| p.y), &projection)
+        .is_some_and(|w| w.iter().all(|&x| x >= -HOLDS_SLACK))
     {
         *points = turned;
     }
@@ -800,25 +801,6 @@ fn turn_triangle(
 /// How far outside a seed face's triangle its point's projection may lie,
 /// in weights, and still count as held: round-off, not a wrong half.
 const HOLDS_SLACK: f64 = 1e-9;
-
-/// The barycentric weights of `q`, a point of the triangle `points`'s
-/// plane, from the 2×2 normal equations of its first corner's edges;
-/// `None` for a degenerate triangle.
-fn triangle_weights(points: &[Vertex; 3], q: &Vector3<f64>) -> Option<[f64; 3]> {
-    let (e1, e2, w) = (
-        points[1].y - points[0].y,
-        points[2].y - points[0].y,
-        q - points[0].y,
-    );
-    let (g11, g12, g22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-    let det = g11 * g22 - g12 * g12;
-    if det.is_nan() || det <= 1e-24 * g11 * g22 {
-        return None;
-    }
-    let (r1, r2) = (w.dot(&e1), w.dot(&e2));
-    let (s, t) = ((r1 * g22 - r2 * g12) / det, (g11 * r2 - g12 * r1) / det);
-    Some([1.0 - s - t, s, t])
-}
 
 /// A shape's support point `support` (index and body point) and the
 /// partners of its held kinks: a cylinder's other cap at the same angle,

@@ -4,6 +4,7 @@
 mod answer;
 mod cap_seed;
 mod compound;
+mod feature_seed;
 mod full_step;
 mod newton_seed;
 mod numerical_algorithm;

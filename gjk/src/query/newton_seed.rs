@@ -35,6 +35,7 @@
 
 use nalgebra::Vector3;
 
+use super::feature_seed::{Feature, features_hold};
 use super::pair::{ConvexPair, rotate, rotate_back};
 use crate::cylinder;
 use crate::johnson::{Vertex, triangle_weights};
@@ -75,12 +76,12 @@ const MAX_STEPS: u32 = 12;
 /// The sine of the angle to a cylinder's axis below which a direction is
 /// tried against its cap (see `cap_seed`): Newton's steps close in on a
 /// cap's answer without reaching it.
-const CAP_NEAR: f64 = 0.25;
+pub(super) const CAP_NEAR: f64 = 0.25;
 
 /// The step (in radians) below which the direction has converged: the next
 /// step would be of its square's order, and the run's stopping rule needs
 /// the direction to about 1e-7.
-const CONVERGED_STEP: f64 = 3e-5;
+pub(super) const CONVERGED_STEP: f64 = 3e-5;
 
 /// The step (in radians) below which the supports at the next direction
 /// may certify the answer (see `certify`): after a larger one the next
@@ -109,14 +110,25 @@ enum Closing {
     },
 }
 
+/// What [`ConvexPair::close_at`] ends with.
+enum Close {
+    Done(Seeding),
+    /// A held kink was let go: the steps go on.
+    Reopened,
+    /// The direction has no part off the held kinks: no seed.
+    Failed,
+    /// The supports do not name the features a closed form assumed.
+    Mismatch,
+}
+
 /// One shape's support at a direction, in the pair frame (scaled).
 #[derive(Clone, Copy)]
-struct Touch {
+pub(super) struct Touch {
     /// The support point.
     point: Vector3<f64>,
     /// The vertex index, or for a cylinder its cap (0 or 1): a change is a
     /// kink.
-    key: u32,
+    pub(super) key: u32,
     /// The support Hessian `k·t·tᵀ`: zero for a polytope.
     curvature: f64,
     tangent: Vector3<f64>,
@@ -125,19 +137,19 @@ struct Touch {
     axis: Vector3<f64>,
     /// A cylinder's `|d_xy|` at the unit body direction `d` (the sine of
     /// its angle to the axis): infinite for a polytope.
-    rho: f64,
+    pub(super) rho: f64,
 }
 
 /// What one shape's kinks have shown: the support keys seen on either side
 /// of each (a cylinder's two caps, a polytope's vertices), at most three.
 #[derive(Clone, Copy, Default)]
-struct Kinks {
-    keys: [u32; 3],
-    len: usize,
+pub(super) struct Kinks {
+    pub(super) keys: [u32; 3],
+    pub(super) len: usize,
 }
 
 impl Kinks {
-    fn has(&self, key: u32) -> bool {
+    pub(super) fn has(&self, key: u32) -> bool {
         self.keys[..self.len].contains(&key)
     }
 
@@ -154,9 +166,9 @@ impl Kinks {
 /// The directions the answer's direction is known to be perpendicular to,
 /// orthonormal, at most two.
 #[derive(Clone, Copy, Default)]
-struct Constraints {
-    axes: [Vector3<f64>; 2],
-    len: usize,
+pub(super) struct Constraints {
+    pub(super) axes: [Vector3<f64>; 2],
+    pub(super) len: usize,
 }
 
 impl Constraints {
@@ -244,8 +256,8 @@ fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
 /// A running Newton solve: the direction, each shape's kinks (a
 /// cylinder's side, a polytope's vertices) and the edges they give.
 #[derive(Default)]
-struct Solve {
-    u: Vector3<f64>,
+pub(super) struct Solve {
+    pub(super) u: Vector3<f64>,
     /// Whether the direction is held on each cylinder's side kink, and
     /// whether that kink was found not to hold the answer.
     side: [bool; 2],
@@ -253,7 +265,7 @@ struct Solve {
     /// Whether each polytope's held face was found not to hold the
     /// answer (see `let_go_of_face`): its vertex changes then add no edge.
     off_face: [bool; 2],
-    kinks: [Kinks; 2],
+    pub(super) kinks: [Kinks; 2],
     /// Edges of the polytopes' kinks (differences of their vertices).
     edges: [Vector3<f64>; 2],
     edge_count: usize,
@@ -262,16 +274,17 @@ struct Solve {
     face_weights: Option<[f64; 2]>,
     this_top: [bool; 2],
     /// The constraints of the held kinks, kept from one step to the next.
-    held: Constraints,
+    pub(super) held: Constraints,
 }
 
 impl Solve {
-    /// The constraints: each held side's axis, then the polytope edges.
-    fn constraints(&self, touches: &[Touch; 2]) -> Constraints {
+    /// The constraints: each held side's axis (`axes`, the cylinders'
+    /// in the pair frame), then the polytope edges.
+    fn constraints(&self, axes: &[Vector3<f64>; 2]) -> Constraints {
         let mut out = Constraints::default();
-        for (held, touch) in self.side.iter().zip(touches) {
+        for (held, axis) in self.side.iter().zip(axes) {
             if *held {
-                out.add_axis(touch.axis);
+                out.add_axis(*axis);
             }
         }
         for edge in &self.edges[..self.edge_count] {
@@ -312,6 +325,7 @@ impl ConvexPair<'_> {
                 ..Solve::default()
             },
             stop_d,
+            None,
         )
     }
 
@@ -332,11 +346,19 @@ impl ConvexPair<'_> {
             mean += self.difference_vertex(ia as usize, ib as usize).y;
         }
         let mut solve = Solve::default();
+        let mut features = [Feature::Other; 2];
         for (k, shape) in [self.a, self.b].into_iter().enumerate() {
             let index = |pair: &[u32; 2]| pair[k];
             let first = index(&pairs[0]);
             if shape.cylinder_dimensions().is_some() {
                 solve.side[k] = pairs.iter().any(|p| index(p) == cylinder::other_cap(first));
+                features[k] = if solve.side[k] {
+                    Feature::Side
+                } else if pairs.iter().all(|p| index(p) == first) {
+                    Feature::Rim(cylinder::is_top(first))
+                } else {
+                    Feature::Other
+                };
                 continue;
             }
             for p in pairs {
@@ -353,6 +375,12 @@ impl ConvexPair<'_> {
                     solve.edge_count += 1;
                 }
             }
+            features[k] = match solve.kinks[k].len {
+                0 => Feature::Vertex(first),
+                2 if pairs.iter().all(|p| solve.kinks[k].has(index(p))) => Feature::Edge,
+                3 if pairs.iter().all(|p| solve.kinks[k].has(index(p))) => Feature::Face,
+                _ => Feature::Other,
+            };
         }
         if !mean.iter().all(|x| x.is_finite()) {
             return None;
@@ -371,7 +399,7 @@ impl ConvexPair<'_> {
         // needed.
         solve.u = held.project(&-mean)?;
         solve.held = held;
-        self.solve_from(solve, stop_d)
+        self.solve_from(solve, stop_d, Some(features))
     }
 
     /// The cap seed (see `cap_seed`) of each cylinder whose `rho` is below
@@ -417,10 +445,38 @@ impl ConvexPair<'_> {
         None
     }
 
+    /// The cylinders' axes in the pair frame (A's is its body's z axis, B's
+    /// turned by the rotation); a polytope's is never read.
+    #[inline(always)]
+    fn axes(&self) -> [Vector3<f64>; 2] {
+        let r = &self.rotation;
+        [Vector3::z(), Vector3::new(r[(0, 2)], r[(1, 2)], r[(2, 2)])]
+    }
+
     /// Newton's steps from `solve` to the seed, or to the answer itself
     /// where the supports at the solved direction certify it within
-    /// `stop_d` (the run's stopping rule, scaled).
-    fn solve_from(&self, mut solve: Solve, stop_d: f64) -> Option<Seeding> {
+    /// `stop_d` (the run's stopping rule, scaled). A warm start's
+    /// `features` are first solved for in closed form (see
+    /// `feature_seed`).
+    fn solve_from(
+        &self,
+        mut solve: Solve,
+        stop_d: f64,
+        features: Option<[Feature; 2]>,
+    ) -> Option<Seeding> {
+        if let Some(features) = features
+            && let Some(u) = self.feature_optimum(&solve, features)
+        {
+            let start = solve.u;
+            solve.u = u;
+            match self.close_at(&mut solve, stop_d, Some(features)) {
+                Close::Done(seeding) => return Some(seeding),
+                Close::Reopened => {}
+                Close::Failed => return None,
+                // Not the features the closed form assumed.
+                Close::Mismatch => solve.u = start,
+            }
+        }
         let mut last: Option<[Touch; 2]> = None;
         let mut cap_tried = [false; 2];
         // Whether the supports may be the answer: at the start (a warm
@@ -452,7 +508,7 @@ impl ConvexPair<'_> {
             if let Some(previous) = last
                 && self.note_vertex_kinks(&mut solve, &previous, &touches)
             {
-                solve.held = solve.constraints(&touches);
+                solve.held = solve.constraints(&self.axes());
                 solve.u = solve.held.project(&solve.u)?;
                 last = None;
                 continue;
@@ -461,7 +517,7 @@ impl ConvexPair<'_> {
             let mut step = newton_step(&solve.u, &solve.held, &touches)?;
             let landed = stop_at_side(&mut solve, &touches, &mut step);
             if landed {
-                solve.held = solve.constraints(&touches);
+                solve.held = solve.constraints(&self.axes());
             }
             // Near a cylinder's axis a turn of the direction turns its rim
             // point by that over `rho`: there the test is on the rim
@@ -474,21 +530,48 @@ impl ConvexPair<'_> {
             if !converged {
                 continue;
             }
-            if solve.side != [false; 2] && self.leave_false_sides(&mut solve, &touches) {
-                solve.held = solve.constraints(&touches);
-                last = None;
-                continue;
-            }
-            match self.seed_at(&solve, stop_d) {
-                Closing::Seeded(seeding) => return Some(seeding),
-                Closing::OffFace { face, keys, away } => {
-                    self.let_go_of_face(&mut solve, face, keys, away);
-                    solve.u = solve.held.project(&solve.u)?;
-                    last = None;
-                }
+            match self.close_at(&mut solve, stop_d, None) {
+                Close::Done(seeding) => return Some(seeding),
+                Close::Reopened | Close::Mismatch => last = None,
+                Close::Failed => return None,
             }
         }
         None
+    }
+
+    /// The close of the steps at the converged direction `solve.u`: the
+    /// seed from the supports there, unless a held side or face turns out
+    /// not to hold the answer (then it is let go and the steps go on from
+    /// the direction turned off it), or the supports do not name the
+    /// `features` a closed form assumed.
+    fn close_at(&self, solve: &mut Solve, stop_d: f64, features: Option<[Feature; 2]>) -> Close {
+        let u = solve.u;
+        let d_b = -rotate_back(&self.rotation, &u);
+        let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
+        if let Some(features) = features
+            && !features_hold(&solve.kinks, [(a.0, u), (b.0, d_b)], features)
+        {
+            return Close::Mismatch;
+        }
+        let support = self.difference_of(a, b);
+        let tops = [a.0, b.0].map(|code| cylinder::is_top(code as u32));
+        if solve.side != [false; 2] && self.leave_false_sides(solve, &support.y, tops) {
+            solve.held = solve.constraints(&self.axes());
+            return Close::Reopened;
+        }
+        match self.seed_of_supports(solve, a, b, support, stop_d) {
+            Closing::Seeded(seeding) => Close::Done(seeding),
+            Closing::OffFace { face, keys, away } => {
+                self.let_go_of_face(solve, face, keys, away);
+                match solve.held.project(&solve.u) {
+                    Some(u) => {
+                        solve.u = u;
+                        Close::Reopened
+                    }
+                    None => Close::Failed,
+                }
+            }
+        }
     }
 
     /// The support point `support` of `K` at the unit direction `u`
@@ -516,10 +599,13 @@ impl ConvexPair<'_> {
     /// side's segment, each polytope edge) within each side's segment; a
     /// side whose coefficient falls outside it is a rim point's, so the
     /// kink is let go and the direction moved off it towards that rim.
-    fn leave_false_sides(&self, solve: &mut Solve, touches: &[Touch; 2]) -> bool {
+    /// `y` is the supports' difference at `solve.u`, `tops` whether each
+    /// cylinder's support is on its top cap.
+    fn leave_false_sides(&self, solve: &mut Solve, y: &Vector3<f64>, tops: [bool; 2]) -> bool {
         let u = solve.u;
         let flat = |x: Vector3<f64>| x - u * u.dot(&x);
-        let y = flat(touches[0].point - touches[1].point);
+        let y = flat(*y);
+        let axes = self.axes();
         // Each span: the shape whose side it is (2 for an edge), its
         // vector in the tangent plane.
         let mut spans = [(2usize, Vector3::zeros()); 2];
@@ -530,9 +616,9 @@ impl ConvexPair<'_> {
             {
                 // y at the other cap minus y here: A's point moves down
                 // from the top, B's move is subtracted.
-                let down = if touches[k].key == 1 { -1.0 } else { 1.0 };
+                let down = if tops[k] { -1.0 } else { 1.0 };
                 let sign = if k == 0 { down } else { -down };
-                spans[count] = (k, flat(touches[k].axis * (2.0 * h * self.scale * sign)));
+                spans[count] = (k, flat(axes[k] * (2.0 * h * self.scale * sign)));
                 count += 1;
             }
         }
@@ -545,7 +631,7 @@ impl ConvexPair<'_> {
         let Some(alpha) = span_weights(&y, &spans[..count]) else {
             return false;
         };
-        solve.this_top = [touches[0].key == 1, touches[1].key == 1];
+        solve.this_top = tops;
         solve.face_weights = (count == 2 && spans[1].0 == 1).then_some(alpha);
         for (j, &(k, _)) in spans[..count].iter().enumerate() {
             if k == 2 || (-1e-9..=1.0 + 1e-9).contains(&alpha[j]) {
@@ -553,12 +639,11 @@ impl ConvexPair<'_> {
             }
             // Below 0 the nearest end is this cap, above 1 the other: turn
             // towards the one (A's top faces +axis, B's top faces -axis).
-            let this_top = touches[k].key == 1;
-            let toward_top = (alpha[j] < 0.0) == this_top;
+            let toward_top = (alpha[j] < 0.0) == tops[k];
             let facing = if (k == 0) == toward_top { 1.0 } else { -1.0 };
             solve.side[k] = false;
             solve.off_side[k] = true;
-            solve.u = (u + touches[k].axis * (1e-3 * facing)).normalize();
+            solve.u = (u + axes[k] * (1e-3 * facing)).normalize();
             return true;
         }
         false
@@ -595,16 +680,22 @@ impl ConvexPair<'_> {
         added
     }
 
-    /// The seed at the solved direction `solve.u` (unit): the support
-    /// points there, each kink's partners included (at most three pairs),
-    /// with the direction's lower bound, so that the run's first iteration
-    /// certifies without a support search of its own; or the answer itself
-    /// when the supports alone certify it (see [`certify`](Self::certify)).
-    fn seed_at(&self, solve: &Solve, stop_d: f64) -> Closing {
+    /// The seed at the solved direction `solve.u` (unit), from the
+    /// supports there (`a` of A, `b` of B, their difference `support`):
+    /// the support points, each kink's partners included (at most three
+    /// pairs), with the direction's lower bound, so that the run's first
+    /// iteration certifies without a support search of its own; or the
+    /// answer itself when the supports alone certify it (see
+    /// [`certify`](Self::certify)).
+    fn seed_of_supports(
+        &self,
+        solve: &Solve,
+        a: (usize, Vector3<f64>),
+        b: (usize, Vector3<f64>),
+        support: Vertex,
+        stop_d: f64,
+    ) -> Closing {
         let u = solve.u;
-        let d_b = -rotate_back(&self.rotation, &u);
-        let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
-        let support = self.difference_of(a, b);
         let lower = -u.dot(&support.y);
         // Kinks are flat features: there the supports never certify.
         if solve.held.len == 0
@@ -631,9 +722,11 @@ impl ConvexPair<'_> {
             }
             3
         } else {
-            let mut len = 0;
-            for &fb in &b.0[..b.1] {
-                for &fa in &a.0[..a.1] {
+            // The first pair is the support's own.
+            points[0] = support;
+            let mut len = 1;
+            for (j, &fb) in b.0[..b.1].iter().enumerate() {
+                for &fa in &a.0[usize::from(j == 0)..a.1] {
                     if len < 3 {
                         points[len] = self.difference_of(fa, fb);
                         len += 1;

@@ -1,0 +1,361 @@
+//! The seed's solve on the features a warm start names: Newton's method
+//! in closed form.
+//!
+//! Where the features of a pair's answer are known (a cylinder's rim on
+//! one cap or its side, a polytope's vertex or edge), the separation on a
+//! unit direction `u` (see `newton_seed`) is a closed form. A rim of radius
+//! `r` about the unit axis `a` (pair frame) contributes `-r·√(1 - (a·u)²)`
+//! and its cap `∓h·(a·u)`; a polytope's vertex `p`, `±u·p`; a held side
+//! its radius, a constant, on the circle of directions across its axis;
+//! the centroids' gap `u·c`. So
+//! `F(u) = u·m - Σ rᵢ·√(1 - (aᵢ·u)²)`, with one or two rims, and `m` the sum
+//! of the linear terms. Its maximum is found by Newton's method on these
+//! terms alone: on the sphere where no kink is held (two rims, or a rim
+//! and a vertex), on the circle across the held axis where one is (a side
+//! or an edge, with at most one rim; with none the maximum is
+//! `atan2(Q, P)`, no step at all). The general steps compute both
+//! shapes' supports, curvatures, kinks and constraints at every step; these
+//! compute a few dot products.
+//!
+//! The features are the warm start's guess. The supports at the solved
+//! direction must name the same ones (the polytope's vertex, or one of the
+//! held edge's; the rim's cap, away from its axis); otherwise the general
+//! steps start over, from the warm start as before, and only the closed
+//! form's time is lost. The run certifies whatever seed follows.
+
+use nalgebra::Vector3;
+
+use super::newton_seed::{CAP_NEAR, CONVERGED_STEP, Kinks, Solve};
+use super::pair::{ConvexPair, rotate};
+use crate::cylinder;
+
+/// What a warm start names as one shape's part of the answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Feature {
+    /// A cylinder's side: both caps at one angle.
+    Side,
+    /// A cylinder's rim point on the top cap (`true`) or the bottom.
+    Rim(bool),
+    /// One vertex of a polytope.
+    Vertex(u32),
+    /// An edge of a polytope, its vertices held as the shape's kinks.
+    Edge,
+    /// A face of a polytope, three of its vertices held as the shape's
+    /// kinks: the direction is the held one.
+    Face,
+    /// Anything else (a cap's points, a polytope's face): no closed form.
+    Other,
+}
+
+/// Newton steps before the closed form is given up: from a warm start a
+/// step's error squares, so three or four reach f64's precision.
+const FEATURE_STEPS: u32 = 8;
+
+/// The Newton step (radians) below which a Chebyshev step has converged:
+/// its error, of the cube's order, is then below the run's need, as
+/// Newton's is below [`CONVERGED_STEP`].
+const CUBIC_CONVERGED: f64 = 2e-3;
+
+/// The largest step (radians) the closed form takes: a larger one means
+/// the warm start's features no longer hold the answer.
+const LARGEST_STEP: f64 = 0.5;
+
+/// A rim's axis (unit, pair frame) and radius (scaled).
+type Rim = (Vector3<f64>, f64);
+
+impl ConvexPair<'_> {
+    /// The direction that maximises the separation of the supports the
+    /// warm start's `features` name, from `solve.u`: on the sphere when
+    /// `solve` holds no kink, on the circle across its one held axis when
+    /// it holds one; `None` where the features give no closed form or its
+    /// steps do not converge.
+    pub(super) fn feature_optimum(
+        &self,
+        solve: &Solve,
+        features: [Feature; 2],
+    ) -> Option<Vector3<f64>> {
+        // Two kinks fix the direction.
+        if solve.held.len == 2 {
+            return (!features.contains(&Feature::Other)).then_some(solve.u);
+        }
+        // F(u) = -u·a + u·b: A's linear terms subtract, B's add, B's in
+        // the pair frame.
+        let mut linear = self.centroid_gap;
+        let mut rims: [Rim; 2] = [(Vector3::zeros(), 0.0); 2];
+        let mut rim_count = 0;
+        for (k, (shape, feature)) in [self.a, self.b].into_iter().zip(features).enumerate() {
+            let sign = if k == 0 { -self.scale } else { self.scale };
+            let into_pair = |x: Vector3<f64>| {
+                if k == 0 {
+                    x
+                } else {
+                    rotate(&self.rotation, &x)
+                }
+            };
+            match feature {
+                Feature::Side => {}
+                Feature::Edge => {
+                    let kinks = &solve.kinks[k];
+                    if kinks.len != 2 {
+                        return None;
+                    }
+                    linear += into_pair(shape.point(kinks.keys[0] as usize)) * sign;
+                }
+                Feature::Vertex(index) => {
+                    linear += into_pair(shape.point(index as usize)) * sign;
+                }
+                Feature::Rim(top) => {
+                    let (r, h) = shape.cylinder_dimensions()?;
+                    let axis = into_pair(Vector3::z());
+                    let cap = if top { h } else { -h };
+                    linear += axis * (cap * sign);
+                    rims[rim_count] = (axis, r * self.scale);
+                    rim_count += 1;
+                }
+                Feature::Face | Feature::Other => return None,
+            }
+        }
+        let rims = &rims[..rim_count];
+        match (solve.held.len, rims) {
+            // One rim: the maximum lies in the plane of its axis and `m`
+            // (there the gradient `m - r·n` is along `u`), a line.
+            (0, [(axis, r)]) => {
+                let normal = axis.cross(&linear);
+                let e1 = solve.u - normal * (normal.dot(&solve.u) / normal.norm_squared());
+                let e1 = e1 / e1.norm();
+                let e2 = normal.cross(&e1) / normal.norm();
+                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
+                let (cos, sin) = line_newton(p, q, axis.dot(&e1), axis.dot(&e2), *r)?;
+                Some(e1 * cos + e2 * sin)
+            }
+            (0, [_, _]) => sphere_newton(solve.u, &linear, rims),
+            (1, []) => {
+                let e1 = solve.u;
+                let e2 = solve.held.axes[0].cross(&e1);
+                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
+                let norm = p.hypot(q);
+                (p > 0.0 && norm.is_finite()).then(|| e1 * (p / norm) + e2 * (q / norm))
+            }
+            (1, [(axis, r)]) => {
+                let e1 = solve.u;
+                let e2 = solve.held.axes[0].cross(&e1);
+                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
+                let (cos, sin) = line_newton(p, q, axis.dot(&e1), axis.dot(&e2), *r)?;
+                Some(e1 * cos + e2 * sin)
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The maximum of `F(θ) = P·cos θ + Q·sin θ - r·√(1 - g²)`,
+/// `g = g₁·cos θ + g₂·sin θ`, by Chebyshev's method (Newton's with the
+/// third derivative, whose error cubes where Newton's squares) from
+/// `θ = 0`, as `(cos θ, sin θ)`; `None` where it is not concave (the
+/// features are wrong), a step is too large, the direction comes near the
+/// rim's axis or the steps do not converge.
+///
+/// With `g' = g₂·cos θ - g₁·sin θ`, `S = √(1 - g²)` and `L` the linear
+/// part (`L''' = -L'`, `L'' = -L`):
+/// `F' = L' + r·g·g'/S`,
+/// `F'' = -L + r·((g'² - g²) + g²·g'²/S²)/S`,
+/// `F''' = -L' - r·(4·g·g'/S - 3·g·g'·(g'² - g²)/S³ - 3·g³·g'³/S⁵)`.
+/// The step is `N - F'''·N²/(2·F'')`, `N = -F'/F''` Newton's. It turns the
+/// direction to `(u + δ·u')/√(1 + δ²)`, by `atan δ`: the difference is of
+/// `δ³`'s order and is taken up by the next step.
+#[inline(always)]
+fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
+    let (mut cos, mut sin) = (1.0f64, 0.0f64);
+    for _ in 0..FEATURE_STEPS {
+        let g = g1 * cos + g2 * sin;
+        let turn = g2 * cos - g1 * sin;
+        let across = 1.0 - g * g;
+        if across.is_nan() || across < CAP_NEAR * CAP_NEAR {
+            return None;
+        }
+        let inv = 1.0 / across;
+        let root = across.sqrt();
+        let inv_root = root * inv;
+        let (gt, spread) = (g * turn, turn * turn - g * g);
+        let linear_slope = q * cos - p * sin;
+        let slope = linear_slope + r * gt * inv_root;
+        let bend = -(p * cos + q * sin) + r * (spread + gt * gt * inv) * inv_root;
+        let third = -linear_slope
+            - r * gt * inv_root * (4.0 - inv * (3.0 * spread + 3.0 * g * g * turn * turn * inv));
+        if bend.is_nan() || bend >= 0.0 {
+            return None;
+        }
+        let newton = -slope / bend;
+        let step = newton - third * newton * newton / (2.0 * bend);
+        if step.is_nan() || step.abs() > LARGEST_STEP {
+            return None;
+        }
+        let k = 1.0 / (1.0 + step * step).sqrt();
+        (cos, sin) = ((cos - sin * step) * k, (sin + cos * step) * k);
+        if newton.abs() < CUBIC_CONVERGED {
+            return Some((cos, sin));
+        }
+    }
+    None
+}
+
+/// The maximum of `F(u) = u·m - Σ rᵢ·√(1 - (aᵢ·u)²)` on the unit sphere
+/// (one or two rims), by Newton's method from the unit `u`.
+///
+/// On the sphere the gradient is `g = ∇ - F·u`, `∇ = m - Σ rᵢ·nᵢ` (`nᵢ` the
+/// rim's unit radial direction at `u`), and the Hessian
+/// `-(F + Σ kᵢ·tᵢ·tᵢᵀ)` across `u`, `tᵢ = aᵢ × nᵢ` the rim's tangent
+/// (perpendicular to `u` already) and `kᵢ = rᵢ / √(1 - (aᵢ·u)²)`; the step
+/// solves `(F + Σ kᵢ·tᵢ·tᵢᵀ)·ξ = g` by the Woodbury identity as the
+/// general step does. `None` where the separation is not positive, a step
+/// is too large, the direction comes near a rim's axis or the steps do not
+/// converge.
+#[inline(always)]
+fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<Vector3<f64>> {
+    for _ in 0..FEATURE_STEPS {
+        let mut grad = *m;
+        let mut tangents = [Vector3::zeros(); 2];
+        let mut curvatures = [0.0; 2];
+        for (i, (axis, r)) in rims.iter().enumerate() {
+            let along = axis.dot(&u);
+            let across = 1.0 - along * along;
+            if across.is_nan() || across < CAP_NEAR * CAP_NEAR {
+                return None;
+            }
+            let inv = 1.0 / across.sqrt();
+            let radial = (u - axis * along) * inv;
+            grad -= radial * *r;
+            tangents[i] = axis.cross(&radial);
+            curvatures[i] = r * inv;
+        }
+        let f = u.dot(&grad);
+        if !(f > 0.0 && f.is_finite()) {
+            return None;
+        }
+        let g = grad - u * f;
+        let [t1, t2] = tangents;
+        let [k1, k2] = curvatures;
+        let (p11, p12, p22) = (t1.dot(&t1), t1.dot(&t2), t2.dot(&t2));
+        let (m11, m12, m21, m22) = (f + k1 * p11, k2 * p12, k1 * p12, f + k2 * p22);
+        let (r1, r2) = (t1.dot(&g), t2.dot(&g));
+        let det = m11 * m22 - m12 * m21;
+        let (a1, a2) = ((r1 * m22 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det);
+        let step = (g - t1 * (k1 * a1) - t2 * (k2 * a2)) / f;
+        let squared = step.norm_squared();
+        if squared.is_nan() || squared > LARGEST_STEP * LARGEST_STEP {
+            return None;
+        }
+        u = (u + step).normalize();
+        if squared < CONVERGED_STEP * CONVERGED_STEP {
+            return Some(u);
+        }
+    }
+    None
+}
+
+/// Whether the supports at the solved direction name the features the
+/// closed form assumed: each shape's support index (a cylinder's code) and
+/// the unit body direction it was taken at, against its feature: the
+/// vertex, one of the held edge's or face's, the rim's cap away from its
+/// axis.
+pub(super) fn features_hold(
+    kinks: &[Kinks; 2],
+    supports: [(usize, Vector3<f64>); 2],
+    features: [Feature; 2],
+) -> bool {
+    supports
+        .into_iter()
+        .zip(features)
+        .zip(kinks)
+        .all(|(((index, d), feature), kinks)| {
+            let key = index as u32;
+            match feature {
+                Feature::Side => true,
+                Feature::Edge | Feature::Face => kinks.has(key),
+                Feature::Vertex(vertex) => key == vertex,
+                Feature::Rim(top) => {
+                    cylinder::is_top(key) == top && d.x * d.x + d.y * d.y >= CAP_NEAR * CAP_NEAR
+                }
+                Feature::Other => false,
+            }
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::{line_newton, sphere_newton};
+
+    /// The line's maximum against a fine scan of the same `F`, and its
+    /// derivative there.
+    #[test]
+    fn line_newton_finds_the_scanned_maximum() {
+        let f = |p: f64, q: f64, g1: f64, g2: f64, r: f64, t: f64| {
+            let g = g1 * t.cos() + g2 * t.sin();
+            p * t.cos() + q * t.sin() - r * (1.0 - g * g).sqrt()
+        };
+        for (p, q, g1, g2, r) in [
+            (1.5, 0.01, 0.3, 0.2, 0.5),
+            (2.0, -0.02, -0.6, 0.1, 0.3),
+            (1.0, 0.002, 0.0, 0.5, 0.8),
+        ] {
+            let (cos, sin) = line_newton(p, q, g1, g2, r).expect("converges");
+            let best = sin.atan2(cos);
+            let scanned = (-20_000..=20_000)
+                .map(|k| f64::from(k) * 1e-5)
+                .max_by(|x, y| f(p, q, g1, g2, r, *x).total_cmp(&f(p, q, g1, g2, r, *y)))
+                .unwrap();
+            assert!((best - scanned).abs() < 2e-5, "{best} vs {scanned}");
+            let h = 1e-6;
+            let slope = (f(p, q, g1, g2, r, best + h) - f(p, q, g1, g2, r, best - h)) / (2.0 * h);
+            assert!(slope.abs() < 1e-8, "{slope}");
+            assert!((cos.hypot(sin) - 1.0).abs() < 1e-15);
+        }
+    }
+
+    /// The sphere's maximum is stationary: no small turn of the solved
+    /// direction raises `F`, for one rim and for two.
+    #[test]
+    fn sphere_newton_finds_a_stationary_maximum() {
+        let f = |u: &Vector3<f64>, m: &Vector3<f64>, rims: &[(Vector3<f64>, f64)]| {
+            let u = u.normalize();
+            u.dot(m)
+                - rims
+                    .iter()
+                    .map(|(a, r)| r * (1.0 - a.dot(&u).powi(2)).sqrt())
+                    .sum::<f64>()
+        };
+        let cases = [
+            (
+                Vector3::new(2.0, 0.3, 0.1),
+                vec![(Vector3::new(0.2, 0.9, 0.3).normalize(), 0.5)],
+            ),
+            (
+                Vector3::new(1.6, -0.4, 0.5),
+                vec![
+                    (Vector3::z(), 0.5),
+                    (Vector3::new(0.5, 0.3, 0.8).normalize(), 0.3),
+                ],
+            ),
+        ];
+        for (m, rims) in cases {
+            // A start a tenth of a radian or so off, as a warm start's.
+            let start = (m.normalize() + Vector3::new(0.02, 0.05, -0.03)).normalize();
+            let u = sphere_newton(start, &m, &rims).expect("converges");
+            assert!((u.norm() - 1.0).abs() < 1e-15);
+            let best = f(&u, &m, &rims);
+            let across = [
+                u.cross(&Vector3::x()).normalize(),
+                u.cross(&Vector3::y()).normalize(),
+            ];
+            for e in across {
+                for h in [1e-4, -1e-4, 1e-3, -1e-3] {
+                    assert!(f(&(u + e * h), &m, &rims) <= best + 1e-15, "{h}");
+                }
+                let slope = (f(&(u + e * 1e-6), &m, &rims) - f(&(u - e * 1e-6), &m, &rims)) / 2e-6;
+                assert!(slope.abs() < 1e-8, "{slope}");
+            }
+        }
+    }
+}

@@ -25,7 +25,7 @@
 
 use nalgebra::Vector3;
 
-use super::newton_seed::{CAP_NEAR, CONVERGED_STEP, Kinks, Solve};
+use super::newton_seed::{CONVERGED_STEP, Kinks, Solve};
 use super::pair::{ConvexPair, rotate};
 use crate::cylinder;
 
@@ -46,6 +46,11 @@ pub(super) enum Feature {
     /// Anything else (a cap's points, a polytope's face): no closed form.
     Other,
 }
+
+/// The sine of the angle to a rim's axis below which the closed form is
+/// not tried: nearer, a cap may hold the answer (see `cap_seed`), and the
+/// rim's curvature `r / sin` outgrows the steps' model.
+const RIM_FLOOR: f64 = 0.05;
 
 /// Newton steps before the closed form is given up: from a warm start a
 /// step's error squares, so three or four reach f64's precision.
@@ -170,7 +175,7 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
         let g = g1 * cos + g2 * sin;
         let turn = g2 * cos - g1 * sin;
         let across = 1.0 - g * g;
-        if across.is_nan() || across < CAP_NEAR * CAP_NEAR {
+        if across.is_nan() || across < RIM_FLOOR * RIM_FLOOR {
             return None;
         }
         let inv = 1.0 / across;
@@ -185,18 +190,34 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
         if bend.is_nan() || bend >= 0.0 {
             return None;
         }
-        let newton = -slope / bend;
-        let step = newton - third * newton * newton / (2.0 * bend);
+        let inv_bend = 1.0 / bend;
+        let newton = -slope * inv_bend;
+        let step = newton - 0.5 * third * newton * newton * inv_bend;
         if step.is_nan() || step.abs() > LARGEST_STEP {
             return None;
         }
-        let k = 1.0 / (1.0 + step * step).sqrt();
+        let k = inverse_hypot_one(step * step);
         (cos, sin) = ((cos - sin * step) * k, (sin + cos * step) * k);
         if newton.abs() < CUBIC_CONVERGED {
             return Some((cos, sin));
         }
     }
     None
+}
+
+/// `1 / √(1 + x2)`, the length's inverse of a unit vector plus a step of
+/// squared length `x2` across it: for a small step (a warm start's) by
+/// its series, exact to f64's precision, which spares a square root and a
+/// division on the steps' critical path.
+#[inline(always)]
+fn inverse_hypot_one(x2: f64) -> f64 {
+    if x2 < 1e-4 {
+        // 1 - x²/2 + 3x⁴/8 - 5x⁶/16 + 35x⁸/128: the next term, 63x¹⁰/256,
+        // is below 2.5e-21 here.
+        1.0 - x2 * (0.5 - x2 * (0.375 - x2 * (0.3125 - x2 * 0.2734375)))
+    } else {
+        1.0 / (1.0 + x2).sqrt()
+    }
 }
 
 /// The maximum of `F(u) = u·m - Σ rᵢ·√(1 - (aᵢ·u)²)` on the unit sphere
@@ -219,10 +240,12 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
         for (i, (axis, r)) in rims.iter().enumerate() {
             let along = axis.dot(&u);
             let across = 1.0 - along * along;
-            if across.is_nan() || across < CAP_NEAR * CAP_NEAR {
+            if across.is_nan() || across < RIM_FLOOR * RIM_FLOOR {
                 return None;
             }
-            let inv = 1.0 / across.sqrt();
+            // A square root and a division side by side, not one after
+            // the other.
+            let inv = across.sqrt() * (1.0 / across);
             let radial = (u - axis * along) * inv;
             grad -= radial * *r;
             tangents[i] = axis.cross(&radial);
@@ -238,14 +261,19 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
         let (p11, p12, p22) = (t1.dot(&t1), t1.dot(&t2), t2.dot(&t2));
         let (m11, m12, m21, m22) = (f + k1 * p11, k2 * p12, k1 * p12, f + k2 * p22);
         let (r1, r2) = (t1.dot(&g), t2.dot(&g));
-        let det = m11 * m22 - m12 * m21;
-        let (a1, a2) = ((r1 * m22 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det);
-        let step = (g - t1 * (k1 * a1) - t2 * (k2 * a2)) / f;
+        let inv_f = 1.0 / f;
+        let inv_det = 1.0 / (m11 * m22 - m12 * m21);
+        let (a1, a2) = (
+            (r1 * m22 - m12 * r2) * inv_det,
+            (m11 * r2 - m21 * r1) * inv_det,
+        );
+        let step = (g - t1 * (k1 * a1) - t2 * (k2 * a2)) * inv_f;
         let squared = step.norm_squared();
         if squared.is_nan() || squared > LARGEST_STEP * LARGEST_STEP {
             return None;
         }
-        u = (u + step).normalize();
+        // `step` is across `u`: the sum's length is `√(1 + |step|²)`.
+        u = (u + step) * inverse_hypot_one(squared);
         if squared < CONVERGED_STEP * CONVERGED_STEP {
             return Some(u);
         }
@@ -274,7 +302,7 @@ pub(super) fn features_hold(
                 Feature::Edge | Feature::Face => kinks.has(key),
                 Feature::Vertex(vertex) => key == vertex,
                 Feature::Rim(top) => {
-                    cylinder::is_top(key) == top && d.x * d.x + d.y * d.y >= CAP_NEAR * CAP_NEAR
+                    cylinder::is_top(key) == top && d.x * d.x + d.y * d.y >= RIM_FLOOR * RIM_FLOOR
                 }
                 Feature::Other => false,
             }
@@ -285,7 +313,22 @@ pub(super) fn features_hold(
 mod tests {
     use nalgebra::Vector3;
 
-    use super::{line_newton, sphere_newton};
+    use super::{inverse_hypot_one, line_newton, sphere_newton};
+
+    /// The series agrees with the closed form to an ulp or two on both
+    /// sides of its switch.
+    #[test]
+    fn inverse_hypot_one_matches_the_closed_form() {
+        for x in [
+            0.0f64, 1e-9, -3e-5, 1e-3, 4e-3, -9.99e-3, 1.001e-2, 0.3, -0.5,
+        ] {
+            let exact = 1.0 / (1.0 + x * x).sqrt();
+            assert!(
+                (inverse_hypot_one(x * x) - exact).abs() <= 2.0 * f64::EPSILON,
+                "{x}"
+            );
+        }
+    }
 
     /// The line's maximum against a fine scan of the same `F`, and its
     /// derivative there.

@@ -341,10 +341,16 @@ impl ConvexPair<'_> {
         if let Some(seed) = self.warm_cap_seed(pairs) {
             return Some(Seeding::Start(seed));
         }
-        let mut mean = Vector3::zeros();
-        for &[ia, ib] in pairs {
-            mean += self.difference_vertex(ia as usize, ib as usize).y;
-        }
+        // The mean of the pairs' points at the new pose, each shape's
+        // averaged first: one rotation, and each distinct point decoded
+        // once.
+        let share = 1.0 / pairs.len() as f64;
+        let mean = self
+            .difference_of(
+                (0, point_sum(self.a, pairs, 0) * share),
+                (0, point_sum(self.b, pairs, 1) * share),
+            )
+            .y;
         let mut solve = Solve::default();
         let mut features = [Feature::Other; 2];
         for (k, shape) in [self.a, self.b].into_iter().enumerate() {
@@ -385,9 +391,8 @@ impl ConvexPair<'_> {
         if !mean.iter().all(|x| x.is_finite()) {
             return None;
         }
-        let axes = [Vector3::z(), rotate(&self.rotation, &Vector3::z())];
         let mut held = Constraints::default();
-        for (side, axis) in solve.side.iter().zip(axes) {
+        for (side, axis) in solve.side.iter().zip(self.axes()) {
             if *side {
                 held.add_axis(axis);
             }
@@ -834,6 +839,29 @@ impl ConvexPair<'_> {
             lower: 0.0,
         }
     }
+}
+
+/// The sum of `shape`'s points named by the pairs (`k`: 0 for A's
+/// index, 1 for B's), a point repeated from the pair before, or its other
+/// cap's, not decoded again.
+#[inline(always)]
+fn point_sum(shape: &Convex, pairs: &[[u32; 2]], k: usize) -> Vector3<f64> {
+    let cylinder = shape.cylinder_dimensions().is_some();
+    let mut sum = Vector3::zeros();
+    let mut last: Option<(u32, Vector3<f64>)> = None;
+    for pair in pairs {
+        let index = pair[k];
+        let point = match last {
+            Some((seen, point)) if seen == index => point,
+            Some((seen, point)) if cylinder && seen == cylinder::other_cap(index) => {
+                Vector3::new(point.x, point.y, -point.z)
+            }
+            _ => shape.point(index as usize),
+        };
+        last = Some((index, point));
+        sum += point;
+    }
+    sum
 }
 
 /// Whether the point `y` of `K`, with `F = -u·y` at the unit `u`, is within

@@ -25,7 +25,7 @@
 
 use nalgebra::Vector3;
 
-use super::newton_seed::{CONVERGED_STEP, Kinks, Solve};
+use super::newton_seed::{Kinks, Solve};
 use super::pair::{ConvexPair, rotate};
 use crate::cylinder;
 
@@ -58,7 +58,7 @@ const FEATURE_STEPS: u32 = 8;
 
 /// The Newton step (radians) below which a Chebyshev step has converged:
 /// its error, of the cube's order, is then below the run's need, as
-/// Newton's is below [`CONVERGED_STEP`].
+/// Newton's is below the general steps' converged step.
 const CUBIC_CONVERGED: f64 = 2e-3;
 
 /// The largest step (radians) the closed form takes: a larger one means
@@ -165,9 +165,7 @@ impl ConvexPair<'_> {
 /// `F' = L' + r·g·g'/S`,
 /// `F'' = -L + r·((g'² - g²) + g²·g'²/S²)/S`,
 /// `F''' = -L' - r·(4·g·g'/S - 3·g·g'·(g'² - g²)/S³ - 3·g³·g'³/S⁵)`.
-/// The step is `N - F'''·N²/(2·F'')`, `N = -F'/F''` Newton's. It turns the
-/// direction to `(u + δ·u')/√(1 + δ²)`, by `atan δ`: the difference is of
-/// `δ³`'s order and is taken up by the next step.
+/// The step is `N - F'''·N²/(2·F'')`, `N = -F'/F''` Newton's.
 #[inline(always)]
 fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
     let (mut cos, mut sin) = (1.0f64, 0.0f64);
@@ -196,8 +194,11 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
         if step.is_nan() || step.abs() > LARGEST_STEP {
             return None;
         }
-        let k = inverse_hypot_one(step * step);
-        (cos, sin) = ((cos - sin * step) * k, (sin + cos * step) * k);
+        // The turn by `step` radians: `tan(step)` along the tangent, to
+        // the cube's order, then back onto the circle.
+        let along = step * (1.0 + step * step * (1.0 / 3.0));
+        let k = inverse_hypot_one(along * along);
+        (cos, sin) = ((cos - sin * along) * k, (sin + cos * along) * k);
         if newton.abs() < CUBIC_CONVERGED {
             return Some((cos, sin));
         }
@@ -221,22 +222,37 @@ fn inverse_hypot_one(x2: f64) -> f64 {
 }
 
 /// The maximum of `F(u) = u·m - Σ rᵢ·√(1 - (aᵢ·u)²)` on the unit sphere
-/// (one or two rims), by Newton's method from the unit `u`.
+/// (one or two rims), by Chebyshev's method from the unit `u`.
 ///
-/// On the sphere the gradient is `g = ∇ - F·u`, `∇ = m - Σ rᵢ·nᵢ` (`nᵢ` the
-/// rim's unit radial direction at `u`), and the Hessian
-/// `-(F + Σ kᵢ·tᵢ·tᵢᵀ)` across `u`, `tᵢ = aᵢ × nᵢ` the rim's tangent
-/// (perpendicular to `u` already) and `kᵢ = rᵢ / √(1 - (aᵢ·u)²)`; the step
-/// solves `(F + Σ kᵢ·tᵢ·tᵢᵀ)·ξ = g` by the Woodbury identity as the
-/// general step does. `None` where the separation is not positive, a step
-/// is too large, the direction comes near a rim's axis or the steps do not
-/// converge.
+/// The steps are taken in the plane tangent at `u`: `ξ` there is the
+/// direction `(u + ξ)/√(1 + |ξ|²)`, where `F` is
+/// `Ψ(ξ) = G(u + ξ)/√(1 + |ξ|²)`, `G(x) = x·m - Σ rᵢ·|Pᵢ·x|` its
+/// 1-homogeneous extension (`Pᵢ` the projection across the axis). With
+/// `nᵢ` the rim's unit radial direction at `u`, `tᵢ = aᵢ × nᵢ` its tangent
+/// (across `u` already), `Sᵢ = √(1 - (aᵢ·u)²)` and `kᵢ = rᵢ/Sᵢ`:
+/// - the gradient is `g = ∇G - F·u`, `∇G = m - Σ rᵢ·nᵢ`;
+/// - the Hessian is `-(F + Σ kᵢ·tᵢ·tᵢᵀ)`, and Newton's step `N` solves
+///   `(F + Σ kᵢ·tᵢ·tᵢᵀ)·N = g` by the Woodbury identity, as the general
+///   step does;
+/// - the cubic terms' gradient at `N` is
+///   `C = ½·T[N, N] - (g·N)·N - ½·|N|²·g`, the last two from the
+///   chart's `1/√(1 + |ξ|²)`, and
+///   `T[w, w] = Σ (rᵢ/Sᵢ²)·((tᵢ·w)²·nᵢ + 2·(nᵢ·w)·(tᵢ·w)·tᵢ)`, the second
+///   derivative of `-rᵢ·nᵢ(x)` along `w`, taken across `u`.
+///
+/// Chebyshev's step is `N + (F + Σ kᵢ·tᵢ·tᵢᵀ)⁻¹·C`: the same system, no
+/// square root or division more, and an error of `N³`'s order, where
+/// Newton's is of `N²`'s. `None` where the separation is not positive, a
+/// step is too large, the direction comes near a rim's axis or the steps
+/// do not converge.
 #[inline(always)]
 fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<Vector3<f64>> {
     for _ in 0..FEATURE_STEPS {
         let mut grad = *m;
+        let mut radials = [Vector3::zeros(); 2];
         let mut tangents = [Vector3::zeros(); 2];
         let mut curvatures = [0.0; 2];
+        let mut inverses = [0.0; 2];
         for (i, (axis, r)) in rims.iter().enumerate() {
             let along = axis.dot(&u);
             let across = 1.0 - along * along;
@@ -248,8 +264,10 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
             let inv = across.sqrt() * (1.0 / across);
             let radial = (u - axis * along) * inv;
             grad -= radial * *r;
+            radials[i] = radial;
             tangents[i] = axis.cross(&radial);
             curvatures[i] = r * inv;
+            inverses[i] = inv;
         }
         let f = u.dot(&grad);
         if !(f > 0.0 && f.is_finite()) {
@@ -260,54 +278,84 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
         let [k1, k2] = curvatures;
         let (p11, p12, p22) = (t1.dot(&t1), t1.dot(&t2), t2.dot(&t2));
         let (m11, m12, m21, m22) = (f + k1 * p11, k2 * p12, k1 * p12, f + k2 * p22);
-        let (r1, r2) = (t1.dot(&g), t2.dot(&g));
         let inv_f = 1.0 / f;
         let inv_det = 1.0 / (m11 * m22 - m12 * m21);
-        let (a1, a2) = (
-            (r1 * m22 - m12 * r2) * inv_det,
-            (m11 * r2 - m21 * r1) * inv_det,
-        );
-        let step = (g - t1 * (k1 * a1) - t2 * (k2 * a2)) * inv_f;
-        let squared = step.norm_squared();
+        let solve = |rhs: &Vector3<f64>| {
+            let (r1, r2) = (t1.dot(rhs), t2.dot(rhs));
+            let (a1, a2) = (
+                (r1 * m22 - m12 * r2) * inv_det,
+                (m11 * r2 - m21 * r1) * inv_det,
+            );
+            (rhs - t1 * (k1 * a1) - t2 * (k2 * a2)) * inv_f
+        };
+        let newton = solve(&g);
+        let squared = newton.norm_squared();
         if squared.is_nan() || squared > LARGEST_STEP * LARGEST_STEP {
             return None;
         }
+        let mut cubic = newton * -g.dot(&newton) - g * (0.5 * squared);
+        for (i, (_, r)) in rims.iter().enumerate() {
+            let (t, n) = (tangents[i], radials[i]);
+            let (tw, nw) = (t.dot(&newton), n.dot(&newton));
+            let weight = 0.5 * r * inverses[i] * inverses[i];
+            let across_n = n - u * u.dot(&n);
+            cubic += (across_n * (tw * tw) + t * (2.0 * nw * tw)) * weight;
+        }
+        let step = newton + solve(&cubic);
         // `step` is across `u`: the sum's length is `√(1 + |step|²)`.
-        u = (u + step) * inverse_hypot_one(squared);
-        if squared < CONVERGED_STEP * CONVERGED_STEP {
+        u = (u + step) * inverse_hypot_one(step.norm_squared());
+        if squared < CUBIC_CONVERGED * CUBIC_CONVERGED {
             return Some(u);
         }
     }
     None
 }
 
-/// Whether the supports at the solved direction name the features the
-/// closed form assumed: each shape's support index (a cylinder's code) and
-/// the unit body direction it was taken at, against its feature: the
-/// vertex, one of the held edge's or face's, the rim's cap away from its
-/// axis.
-pub(super) fn features_hold(
-    kinks: &[Kinks; 2],
-    supports: [(usize, Vector3<f64>); 2],
-    features: [Feature; 2],
-) -> bool {
-    supports
-        .into_iter()
-        .zip(features)
-        .zip(kinks)
-        .all(|(((index, d), feature), kinks)| {
-            let key = index as u32;
-            match feature {
-                Feature::Side => true,
-                Feature::Edge | Feature::Face => kinks.has(key),
-                Feature::Vertex(vertex) => key == vertex,
-                Feature::Rim(top) => {
-                    cylinder::is_top(key) == top && d.x * d.x + d.y * d.y >= RIM_FLOOR * RIM_FLOOR
+impl ConvexPair<'_> {
+    /// Whether the supports at the solved direction name the features the
+    /// closed form assumed: each shape's support index (a cylinder's code)
+    /// and the unit body direction it was taken at, against its feature:
+    /// the vertex, one of the held edge's, a vertex of the held face (its
+    /// fourth ties with the three held, and round-off picks among them),
+    /// the rim's cap away from its axis.
+    pub(super) fn features_hold(
+        &self,
+        kinks: &[Kinks; 2],
+        supports: [(usize, Vector3<f64>); 2],
+        features: [Feature; 2],
+    ) -> bool {
+        [self.a, self.b]
+            .into_iter()
+            .zip(supports)
+            .zip(features)
+            .zip(kinks)
+            .all(|(((shape, (index, d)), feature), kinks)| {
+                let key = index as u32;
+                match feature {
+                    Feature::Side => true,
+                    Feature::Edge => kinks.has(key),
+                    Feature::Face => {
+                        kinks.has(key) || {
+                            let rise = shape.point(index) - shape.point(kinks.keys[0] as usize);
+                            d.dot(&rise).abs() <= FACE_TIE * rise.norm()
+                        }
+                    }
+                    Feature::Vertex(vertex) => key == vertex,
+                    Feature::Rim(top) => {
+                        cylinder::is_top(key) == top
+                            && d.x * d.x + d.y * d.y >= RIM_FLOOR * RIM_FLOOR
+                    }
+                    Feature::Other => false,
                 }
-                Feature::Other => false,
-            }
-        })
+            })
+    }
 }
+
+/// How far (in radians) from perpendicular to a held face's direction a
+/// vertex's offset from the face may be and the vertex still count as the
+/// face's: round-off of the held direction, far below any other face's
+/// angle.
+const FACE_TIE: f64 = 1e-9;
 
 #[cfg(test)]
 mod tests {

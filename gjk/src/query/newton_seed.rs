@@ -35,7 +35,7 @@
 
 use nalgebra::Vector3;
 
-use super::feature_seed::{Feature, features_hold};
+use super::feature_seed::Feature;
 use super::pair::{ConvexPair, rotate, rotate_back};
 use crate::cylinder;
 use crate::johnson::{Vertex, triangle_weights};
@@ -554,7 +554,7 @@ impl ConvexPair<'_> {
         let d_b = -rotate_back(&self.rotation, &u);
         let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
         if let Some(features) = features
-            && !features_hold(&solve.kinks, [(a.0, u), (b.0, d_b)], features)
+            && !self.features_hold(&solve.kinks, [(a.0, u), (b.0, d_b)], features)
         {
             return Close::Mismatch;
         }

@@ -320,7 +320,7 @@ impl ConvexPair<'_> {
             return None;
         }
         self.solve_from(
-            Solve {
+            &mut Solve {
                 u: -v / norm,
                 ..Solve::default()
             },
@@ -404,7 +404,7 @@ impl ConvexPair<'_> {
         // needed.
         solve.u = held.project(&-mean)?;
         solve.held = held;
-        self.solve_from(solve, stop_d, Some(features))
+        self.solve_from(&mut solve, stop_d, Some(features))
     }
 
     /// The cap seed (see `cap_seed`) of each cylinder whose `rho` is below
@@ -465,16 +465,16 @@ impl ConvexPair<'_> {
     /// `feature_seed`).
     fn solve_from(
         &self,
-        mut solve: Solve,
+        solve: &mut Solve,
         stop_d: f64,
         features: Option<[Feature; 2]>,
     ) -> Option<Seeding> {
         if let Some(features) = features
-            && let Some(u) = self.feature_optimum(&solve, features)
+            && let Some(u) = self.feature_optimum(solve, features)
         {
             let start = solve.u;
             solve.u = u;
-            match self.close_at(&mut solve, stop_d, Some(features)) {
+            match self.close_at(solve, stop_d, Some(features)) {
                 Close::Done(seeding) => return Some(seeding),
                 Close::Reopened => {}
                 Close::Failed => return None,
@@ -511,7 +511,7 @@ impl ConvexPair<'_> {
                 return Some(seed);
             }
             if let Some(previous) = last
-                && self.note_vertex_kinks(&mut solve, &previous, &touches)
+                && self.note_vertex_kinks(solve, &previous, &touches)
             {
                 solve.held = solve.constraints(&self.axes());
                 solve.u = solve.held.project(&solve.u)?;
@@ -520,7 +520,7 @@ impl ConvexPair<'_> {
             }
             last = Some(touches);
             let mut step = newton_step(&solve.u, &solve.held, &touches)?;
-            let landed = stop_at_side(&mut solve, &touches, &mut step);
+            let landed = stop_at_side(solve, &touches, &mut step);
             if landed {
                 solve.held = solve.constraints(&self.axes());
             }
@@ -535,7 +535,7 @@ impl ConvexPair<'_> {
             if !converged {
                 continue;
             }
-            match self.close_at(&mut solve, stop_d, None) {
+            match self.close_at(solve, stop_d, None) {
                 Close::Done(seeding) => return Some(seeding),
                 Close::Reopened | Close::Mismatch => last = None,
                 Close::Failed => return None,

@@ -345,12 +345,9 @@ impl ConvexPair<'_> {
         // averaged first: one rotation, and each distinct point decoded
         // once.
         let share = 1.0 / pairs.len() as f64;
-        let mean = self
-            .difference_of(
-                (0, point_sum(self.a, pairs, 0) * share),
-                (0, point_sum(self.b, pairs, 1) * share),
-            )
-            .y;
+        let (sum_a, first_a) = point_sum(self.a, pairs, 0);
+        let (sum_b, first_b) = point_sum(self.b, pairs, 1);
+        let mean = self.difference_of((0, sum_a * share), (0, sum_b * share)).y;
         let mut solve = Solve::default();
         let mut features = [Feature::Other; 2];
         for (k, shape) in [self.a, self.b].into_iter().enumerate() {
@@ -400,11 +397,50 @@ impl ConvexPair<'_> {
         for edge in &solve.edges[..solve.edge_count] {
             held.add(*edge);
         }
-        // Projected first and normalised once: the mean's length is not
+        let guess = self.last_direction(&solve, features, [first_a, first_b], &mean);
+        // Projected first and normalised once: the guess's length is not
         // needed.
-        solve.u = held.project(&-mean)?;
+        solve.u = held.project(&guess)?;
         solve.held = held;
         self.solve_from(&mut solve, stop_d, Some(features))
+    }
+
+    /// Where the answer's direction (unnormalised) was at the pose the warm
+    /// start's `features` come from, as far as they tell, in the pair frame:
+    /// a held side's rim direction is that direction (A's support
+    /// direction is `u`, B's `-u`); a rim's lies in the plane of its axis
+    /// and rim direction, which a held edge cuts to a line. Otherwise the
+    /// direction of the mean of the warm start's points (`mean`) at the new
+    /// pose. Along a motion the nearest points slide: the mean's direction
+    /// turns by their slide over their distance, the features' by the
+    /// slide over the curvatures' radii, far less where the shapes are
+    /// near. `first` holds each shape's first warm point (body frame).
+    fn last_direction(
+        &self,
+        solve: &Solve,
+        features: [Feature; 2],
+        first: [Vector3<f64>; 2],
+        mean: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let radial = |k: usize| {
+            let flat = Vector3::new(first[k].x, first[k].y, 0.0);
+            if k == 0 {
+                flat
+            } else {
+                rotate(&self.rotation, &flat)
+            }
+        };
+        let rim_plane = |k: usize| self.axes()[k].cross(&radial(k));
+        match features {
+            [Feature::Side, _] => radial(0),
+            [_, Feature::Side] => -radial(1),
+            [Feature::Rim(_), Feature::Edge] | [Feature::Edge, Feature::Rim(_)] => {
+                let k = usize::from(features[1] != Feature::Edge);
+                let line = rim_plane(k).cross(&solve.edges[0]);
+                if line.dot(mean) > 0.0 { -line } else { line }
+            }
+            _ => -mean,
+        }
     }
 
     /// The cap seed (see `cap_seed`) of each cylinder whose `rho` is below
@@ -843,11 +879,12 @@ impl ConvexPair<'_> {
 
 /// The sum of `shape`'s points named by the pairs (`k`: 0 for A's
 /// index, 1 for B's), a point repeated from the pair before, or its other
-/// cap's, not decoded again.
+/// cap's, not decoded again; and the first of them.
 #[inline(always)]
-fn point_sum(shape: &Convex, pairs: &[[u32; 2]], k: usize) -> Vector3<f64> {
+fn point_sum(shape: &Convex, pairs: &[[u32; 2]], k: usize) -> (Vector3<f64>, Vector3<f64>) {
     let cylinder = shape.cylinder_dimensions().is_some();
     let mut sum = Vector3::zeros();
+    let mut first = None;
     let mut last: Option<(u32, Vector3<f64>)> = None;
     for pair in pairs {
         let index = pair[k];
@@ -859,9 +896,10 @@ fn point_sum(shape: &Convex, pairs: &[[u32; 2]], k: usize) -> Vector3<f64> {
             _ => shape.point(index as usize),
         };
         last = Some((index, point));
+        first.get_or_insert(point);
         sum += point;
     }
-    sum
+    (sum, first.unwrap_or_default())
 }
 
 /// Whether the point `y` of `K`, with `F = -u·y` at the unit `u`, is within

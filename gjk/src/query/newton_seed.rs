@@ -409,9 +409,9 @@ impl ConvexPair<'_> {
     /// start's `features` come from, as far as they tell, in the pair frame:
     /// a held side's rim direction is that direction (A's support
     /// direction is `u`, B's `-u`); a rim's lies in the plane of its axis
-    /// and rim direction, which a held edge cuts to a line. Otherwise the
-    /// direction of the mean of the warm start's points (`mean`) at the new
-    /// pose. Along a motion the nearest points slide: the mean's direction
+    /// and rim direction, which a held edge cuts to a line, and into which
+    /// two rims move the direction of the mean of the warm start's points
+    /// (`mean`) at the new pose. Otherwise the mean's direction. Along a motion the nearest points slide: the mean's direction
     /// turns by their slide over their distance, the features' by the
     /// slide over the curvatures' radii, far less where the shapes are
     /// near. `first` holds each shape's first warm point (body frame).
@@ -438,6 +438,13 @@ impl ConvexPair<'_> {
                 let k = usize::from(features[1] != Feature::Edge);
                 let line = rim_plane(k).cross(&solve.edges[0]);
                 if line.dot(mean) > 0.0 { -line } else { line }
+            }
+            // Each rim's plane holds it: the mean's direction moved into
+            // one, then the other.
+            [Feature::Rim(_), Feature::Rim(_)] => {
+                let onto =
+                    |x: Vector3<f64>, n: Vector3<f64>| x - n * (n.dot(&x) / n.norm_squared());
+                onto(onto(-mean, rim_plane(0)), rim_plane(1))
             }
             _ => -mean,
         }

@@ -58,8 +58,23 @@ const FEATURE_STEPS: u32 = 8;
 
 /// The Newton step (radians) below which a Chebyshev step has converged:
 /// its error, of the cube's order, is then below the run's need, as
-/// Newton's is below the general steps' converged step.
+/// Newton's is below the general steps' converged step. It shrinks with
+/// a rim's sine to its axis below [`CUBIC_FULL_SINE`] (see
+/// `cubic_converged`).
 const CUBIC_CONVERGED: f64 = 2e-3;
+
+/// The sine of a direction's angle to a rim's axis below which the
+/// converged step shrinks in proportion: the rim point turns by the
+/// direction's turn over the sine, and the step's error grows with the
+/// rim's curvature `r / sine` and its derivatives.
+const CUBIC_FULL_SINE: f64 = 0.5;
+
+/// [`CUBIC_CONVERGED`] at the smallest sine `sine` of the direction to a
+/// rim's axis.
+#[inline(always)]
+fn cubic_converged(sine: f64) -> f64 {
+    CUBIC_CONVERGED * (sine / CUBIC_FULL_SINE).min(1.0)
+}
 
 /// The largest step (radians) the closed form takes: a larger one means
 /// the warm start's features no longer hold the answer.
@@ -199,7 +214,7 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
         let along = step * (1.0 + step * step * (1.0 / 3.0));
         let k = inverse_hypot_one(along * along);
         (cos, sin) = ((cos - sin * along) * k, (sin + cos * along) * k);
-        if newton.abs() < CUBIC_CONVERGED {
+        if newton.abs() < cubic_converged(root) {
             return Some((cos, sin));
         }
     }
@@ -304,7 +319,8 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
         let step = newton + solve(&cubic);
         // `step` is across `u`: the sum's length is `√(1 + |step|²)`.
         u = (u + step) * inverse_hypot_one(step.norm_squared());
-        if squared < CUBIC_CONVERGED * CUBIC_CONVERGED {
+        let converged = cubic_converged(1.0 / inverses[0].max(inverses[1]));
+        if squared < converged * converged {
             return Some(u);
         }
     }

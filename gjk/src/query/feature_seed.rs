@@ -103,6 +103,7 @@ impl ConvexPair<'_> {
         let mut linear = self.centroid_gap;
         let mut rims: [Rim; 2] = [(Vector3::zeros(), 0.0); 2];
         let mut rim_count = 0;
+        let axes = self.axes();
         for (k, (shape, feature)) in [self.a, self.b].into_iter().zip(features).enumerate() {
             let sign = if k == 0 { -self.scale } else { self.scale };
             let into_pair = |x: Vector3<f64>| {
@@ -126,7 +127,7 @@ impl ConvexPair<'_> {
                 }
                 Feature::Rim(top) => {
                     let (r, h) = shape.cylinder_dimensions()?;
-                    let axis = into_pair(Vector3::z());
+                    let axis = axes[k];
                     let cap = if top { h } else { -h };
                     linear += axis * (cap * sign);
                     rims[rim_count] = (axis, r * self.scale);
@@ -139,33 +140,47 @@ impl ConvexPair<'_> {
         match (solve.held.len, rims) {
             // One rim: the maximum lies in the plane of its axis and `m`
             // (there the gradient `m - r·n` is along `u`), a line.
-            (0, [(axis, r)]) => {
-                let normal = axis.cross(&linear);
+            (0, [rim]) => {
+                let normal = rim.0.cross(&linear);
                 let e1 = solve.u - normal * (normal.dot(&solve.u) / normal.norm_squared());
                 let e1 = e1 / e1.norm();
                 let e2 = normal.cross(&e1) / normal.norm();
-                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
-                let (cos, sin) = line_newton(p, q, axis.dot(&e1), axis.dot(&e2), *r)?;
-                Some(e1 * cos + e2 * sin)
+                circle_optimum(e1, e2, &linear, Some(rim))
             }
             (0, [_, _]) => sphere_newton(solve.u, &linear, rims),
-            (1, []) => {
+            (1, [] | [_]) => {
                 let e1 = solve.u;
                 let e2 = solve.held.axes[0].cross(&e1);
-                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
-                let norm = p.hypot(q);
-                (p > 0.0 && norm.is_finite()).then(|| e1 * (p / norm) + e2 * (q / norm))
-            }
-            (1, [(axis, r)]) => {
-                let e1 = solve.u;
-                let e2 = solve.held.axes[0].cross(&e1);
-                let (p, q) = (linear.dot(&e1), linear.dot(&e2));
-                let (cos, sin) = line_newton(p, q, axis.dot(&e1), axis.dot(&e2), *r)?;
-                Some(e1 * cos + e2 * sin)
+                circle_optimum(e1, e2, &linear, rims.first())
             }
             _ => None,
         }
     }
+}
+
+/// The direction `cos θ·e₁ + sin θ·e₂` (orthonormal, `e₁` the start) that
+/// maximises `F` on that circle: `u·m`, less the `rim`'s term if there is
+/// one (see [`line_newton`]); with none, `m`'s own direction in the plane,
+/// `atan2(Q, P)`, if it is less than a quarter turn from `e₁`.
+#[inline(always)]
+fn circle_optimum(
+    e1: Vector3<f64>,
+    e2: Vector3<f64>,
+    m: &Vector3<f64>,
+    rim: Option<&Rim>,
+) -> Option<Vector3<f64>> {
+    let (p, q) = (m.dot(&e1), m.dot(&e2));
+    let (cos, sin) = match rim {
+        Some((axis, r)) => line_newton(p, q, axis.dot(&e1), axis.dot(&e2), *r)?,
+        None => {
+            let norm = p.hypot(q);
+            if !(p > 0.0 && norm.is_finite()) {
+                return None;
+            }
+            (p / norm, q / norm)
+        }
+    };
+    Some(e1 * cos + e2 * sin)
 }
 
 /// The maximum of `F(θ) = P·cos θ + Q·sin θ - r·√(1 - g²)`,

@@ -496,7 +496,7 @@ impl ConvexPair<'_> {
     /// The cylinders' axes in the pair frame (A's is its body's z axis, B's
     /// turned by the rotation); a polytope's is never read.
     #[inline(always)]
-    fn axes(&self) -> [Vector3<f64>; 2] {
+    pub(super) fn axes(&self) -> [Vector3<f64>; 2] {
         let r = &self.rotation;
         [Vector3::z(), Vector3::new(r[(0, 2)], r[(1, 2)], r[(2, 2)])]
     }

@@ -2,14 +2,27 @@
 //! search path, `file://` URLs and absolute paths as they are, relative paths
 //! against the URDF file's folder.
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 /// The environment variable holding extra package folders, separated like
-/// `PATH` (`:` on Unix). ROS's `ROS_PACKAGE_PATH` is read as well, after it.
+/// `PATH` (`:` on Unix). ROS's `ROS_PACKAGE_PATH` is read as well, after it,
+/// then ROS 2's `AMENT_PREFIX_PATH` (each prefix's `share` folder).
 pub const PACKAGE_PATH_ENV: &str = "GJKD_PACKAGE_PATH";
 
-/// A search path for `package://NAME/REST` URLs: in each folder `DIR`, the
-/// file is `DIR/NAME/REST`, or `DIR/REST` when `DIR` itself is named `NAME`.
+/// How many folder levels below a search folder a package is looked for:
+/// a workspace's `src`, a repository, a folder of repositories.
+const CRAWL_DEPTH: usize = 6;
+
+/// How many folders one search folder's crawl reads at most, so that a
+/// search path naming a large tree (a home folder) fails in bounded time.
+const CRAWL_FOLDERS: usize = 20_000;
+
+/// A search path for `package://NAME/REST` URLs, searched as ROS does: in
+/// each folder `DIR`, the file is `DIR/NAME/REST`, or `DIR/REST` when `DIR`
+/// itself is named `NAME`; failing those, `PKG/REST` for the first package
+/// folder `PKG` below a search folder (one holding a `package.xml`) whose
+/// manifest's `<name>`, or whose folder name, is `NAME`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct PackagePath {
     /// The folders, searched in order.
@@ -25,15 +38,21 @@ impl PackagePath {
     }
 
     /// `dirs`, then the folders of [`PACKAGE_PATH_ENV`], then those of
-    /// `ROS_PACKAGE_PATH`.
+    /// `ROS_PACKAGE_PATH`, then the `share` folder of each prefix in
+    /// `AMENT_PREFIX_PATH` (where ROS 2 installs a package's files).
     pub fn with_env(dirs: impl IntoIterator<Item = PathBuf>) -> Self {
         let mut path = Self::new(dirs);
-        for var in [PACKAGE_PATH_ENV, "ROS_PACKAGE_PATH"] {
-            if let Some(value) = std::env::var_os(var) {
-                path.dirs
-                    .extend(std::env::split_paths(&value).filter(|d| !d.as_os_str().is_empty()));
-            }
-        }
+        let split = |var: &str| {
+            std::env::var_os(var)
+                .map(|value| std::env::split_paths(&value).collect::<Vec<_>>())
+                .unwrap_or_default()
+                .into_iter()
+                .filter(|d| !d.as_os_str().is_empty())
+        };
+        path.dirs.extend(split(PACKAGE_PATH_ENV));
+        path.dirs.extend(split("ROS_PACKAGE_PATH"));
+        path.dirs
+            .extend(split("AMENT_PREFIX_PATH").map(|prefix| prefix.join("share")));
         path
     }
 
@@ -61,13 +80,28 @@ impl PackagePath {
                     tried.push(c.display().to_string());
                 }
             }
+            // Deeper, as ROS crawls its package path: only once the direct
+            // places fail, which keeps the common layout free of walks.
+            for dir in &self.dirs {
+                if let Some(found) = find_package(dir, package) {
+                    let c = found.join(inner);
+                    if c.is_file() {
+                        return Ok(c);
+                    }
+                    tried.push(c.display().to_string());
+                }
+            }
             return Err(if tried.is_empty() {
                 format!(
                     "{filename}: no package folders to search (give them with \
                      --package-path or {PACKAGE_PATH_ENV})"
                 )
             } else {
-                format!("{filename}: not found (tried {})", tried.join(", "))
+                format!(
+                    "{filename}: not found (tried {}; no other package `{package}` \
+                     below those folders)",
+                    tried.join(", ")
+                )
             });
         }
         let plain = filename.strip_prefix("file://").unwrap_or(filename);
@@ -77,6 +111,76 @@ impl PackagePath {
             _ => path.to_path_buf(),
         })
     }
+}
+
+/// The first package folder named `name` below `dir`, breadth first (the
+/// shallowest wins, then the alphabetically first): a folder holding a
+/// `package.xml` whose `<name>` is `name`, or, when its manifest gives no
+/// name, whose own name is. As ROS's crawl does, it does not look inside a
+/// package for others, nor inside hidden folders or those marked
+/// `CATKIN_IGNORE` or `COLCON_IGNORE`; it goes [`CRAWL_DEPTH`] levels
+/// down and reads at most [`CRAWL_FOLDERS`] folders.
+fn find_package(dir: &Path, name: &str) -> Option<PathBuf> {
+    let mut queue = VecDeque::from([(dir.to_path_buf(), 0)]);
+    let mut read = 0;
+    while let Some((folder, depth)) = queue.pop_front() {
+        if read == CRAWL_FOLDERS {
+            return None;
+        }
+        read += 1;
+        if depth > 0 {
+            let manifest = folder.join("package.xml");
+            if manifest.is_file() {
+                if package_name(&manifest, &folder).as_deref() == Some(name) {
+                    return Some(folder);
+                }
+                continue;
+            }
+            if ["CATKIN_IGNORE", "COLCON_IGNORE"]
+                .iter()
+                .any(|mark| folder.join(mark).exists())
+            {
+                continue;
+            }
+        }
+        if depth == CRAWL_DEPTH {
+            continue;
+        }
+        let Ok(entries) = std::fs::read_dir(&folder) else {
+            continue;
+        };
+        let mut children: Vec<PathBuf> = entries
+            .filter_map(Result::ok)
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_dir() || t.is_symlink()))
+            .map(|e| e.path())
+            .filter(|p| {
+                p.is_dir()
+                    && p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| !n.starts_with('.'))
+            })
+            .collect();
+        children.sort();
+        queue.extend(children.into_iter().map(|c| (c, depth + 1)));
+    }
+    None
+}
+
+/// A package's name: its manifest's `<name>`, or its folder's name when
+/// the manifest cannot be read or names none.
+fn package_name(manifest: &Path, folder: &Path) -> Option<String> {
+    let from_manifest = std::fs::read_to_string(manifest).ok().and_then(|text| {
+        let doc = roxmltree::Document::parse(&text).ok()?;
+        let name = doc
+            .root_element()
+            .children()
+            .find(|n| n.has_tag_name("name"))?
+            .text()?
+            .trim()
+            .to_owned();
+        (!name.is_empty()).then_some(name)
+    });
+    from_manifest.or_else(|| folder.file_name()?.to_str().map(str::to_owned))
 }
 
 #[cfg(test)]
@@ -112,6 +216,67 @@ mod tests {
             path.resolve("file:///abs/a.stl", Some(Path::new("/robots"))),
             Ok(PathBuf::from("/abs/a.stl"))
         );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    /// Writes `package.xml` naming `name` in `folder` (no `<name>` if
+    /// `None`), and a mesh file at `folder/meshes/link.stl`.
+    fn package(folder: &Path, name: Option<&str>) -> PathBuf {
+        let mesh = folder.join("meshes/link.stl");
+        std::fs::create_dir_all(mesh.parent().unwrap()).unwrap();
+        std::fs::write(&mesh, b"solid x\nendsolid x\n").unwrap();
+        let name = name.map_or(String::new(), |n| format!("<name>\n  {n}\n</name>"));
+        std::fs::write(
+            folder.join("package.xml"),
+            format!("<?xml version=\"1.0\"?>\n<package format=\"2\">{name}<version>1.0.0</version></package>"),
+        )
+        .unwrap();
+        mesh
+    }
+
+    #[test]
+    fn packages_below_the_search_folders_are_found_as_ros_finds_them() {
+        let root = std::env::temp_dir().join(format!("gjkd-model-crawl-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        // A workspace of repositories: the package's folder is named unlike
+        // the package, three levels down.
+        let arm = package(
+            &root.join("ws/src/arm-repo/arm_ros"),
+            Some("arm_description"),
+        );
+        // Named by its folder when its manifest names none.
+        let hand = package(&root.join("ws/src/hand_description"), None);
+        // Not found: inside a hidden folder, under an ignore mark, inside
+        // another package, too deep.
+        package(&root.join("ws/.cache/gripper"), Some("gripper"));
+        package(&root.join("ws/src/ignored/wrist"), Some("wrist"));
+        std::fs::write(root.join("ws/src/ignored/CATKIN_IGNORE"), b"").unwrap();
+        package(
+            &root.join("ws/src/arm-repo/arm_ros/nested/base"),
+            Some("base"),
+        );
+        package(&root.join("ws/a/b/c/d/e/f/deep"), Some("deep"));
+        // The shallower of two packages of one name wins.
+        let near = package(&root.join("ws/src/tool"), Some("tool"));
+        package(&root.join("ws/src/z/older/tool"), Some("tool"));
+
+        let path = PackagePath::new([root.join("nothing-here"), root.clone()]);
+        let url = |p: &str| format!("package://{p}/meshes/link.stl");
+        assert_eq!(path.resolve(&url("arm_description"), None), Ok(arm));
+        assert_eq!(path.resolve(&url("hand_description"), None), Ok(hand));
+        assert_eq!(path.resolve(&url("tool"), None), Ok(near));
+        for lost in ["gripper", "wrist", "base", "deep", "arm_ros"] {
+            let error = path.resolve(&url(lost), None).unwrap_err();
+            assert!(
+                error.contains(&format!("no other package `{lost}`")),
+                "{error}"
+            );
+        }
+        // A package found whose file is missing is reported with its path.
+        let error = path
+            .resolve("package://arm_description/meshes/gone.stl", None)
+            .unwrap_err();
+        assert!(error.contains("arm_ros/meshes/gone.stl"), "{error}");
         std::fs::remove_dir_all(&root).unwrap();
     }
 }

@@ -115,10 +115,11 @@ impl Mesh {
             .flatten();
         let bytes = flat.map_or(bytes, String::into_bytes);
         let loader = mesh_loader::Loader::default().merge_meshes(true);
+        let named = lower_case_extension(path);
         let scene = loader
-            .load_from_slice(&bytes, path)
+            .load_from_slice(&bytes, &named)
             .or_else(|e| match binary_stl_named_solid(&bytes) {
-                Some(binary) => loader.load_from_slice(&binary, path),
+                Some(binary) => loader.load_from_slice(&binary, &named),
                 None => Err(e),
             })
             .map_err(|e| MeshError::Parse {
@@ -322,6 +323,19 @@ impl Decomposition {
             .map(|p| Ok((Isometry3::identity(), Convex::new(p.clone(), 0.0)?)))
             .collect::<Result<Vec<_>, gjk::Error>>()?;
         Ok(Compound::new(pieces)?)
+    }
+}
+
+/// `path` with its extension in lower case: `mesh-loader` tells a format
+/// by its extension in lower or upper case only, and exporters also write
+/// `.Stl` or `.Obj` (binary STL and OBJ have no marker to tell them by
+/// otherwise).
+fn lower_case_extension(path: &Path) -> std::borrow::Cow<'_, Path> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.chars().any(|c| c.is_ascii_uppercase()) => {
+            path.with_extension(e.to_ascii_lowercase()).into()
+        }
+        _ => path.into(),
     }
 }
 

@@ -323,3 +323,23 @@ fn bad_meshes_get_their_errors() {
     ));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn extensions_in_any_case_name_their_format() {
+    // Exporters write `.STL`, `.Stl` or `.Obj`; the format is the
+    // extension's, whatever its case (binary STL and OBJ have no marker
+    // the content could be told by).
+    let dir = files::scratch("extension-case");
+    let (v, t) = files::cuboid([0.5, 0.25, 0.125]);
+    for name in ["a.Stl", "b.sTL", "c.STL"] {
+        files::write_stl_binary(&dir.join(name), &v, &t);
+    }
+    files::write_obj(&dir.join("d.Obj"), &v, &t);
+    files::write_dae(&dir.join("e.Dae"), &v, &t, 1.0);
+    for name in ["a.Stl", "b.sTL", "c.STL", "d.Obj", "e.Dae"] {
+        let mesh = Mesh::load(&dir.join(name), [1.0; 3]).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_same_points(&mesh.hull(), &v, 1e-7);
+        assert_eq!(mesh.triangles.len(), 12, "{name}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

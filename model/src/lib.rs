@@ -43,6 +43,7 @@ pub mod paths;
 pub mod robot;
 pub mod srdf;
 mod urdf;
+mod xml_prefixes;
 
 pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
 pub use mesh::{Decomposition, Mesh, MeshError};

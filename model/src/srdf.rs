@@ -4,6 +4,7 @@
 //! `reason`); groups, states and the rest of the format are ignored.
 
 use crate::kinematics::Kinematics;
+use crate::xml_prefixes::rename_unbound_prefixes;
 
 /// What can be wrong with an SRDF.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -42,8 +43,10 @@ pub fn disabled_pairs(
         pairs.extend(kinematics.adjacent_links());
     }
     if let Some(text) = srdf {
+        // Prefixes used undeclared, as ROS's parser allows, renamed.
+        let text = rename_unbound_prefixes(text);
         let doc =
-            roxmltree::Document::parse(text).map_err(|e| SrdfError::Malformed(e.to_string()))?;
+            roxmltree::Document::parse(&text).map_err(|e| SrdfError::Malformed(e.to_string()))?;
         for node in doc
             .descendants()
             .filter(|n| n.has_tag_name("disable_collisions"))

@@ -10,10 +10,13 @@
 //! `<material>` elements are cut out of the text, by the byte ranges a real
 //! XML parser gives, before `urdf-rs` reads it. Text that is not
 //! well-formed XML goes to `urdf-rs` as it is, to get its own error.
+//! Namespace prefixes used undeclared (as ROS's parser allows) are renamed
+//! first (see `xml_prefixes`).
 
 use std::ops::Range;
 
 use crate::kinematics::KinematicsError;
+use crate::xml_prefixes::rename_unbound_prefixes;
 
 /// Parses URDF text, the elements gjkd never reads removed.
 ///
@@ -21,6 +24,8 @@ use crate::kinematics::KinematicsError;
 /// [`KinematicsError::Malformed`] with `urdf-rs`'s (or the XML parser's)
 /// message.
 pub(crate) fn parse_urdf(text: &str) -> Result<urdf_rs::Robot, KinematicsError> {
+    let text = rename_unbound_prefixes(text);
+    let text = text.as_ref();
     let stripped = without_unused_elements(text);
     urdf_rs::read_from_string(stripped.as_deref().unwrap_or(text))
         .map_err(|e| KinematicsError::Malformed(e.to_string()))

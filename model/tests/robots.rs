@@ -5,7 +5,8 @@ mod files;
 
 use gjk::Shape;
 use gjkd_model::{
-    KinematicsError, MeshError, PackagePath, RobotError, RobotModel, SrdfError, disabled_pairs,
+    KinematicsError, LimitMode, MeshError, PackagePath, RobotError, RobotModel, SrdfError,
+    disabled_pairs,
 };
 
 fn load(tag: &str) -> (std::path::PathBuf, RobotModel) {
@@ -229,4 +230,57 @@ fn cylinder_elements_are_exact_along_their_z_axis() {
         );
         assert!(a.lower <= want && want <= a.upper, "{at:?}");
     }
+}
+
+#[test]
+fn undeclared_namespace_prefixes_load_as_ros_reads_them() {
+    // Fetch's URDF names its Gazebo sensors `<sensor:camera>` with no
+    // `xmlns:sensor`: ROS's parser takes the colon as part of the name,
+    // and the robot must load here too, the same as without them.
+    let plain = r#"<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <link name="base"><collision><geometry><box size="0.2 0.4 0.6"/></geometry></collision></link>
+  <link name="arm"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+  <joint name="j" type="revolute">
+    <parent link="base"/><child link="arm"/>
+    <origin xyz="0.5 0 0.25" rpy="0 0 0.3"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+GAZEBO</robot>"#;
+    let gazebo = r#"<gazebo reference="arm">
+    <sensor:camera name="rgb" cam:fov="50"><imageSize>192 128</imageSize></sensor:camera>
+    <controller:gazebo_ros_camera name="c" plugin="libgazebo_ros_camera.so"/>
+  </gazebo>
+"#;
+    let with = plain.replace("GAZEBO", gazebo);
+    let without = plain.replace("GAZEBO", "");
+    let packages = PackagePath::default();
+    let a = RobotModel::from_urdf_str(&with, None, &packages).unwrap();
+    let b = RobotModel::from_urdf_str(&without, None, &packages).unwrap();
+    assert_eq!(a.kinematics.joint_names(), ["j"]);
+    let base = nalgebra::Isometry3::translation(1.0, 2.0, 3.0);
+    for q in [-0.7, 0.0, 0.9] {
+        let (pa, pb) = (
+            a.kinematics
+                .link_poses(&base, &[q], LimitMode::Reject)
+                .unwrap(),
+            b.kinematics
+                .link_poses(&base, &[q], LimitMode::Reject)
+                .unwrap(),
+        );
+        assert_eq!(pa, pb);
+    }
+    let counts = |m: &RobotModel| -> Vec<Vec<usize>> {
+        m.links
+            .iter()
+            .map(|l| vertex_count(l.shape.as_ref().unwrap()))
+            .collect()
+    };
+    assert_eq!(counts(&a), counts(&b));
+    // An SRDF may carry the same: its pairs are read all the same.
+    let srdf =
+        r#"<robot name="r"><group:x/><disable_collisions link1="base" link2="arm"/></robot>"#;
+    assert_eq!(
+        disabled_pairs(Some(srdf), &a.kinematics, false).unwrap(),
+        [(0, 1)]
+    );
 }

@@ -105,7 +105,10 @@ fn find_urdfs(path: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
         let entry = entry?.path();
         if entry.is_dir() {
             find_urdfs(&entry, out)?;
-        } else if entry.extension().is_some_and(|e| e == "urdf") {
+        } else if entry
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+        {
             out.push(entry);
         }
     }

@@ -22,7 +22,8 @@ const CRAWL_FOLDERS: usize = 20_000;
 /// each folder `DIR`, the file is `DIR/NAME/REST`, or `DIR/REST` when `DIR`
 /// itself is named `NAME`; failing those, `PKG/REST` for the first package
 /// folder `PKG` below a search folder (one holding a `package.xml`) whose
-/// manifest's `<name>`, or whose folder name, is `NAME`.
+/// manifest's `<name>`, or whose folder name, is `NAME`, or, outside
+/// packages, for the first folder named `NAME` that holds `REST`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct PackagePath {
     /// The folders, searched in order.
@@ -83,7 +84,7 @@ impl PackagePath {
             // Deeper, as ROS crawls its package path: only once the direct
             // places fail, which keeps the common layout free of walks.
             for dir in &self.dirs {
-                if let Some(found) = find_package(dir, package) {
+                if let Some(found) = find_package(dir, package, inner) {
                     let c = found.join(inner);
                     if c.is_file() {
                         return Ok(c);
@@ -113,14 +114,16 @@ impl PackagePath {
     }
 }
 
-/// The first package folder named `name` below `dir`, breadth first (the
-/// shallowest wins, then the alphabetically first): a folder holding a
-/// `package.xml` whose `<name>` is `name`, or, when its manifest gives no
-/// name, whose own name is. As ROS's crawl does, it does not look inside a
-/// package for others, nor inside hidden folders or those marked
-/// `CATKIN_IGNORE` or `COLCON_IGNORE`; it goes [`CRAWL_DEPTH`] levels
-/// down and reads at most [`CRAWL_FOLDERS`] folders.
-fn find_package(dir: &Path, name: &str) -> Option<PathBuf> {
+/// The package `name` below `dir`, for the file `inner` in it, breadth
+/// first (the shallowest wins, then the alphabetically first): a folder
+/// holding a `package.xml` whose `<name>` is `name` (when its manifest
+/// gives no name, whose own name is), as ROS finds it; or, where no
+/// manifests mark the packages (collections of descriptions copied without
+/// them), a folder named `name` that holds `inner`. As ROS's crawl does,
+/// it does not look inside a package for others, nor inside hidden folders
+/// or those marked `CATKIN_IGNORE` or `COLCON_IGNORE`; it goes
+/// [`CRAWL_DEPTH`] levels down and reads at most [`CRAWL_FOLDERS`] folders.
+fn find_package(dir: &Path, name: &str, inner: &str) -> Option<PathBuf> {
     let mut queue = VecDeque::from([(dir.to_path_buf(), 0)]);
     let mut read = 0;
     while let Some((folder, depth)) = queue.pop_front() {
@@ -141,6 +144,9 @@ fn find_package(dir: &Path, name: &str) -> Option<PathBuf> {
                 .any(|mark| folder.join(mark).exists())
             {
                 continue;
+            }
+            if folder.file_name().is_some_and(|n| n == name) && folder.join(inner).is_file() {
+                return Some(folder);
             }
         }
         if depth == CRAWL_DEPTH {
@@ -256,6 +262,12 @@ mod tests {
             Some("base"),
         );
         package(&root.join("ws/a/b/c/d/e/f/deep"), Some("deep"));
+        // With no manifest, a folder of the package's name that holds the
+        // file: not the first such folder, which lacks it.
+        let bare = root.join("ws/src/z/copies/bare_description/meshes/link.stl");
+        std::fs::create_dir_all(root.join("ws/src/a/bare_description")).unwrap();
+        std::fs::create_dir_all(bare.parent().unwrap()).unwrap();
+        std::fs::write(&bare, b"solid x\nendsolid x\n").unwrap();
         // The shallower of two packages of one name wins.
         let near = package(&root.join("ws/src/tool"), Some("tool"));
         package(&root.join("ws/src/z/older/tool"), Some("tool"));
@@ -265,6 +277,7 @@ mod tests {
         assert_eq!(path.resolve(&url("arm_description"), None), Ok(arm));
         assert_eq!(path.resolve(&url("hand_description"), None), Ok(hand));
         assert_eq!(path.resolve(&url("tool"), None), Ok(near));
+        assert_eq!(path.resolve(&url("bare_description"), None), Ok(bare));
         for lost in ["gripper", "wrist", "base", "deep", "arm_ros"] {
             let error = path.resolve(&url(lost), None).unwrap_err();
             assert!(

@@ -8,7 +8,9 @@
 //! all the same, since none of it changes a link's pose or shape. So a
 //! link's `<visual>` and `<inertial>` elements and the robot's own
 //! `<material>` elements are cut out of the text, by the byte ranges a real
-//! XML parser gives, before `urdf-rs` reads it. Text that is not
+//! XML parser gives, before `urdf-rs` reads it; so are the parts ROS's
+//! parser never reads and `urdf-rs` may refuse: a collision geometry's
+//! elements after its first, a fixed or floating joint's `<axis>`. Text that is not
 //! well-formed XML goes to `urdf-rs` as it is, to get its own error.
 //! Namespace prefixes used undeclared (as ROS's parser allows) are renamed
 //! first (see `xml_prefixes`).
@@ -31,6 +33,15 @@ pub(crate) fn parse_urdf(text: &str) -> Result<urdf_rs::Robot, KinematicsError> 
         .map_err(|e| KinematicsError::Malformed(e.to_string()))
 }
 
+/// `node`'s child elements named `name`.
+fn elements<'a, 'input>(
+    node: roxmltree::Node<'a, 'input>,
+    name: &'static str,
+) -> impl Iterator<Item = roxmltree::Node<'a, 'input>> {
+    node.children()
+        .filter(move |n| n.is_element() && n.tag_name().name() == name)
+}
+
 /// The text without the unused elements, or `None` when there are none or
 /// the text is not well-formed XML (then `urdf-rs` reports on it as it is).
 fn without_unused_elements(text: &str) -> Option<String> {
@@ -40,12 +51,33 @@ fn without_unused_elements(text: &str) -> Option<String> {
     for child in root.children().filter(roxmltree::Node::is_element) {
         match child.tag_name().name() {
             "material" => cut.push(child.range()),
-            "link" => cut.extend(
-                child
-                    .children()
-                    .filter(|n| matches!(n.tag_name().name(), "visual" | "inertial"))
-                    .map(|n| n.range()),
-            ),
+            "link" => {
+                for element in child.children().filter(roxmltree::Node::is_element) {
+                    match element.tag_name().name() {
+                        "visual" | "inertial" => cut.push(element.range()),
+                        // ROS reads a geometry's first element only: what
+                        // follows (an `<origin>` put there by mistake) is
+                        // no part of it.
+                        "collision" => {
+                            for geometry in elements(element, "geometry") {
+                                cut.extend(
+                                    geometry
+                                        .children()
+                                        .filter(roxmltree::Node::is_element)
+                                        .skip(1)
+                                        .map(|n| n.range()),
+                                );
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            // ROS reads no axis of a fixed or floating joint, so a
+            // malformed one there does not matter.
+            "joint" if matches!(child.attribute("type"), Some("fixed" | "floating")) => {
+                cut.extend(elements(child, "axis").map(|n| n.range()));
+            }
             _ => {}
         }
     }
@@ -89,6 +121,31 @@ mod tests {
         assert_eq!(robot.links.len(), 1);
         assert_eq!(robot.links[0].collision.len(), 1);
         assert!(robot.links[0].visual.is_empty());
+    }
+
+    #[test]
+    fn what_ros_never_reads_is_cut_and_the_robot_loads() {
+        // A description in the wild: an origin inside a geometry after its
+        // shape, a fixed joint's axis with a misspelt attribute.
+        let text = r#"<robot name="r">
+  <link name="a"><collision><origin xyz="0 0 1"/>
+    <geometry name="g"><box size="1 2 3"/><origin xyz="5 0 0"/></geometry>
+  </collision></link>
+  <link name="b"/>
+  <joint name="f" type="fixed"><parent link="a"/><child link="b"/><axis xzy="0 0 1"/></joint>
+  <link name="c"/>
+  <joint name="m" type="revolute"><parent link="a"/><child link="c"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"#;
+        assert!(urdf_rs::read_from_string(text).is_err());
+        let robot = parse_urdf(text).unwrap();
+        let collision = &robot.links[0].collision[0];
+        assert_eq!(collision.origin.xyz.0, [0.0, 0.0, 1.0]);
+        assert!(matches!(
+            collision.geometry,
+            urdf_rs::Geometry::Box { ref size } if size.0 == [1.0, 2.0, 3.0]
+        ));
+        assert_eq!(robot.joints[1].axis.xyz.0, [0.0, 1.0, 0.0]);
     }
 
     #[test]

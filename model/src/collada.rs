@@ -5,12 +5,15 @@
 //! composes a node's transform with its parents' in the reverse order (a
 //! child's translation is turned by its own rotation instead of its
 //! parent's), scales by the unit before the nodes' translations instead of
-//! after them, and also returns the geometries that no node places. Here
-//! the scene is flattened first: each placed geometry gets one node directly
-//! under the scene holding its whole transform, unit included, and the
-//! document's unit becomes the metre, so that the crate's reading of that
-//! simpler document is exact. Only the scene's structure is rewritten; the
-//! geometries go through verbatim, and the crate still parses them.
+//! after them, drops any transform within 0.01 of the identity in every
+//! entry (a part moved 3 mm), applies the rest in single precision, and
+//! also returns the geometries that no node places. Here the scene is
+//! flattened first: each placed geometry gets one node directly under the
+//! scene, with no transform, the document's unit becomes the metre, and
+//! each geometry's whole transform (unit included) is returned beside the
+//! document, for the caller to apply to the vertices the crate reads. Only
+//! the scene's structure is rewritten; the geometries go through verbatim,
+//! and the crate still parses them.
 //!
 //! The up axis (`<up_axis>`) is left alone, as ROS's tools leave it: a
 //! URDF's mesh is read in the frame its numbers are written in.
@@ -25,12 +28,22 @@ use roxmltree::{Document, Node};
 /// cycle of `<instance_node>` references.
 const MAX_DEPTH: usize = 64;
 
+/// A COLLADA document flattened (see the module's note).
+pub(crate) struct FlatScene {
+    /// The document: each placed geometry once, under a node of its own
+    /// with no transform, in metres.
+    pub text: String,
+    /// Each geometry's id in `text` and the transform that places it,
+    /// unit included, to apply to its vertices as `mesh-loader` reads them.
+    pub placements: HashMap<String, Matrix4<f64>>,
+}
+
 /// The document with its scene flattened (see the module's note), or
 /// `None` to leave it to `mesh-loader` as it is: text that is not XML, no
 /// scene that places a geometry, or a transform this module does not read
 /// (`<lookat>`, `<skew>`, a malformed number), which the crate then reads
 /// or refuses by itself.
-pub(crate) fn flatten_scene(text: &str) -> Option<String> {
+pub(crate) fn flatten_scene(text: &str) -> Option<FlatScene> {
     let doc = Document::parse(text).ok()?;
     let root = doc.root_element();
     let unit = child(root, "asset")
@@ -56,6 +69,7 @@ pub(crate) fn flatten_scene(text: &str) -> Option<String> {
     }
     let mut geometries = String::new();
     let mut nodes = String::new();
+    let mut placements = HashMap::new();
     let mut instances: HashMap<&str, usize> = HashMap::new();
     for (k, (url, transform)) in placed.iter().enumerate() {
         let id = url.strip_prefix('#')?;
@@ -76,20 +90,15 @@ pub(crate) fn flatten_scene(text: &str) -> Option<String> {
             copy
         };
         *count += 1;
-        let _ = write!(nodes, r#"<node id="gjkd-node-{k}"><matrix>"#);
-        for row in 0..4 {
-            for col in 0..4 {
-                let _ = write!(nodes, "{:e} ", transform[(row, col)]);
-            }
-        }
         let _ = write!(
             nodes,
-            r##"</matrix><instance_geometry url="#{name}"/></node>"##
+            r##"<node id="gjkd-node-{k}"><instance_geometry url="#{name}"/></node>"##
         );
+        placements.insert(name, *transform);
     }
     let namespace = root.tag_name().namespace().unwrap_or_default();
     let version = root.attribute("version").unwrap_or("1.4.1");
-    Some(format!(
+    let text = format!(
         r##"<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="{namespace}" version="{version}">
 <asset><unit name="meter" meter="1"/></asset>
@@ -98,7 +107,8 @@ pub(crate) fn flatten_scene(text: &str) -> Option<String> {
 <scene><instance_visual_scene url="#gjkd-scene"/></scene>
 </COLLADA>
 "##
-    ))
+    );
+    Some(FlatScene { text, placements })
 }
 
 /// The first child element of `node` named `name`.

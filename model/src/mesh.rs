@@ -8,6 +8,7 @@
 //! closest points lie on the mesh's convex parts). A decomposition is closer
 //! to a non-convex mesh, at the price of several pieces.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use gjk::{Compound, Convex};
@@ -113,8 +114,12 @@ impl Mesh {
                     .and_then(collada::flatten_scene)
             })
             .flatten();
-        let bytes = flat.map_or(bytes, String::into_bytes);
-        let loader = mesh_loader::Loader::default().merge_meshes(true);
+        let (bytes, placements) = match flat {
+            Some(flat) => (flat.text.into_bytes(), flat.placements),
+            None => (bytes, HashMap::new()),
+        };
+        // One mesh per geometry, named by its id, for its placement.
+        let loader = mesh_loader::Loader::default().merge_meshes(false);
         let named = lower_case_extension(path);
         let scene = loader
             .load_from_slice(&bytes, &named)
@@ -129,12 +134,11 @@ impl Mesh {
         let mut mesh = Mesh::default();
         for m in &scene.meshes {
             let base = u32::try_from(mesh.vertices.len()).unwrap_or(u32::MAX);
+            let place = placements.get(&m.name);
             mesh.vertices.extend(m.vertices.iter().map(|v| {
-                Point3::new(
-                    f64::from(v[0]) * scale[0],
-                    f64::from(v[1]) * scale[1],
-                    f64::from(v[2]) * scale[2],
-                )
+                let p = Point3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+                let p = place.map_or(p, |t| t.transform_point(&p));
+                Point3::new(p.x * scale[0], p.y * scale[1], p.z * scale[2])
             }));
             mesh.triangles.extend(
                 m.faces

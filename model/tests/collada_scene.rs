@@ -166,3 +166,32 @@ fn a_cycle_of_instance_nodes_is_refused_not_followed_forever() {
     // Returns, whatever it reads: no stack overflow, no hang.
     let _ = Mesh::load(&path, [1.0; 3]);
 }
+
+#[test]
+fn transforms_near_the_identity_are_applied_in_full() {
+    // mesh-loader takes any transform within 0.01 of the identity in each
+    // entry for the identity and drops it: a part moved 3 mm (Franka's
+    // visual link4, UR5's base) or turned a third of a degree.
+    let nodes = r##"<node id="n"><translate>0.003 -0.002 0.001</translate>
+        <instance_geometry url="#tri"/></node>"##;
+    let got = load("near-identity", &document(1.0, nodes, "", false));
+    assert_points(
+        &got,
+        &[
+            [1.003, -0.002, 0.001],
+            [0.003, 0.998, 0.001],
+            [0.003, -0.002, 1.001],
+        ],
+        1.0,
+    );
+    let nodes = r##"<node id="n"><rotate>0 0 1 0.3</rotate><scale>1.005 1.005 1.005</scale>
+        <instance_geometry url="#tri"/></node>"##;
+    let got = load("near-identity-turn", &document(1.0, nodes, "", false));
+    let (s, c) = 0.3_f64.to_radians().sin_cos();
+    let k = 1.005;
+    assert_points(
+        &got,
+        &[[k * c, k * s, 0.0], [-k * s, k * c, 0.0], [0.0, 0.0, k]],
+        1.0,
+    );
+}

@@ -14,6 +14,16 @@
 
 use std::borrow::Cow;
 
+/// What the scan skips whole, by its start and end: comments, CDATA
+/// sections, processing instructions and declarations (the order matters:
+/// `<!` last).
+const SKIPPED: [(&[u8], &[u8]); 4] = [
+    (b"<!--", b"-->"),
+    (b"<![CDATA[", b"]]>"),
+    (b"<?", b"?>"),
+    (b"<!", b">"),
+];
+
 /// `text` with the colon of every unbound prefix in an element or attribute
 /// name replaced by `_` (see the module's note), or `text` itself when
 /// there is none. Text that is not well-formed XML is scanned as far as it
@@ -43,21 +53,8 @@ fn unbound_prefix_colons(b: &[u8]) -> Vec<usize> {
     while let Some(offset) = b[i..].iter().position(|&c| c == b'<') {
         let at = i + offset;
         let rest = &b[at..];
-        let skip_to = |end: &[u8]| find(b, at, end).map_or(b.len(), |e| e + end.len());
-        if rest.starts_with(b"<!--") {
-            i = skip_to(b"-->");
-            continue;
-        }
-        if rest.starts_with(b"<![CDATA[") {
-            i = skip_to(b"]]>");
-            continue;
-        }
-        if rest.starts_with(b"<?") {
-            i = skip_to(b"?>");
-            continue;
-        }
-        if rest.starts_with(b"<!") {
-            i = skip_to(b">");
+        if let Some((_, end)) = SKIPPED.iter().find(|(start, _)| rest.starts_with(start)) {
+            i = find(b, at, end).map_or(b.len(), |e| e + end.len());
             continue;
         }
         let closing = rest.starts_with(b"</");

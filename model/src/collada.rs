@@ -6,7 +6,7 @@
 //! child's translation is turned by its own rotation instead of its
 //! parent's), scales by the unit before the nodes' translations instead of
 //! after them, drops any transform within 0.01 of the identity in every
-//! entry (a part moved 3 mm), applies the rest in single precision, and
+//! entry (a part moved a few millimetres), applies the rest in single precision, and
 //! also returns the geometries that no node places. Here the scene is
 //! flattened first: each placed geometry gets one node directly under the
 //! scene, with no transform, the document's unit becomes the metre, and

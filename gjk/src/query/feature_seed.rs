@@ -26,7 +26,7 @@
 use nalgebra::Vector3;
 
 use super::newton_seed::{Kinks, Solve};
-use super::pair::{ConvexPair, rotate};
+use super::pair::ConvexPair;
 use crate::cylinder;
 
 /// What a warm start names as one shape's part of the answer.
@@ -43,7 +43,8 @@ pub(super) enum Feature {
     /// A face of a polytope, three of its vertices held as the shape's
     /// kinks: the direction is the held one.
     Face,
-    /// Anything else (a cap's points, a polytope's face): no closed form.
+    /// Anything else (a cap's points, a polytope's points on no one edge
+    /// or face): no closed form.
     Other,
 }
 
@@ -106,13 +107,6 @@ impl ConvexPair<'_> {
         let axes = self.axes();
         for (k, (shape, feature)) in [self.a, self.b].into_iter().zip(features).enumerate() {
             let sign = if k == 0 { -self.scale } else { self.scale };
-            let into_pair = |x: Vector3<f64>| {
-                if k == 0 {
-                    x
-                } else {
-                    rotate(&self.rotation, &x)
-                }
-            };
             match feature {
                 Feature::Side => {}
                 Feature::Edge => {
@@ -120,10 +114,10 @@ impl ConvexPair<'_> {
                     if kinks.len != 2 {
                         return None;
                     }
-                    linear += into_pair(shape.point(kinks.keys[0] as usize)) * sign;
+                    linear += self.in_pair_frame(k, shape.point(kinks.keys[0] as usize)) * sign;
                 }
                 Feature::Vertex(index) => {
-                    linear += into_pair(shape.point(index as usize)) * sign;
+                    linear += self.in_pair_frame(k, shape.point(index as usize)) * sign;
                 }
                 Feature::Rim(top) => {
                     let (r, h) = shape.cylinder_dimensions()?;

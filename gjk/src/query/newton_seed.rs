@@ -370,11 +370,7 @@ impl ConvexPair<'_> {
                     solve.kinks[k].add(first);
                     solve.kinks[k].add(key);
                     let edge = shape.point(key as usize) - shape.point(first as usize);
-                    solve.edges[solve.edge_count] = if k == 0 {
-                        edge
-                    } else {
-                        rotate(&self.rotation, &edge)
-                    };
+                    solve.edges[solve.edge_count] = self.in_pair_frame(k, edge);
                     solve.edge_count += 1;
                 }
             }
@@ -388,6 +384,8 @@ impl ConvexPair<'_> {
         if !mean.iter().all(|x| x.is_finite()) {
             return None;
         }
+        // What `Solve::constraints` gives, built in place: the call, out of
+        // line there, measurably slowed every warm query.
         let mut held = Constraints::default();
         for (side, axis) in solve.side.iter().zip(self.axes()) {
             if *side {
@@ -422,14 +420,7 @@ impl ConvexPair<'_> {
         first: [Vector3<f64>; 2],
         mean: &Vector3<f64>,
     ) -> Vector3<f64> {
-        let radial = |k: usize| {
-            let flat = Vector3::new(first[k].x, first[k].y, 0.0);
-            if k == 0 {
-                flat
-            } else {
-                rotate(&self.rotation, &flat)
-            }
-        };
+        let radial = |k: usize| self.in_pair_frame(k, Vector3::new(first[k].x, first[k].y, 0.0));
         let rim_plane = |k: usize| self.axes()[k].cross(&radial(k));
         match features {
             [Feature::Side, _] => radial(0),
@@ -491,6 +482,17 @@ impl ConvexPair<'_> {
             return self.cap_seed(k, &u).map(|pairs| self.seed_of_pairs(&pairs));
         }
         None
+    }
+
+    /// Shape `k`'s body vector `x` (0 for A, 1 for B) in the pair frame:
+    /// A's as it is, B's turned by the rotation.
+    #[inline(always)]
+    pub(super) fn in_pair_frame(&self, k: usize, x: Vector3<f64>) -> Vector3<f64> {
+        if k == 0 {
+            x
+        } else {
+            rotate(&self.rotation, &x)
+        }
     }
 
     /// The cylinders' axes in the pair frame (A's is its body's z axis, B's
@@ -851,12 +853,10 @@ impl ConvexPair<'_> {
     /// and the face's vertex changes are no longer kinks.
     fn let_go_of_face(&self, solve: &mut Solve, face: usize, keys: [u32; 2], away: Vector3<f64>) {
         let shape = if face == 0 { self.a } else { self.b };
-        let edge = shape.point(keys[1] as usize) - shape.point(keys[0] as usize);
-        let edge = if face == 0 {
-            edge
-        } else {
-            rotate(&self.rotation, &edge)
-        };
+        let edge = self.in_pair_frame(
+            face,
+            shape.point(keys[1] as usize) - shape.point(keys[0] as usize),
+        );
         solve.off_face[face] = true;
         solve.kinks[face] = Kinks {
             keys: [keys[0], keys[1], 0],

@@ -513,13 +513,15 @@ fn warm_cylinder_against_a_box_certifies_at_once_along_a_motion() {
 /// closed form (`gjk/src/query/feature_seed.rs`), and the seed must be
 /// exact enough for the run to certify at once. Before the closed form's
 /// converged step shrank with a rim's sine to its axis, 67 of these steps,
-/// near the axis, took 2 to 4 iterations.
+/// near the axis, took 2 to 4 iterations; before two rims were solved on
+/// their angles where the direction is nearer A's axis than the sphere's
+/// closed form goes, 12 steps took 3 to 34.
 #[test]
 fn warm_cylinder_against_a_cylinder_certifies_at_once_along_a_motion() {
     let other = bracketed_cylinder(0.3, 0.6, 0.0);
     let at_once = warm_motion_against(&other);
-    // A few steps near the top cap's axis take more.
-    assert!(at_once >= 2980, "{at_once} of 3000 in one iteration");
+    // One step, where the answer changes feature, takes two.
+    assert!(at_once >= 2998, "{at_once} of 3000 in one iteration");
 }
 
 /// The steps, of 3 000 along a motion of `other` past a cylinder, whose

@@ -13,13 +13,15 @@
 //! terms alone: on the sphere where no kink is held (two rims, or a rim
 //! and a vertex), on the circle across the held axis where one is (a side
 //! or an edge, with at most one rim; with none the maximum is
-//! `atan2(Q, P)`, no step at all). The general steps compute both
+//! `atan2(Q, P)`, no step at all). Two rims whose direction is near
+//! either's axis are solved on the rims' angles instead, the nearest
+//! points of two circles. The general steps compute both
 //! shapes' supports, curvatures, kinks and constraints at every step; these
 //! compute a few dot products.
 //!
 //! The features are the warm start's guess. The supports at the solved
 //! direction must name the same ones (the polytope's vertex, or one of the
-//! held edge's; the rim's cap, away from its axis); otherwise the general
+//! held edge's; the rim's cap); otherwise the general
 //! steps start over, from the warm start as before, and only the closed
 //! form's time is lost. The run certifies whatever seed follows.
 
@@ -48,9 +50,11 @@ pub(super) enum Feature {
     Other,
 }
 
-/// The sine of the angle to a rim's axis below which the closed form is
-/// not tried: nearer, a cap may hold the answer (see `cap_seed`), and the
-/// rim's curvature `r / sin` outgrows the steps' model.
+/// The sine of the angle to a rim's axis below which the closed form on
+/// the sphere of directions is not tried: nearer, the rim's curvature
+/// `r / sin` outgrows the steps' model (two rims are then solved on their
+/// angles, see `rim_pair_newton`, and a cap may hold the answer, see
+/// `cap_seed`).
 const RIM_FLOOR: f64 = 0.05;
 
 /// Newton steps before the closed form is given up: from a warm start a
@@ -141,7 +145,10 @@ impl ConvexPair<'_> {
                 let e2 = normal.cross(&e1) / normal.norm();
                 circle_optimum(e1, e2, &linear, Some(rim))
             }
-            (0, [_, _]) => sphere_newton(solve.u, &linear, rims),
+            // Near a rim's axis the sphere's chart fails (see
+            // `rim_pair_newton`).
+            (0, [a, b]) => sphere_newton(solve.u, &linear, rims)
+                .or_else(|| rim_pair_newton(solve.rim_radials, &linear, a, b)),
             (1, [] | [_]) => {
                 let e1 = solve.u;
                 let e2 = solve.held.axes[0].cross(&e1);
@@ -229,6 +236,72 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
     }
     None
 }
+
+/// The nearest points of two rims, `a` (A's, centre `0`) and `b` (B's,
+/// centre `m`, the sum of the linear terms), by Newton's method on the
+/// angles of their points from the radial directions `starts` (pair
+/// frame, any length: the warm start's points'), as the direction between
+/// them; `None` where the squared distance is not convex there, a step is
+/// too large, a start is zero or the steps do not converge.
+///
+/// It serves where a rim's sine to its axis is below [`RIM_FLOOR`]: there
+/// the rim point turns by the direction's turn over the sine, and on the
+/// sphere of directions `F`'s curvature `r / sine` outgrows the steps'
+/// model, while on the rims' angles nothing is near a singularity. Nor is
+/// the direction a start: near an axis its small part across the axis,
+/// which names the rim point, is the part the warm start's guess gets
+/// wrong. With `D = m + r_b·n_b - r_a·n_a` (`n` a rim's unit radial
+/// direction, `t = axis × n` its tangent, both turning with the angle),
+/// the gradient of `|D|²/2` is `(-r_a·D·t_a, r_b·D·t_b)` and its Hessian
+/// `[[r_a² + r_a·D·n_a, -r_a·r_b·t_a·t_b], [·, r_b² - r_b·D·n_b]]`.
+fn rim_pair_newton(
+    starts: [Vector3<f64>; 2],
+    m: &Vector3<f64>,
+    a: &Rim,
+    b: &Rim,
+) -> Option<Vector3<f64>> {
+    let (&(axis_a, r_a), &(axis_b, r_b)) = (a, b);
+    let unit = |x: Vector3<f64>| {
+        let norm = x.norm();
+        (norm > 0.0 && norm.is_finite()).then(|| x / norm)
+    };
+    let (mut n_a, mut n_b) = (unit(starts[0])?, unit(starts[1])?);
+    for _ in 0..FEATURE_STEPS {
+        let (t_a, t_b) = (axis_a.cross(&n_a), axis_b.cross(&n_b));
+        let d = m + n_b * r_b - n_a * r_a;
+        let (g_a, g_b) = (-r_a * d.dot(&t_a), r_b * d.dot(&t_b));
+        let h_aa = r_a * r_a + r_a * d.dot(&n_a);
+        let h_bb = r_b * r_b - r_b * d.dot(&n_b);
+        let h_ab = -r_a * r_b * t_a.dot(&t_b);
+        let det = h_aa * h_bb - h_ab * h_ab;
+        if !(h_aa > 0.0 && det > 0.0) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let step_a = (h_ab * g_b - h_bb * g_a) * inv_det;
+        let step_b = (h_ab * g_a - h_aa * g_b) * inv_det;
+        let largest = step_a.abs().max(step_b.abs());
+        if largest.is_nan() || largest > LARGEST_STEP {
+            return None;
+        }
+        // Each radial turned by its step, as `line_newton` turns.
+        let turn = |n: Vector3<f64>, t: Vector3<f64>, step: f64| {
+            let along = step * (1.0 + step * step * (1.0 / 3.0));
+            (n + t * along) * inverse_hypot_one(along * along)
+        };
+        (n_a, n_b) = (turn(n_a, t_a, step_a), turn(n_b, t_b, step_b));
+        // Newton's error squares: the next is far below the run's need.
+        if largest < ANGLE_CONVERGED {
+            return unit(m + n_b * r_b - n_a * r_a);
+        }
+    }
+    None
+}
+
+/// The step (radians) on the rims' angles below which
+/// [`rim_pair_newton`] has converged: the next, of its square's order, is
+/// below the quantisation of a cylinder's support codes.
+const ANGLE_CONVERGED: f64 = 1e-6;
 
 /// `1 / √(1 + x2)`, the length's inverse of a unit vector plus a step of
 /// squared length `x2` across it: for a small step (a warm start's) by
@@ -342,7 +415,9 @@ impl ConvexPair<'_> {
     /// and the unit body direction it was taken at, against its feature:
     /// the vertex, one of the held edge's, a vertex of the held face (its
     /// fourth ties with the three held, and round-off picks among them),
-    /// the rim's cap away from its axis.
+    /// the rim's cap. A rim's support near its axis is still its rim's
+    /// point, and where a cap holds the answer instead the supports do not
+    /// certify: the run goes on from them.
     pub(super) fn features_hold(
         &self,
         kinks: &[Kinks; 2],
@@ -366,10 +441,7 @@ impl ConvexPair<'_> {
                         }
                     }
                     Feature::Vertex(vertex) => key == vertex,
-                    Feature::Rim(top) => {
-                        cylinder::is_top(key) == top
-                            && d.x * d.x + d.y * d.y >= RIM_FLOOR * RIM_FLOOR
-                    }
+                    Feature::Rim(top) => cylinder::is_top(key) == top,
                     Feature::Other => false,
                 }
             })
@@ -386,7 +458,7 @@ const FACE_TIE: f64 = 1e-9;
 mod tests {
     use nalgebra::Vector3;
 
-    use super::{inverse_hypot_one, line_newton, sphere_newton};
+    use super::{RIM_FLOOR, inverse_hypot_one, line_newton, rim_pair_newton, sphere_newton};
 
     /// The series agrees with the closed form to an ulp or two on both
     /// sides of its switch.
@@ -472,6 +544,78 @@ mod tests {
                 let slope = (f(&(u + e * 1e-6), &m, &rims) - f(&(u - e * 1e-6), &m, &rims)) / 2e-6;
                 assert!(slope.abs() < 1e-8, "{slope}");
             }
+        }
+    }
+
+    /// Two rims whose nearest points lie just outside A's rim and above
+    /// it, so that the direction between them is within a hundredth of a
+    /// radian of A's axis, where the sphere's closed form gives up: the
+    /// rims' angles give the points that a scan of both angles, refined
+    /// about its best, finds, from starts a tenth of a radian off.
+    #[test]
+    fn rim_pair_newton_finds_the_scanned_nearest_points_near_an_axis() {
+        let (r_a, r_b) = (0.5, 0.3);
+        let axis_b = Vector3::new(0.3, 0.9, 0.2).normalize();
+        let down = (-Vector3::z() + axis_b * axis_b.z).normalize();
+        let side = axis_b.cross(&down);
+        for (angle, outside, height) in [(1.2, 5e-4, 0.1), (-2.0, 3e-4, 0.05), (0.4, 1e-4, 0.3)] {
+            let radial = Vector3::new(f64::cos(angle), f64::sin(angle), 0.0);
+            // B's lowest point hovers over A's rim.
+            let lowest = radial * (r_a + outside) + Vector3::z() * height;
+            let m = lowest - down * r_b;
+            let point = |a: f64, b: f64| {
+                let n_a = Vector3::new(a.cos(), a.sin(), 0.0);
+                let n_b = down * b.cos() + side * b.sin();
+                m + n_b * r_b - n_a * r_a
+            };
+            // The scan: a coarse grid of both angles, then finer grids
+            // about the best.
+            let (mut best, mut span) = ((0.0, 0.0), std::f64::consts::PI);
+            for _ in 0..12 {
+                let (a0, b0) = best;
+                let mut least = f64::INFINITY;
+                for i in -50..=50 {
+                    for j in -50..=50 {
+                        let (a, b) = (
+                            a0 + span * f64::from(i) / 50.0,
+                            b0 + span * f64::from(j) / 50.0,
+                        );
+                        let d = point(a, b).norm();
+                        if d < least {
+                            (least, best) = (d, (a, b));
+                        }
+                    }
+                }
+                span /= 10.0;
+            }
+            let scanned = point(best.0, best.1);
+            let want = scanned / scanned.norm();
+            let sine = want.x.hypot(want.y);
+            assert!(sine < RIM_FLOOR / 4.0, "{sine}");
+            let rims = [(Vector3::z(), r_a), (axis_b, r_b)];
+            assert!(sphere_newton(want, &m, &rims).is_none());
+            let starts = [
+                Vector3::new(f64::cos(angle + 0.1), f64::sin(angle + 0.1), 0.0),
+                down * f64::cos(0.1) - side * f64::sin(0.1),
+            ];
+            let u = rim_pair_newton(starts, &m, &rims[0], &rims[1]).expect("converges");
+            // The scan finds the angles only to about the square root of
+            // f64's precision, the distance is flat there.
+            assert!((u - want).norm() < 1e-7, "{u:?} vs {want:?}");
+            // The rims' points at `u` (A's support at `u`, B's at `-u`)
+            // are the nearest: their difference lies along `u` and is no
+            // longer than the scan's. Near A's axis its rim point turns by
+            // `u`'s round-off over the sine, hence the looser direction.
+            let across =
+                |axis: &Vector3<f64>, d: Vector3<f64>| (d - axis * axis.dot(&d)).normalize();
+            let gap = m + across(&axis_b, -u) * r_b - across(&Vector3::z(), u) * r_a;
+            assert!(
+                gap.norm() <= scanned.norm() + 1e-15,
+                "{} vs {}",
+                gap.norm(),
+                scanned.norm()
+            );
+            assert!((gap / gap.norm() - u).norm() < 1e-10, "{gap:?} vs {u:?}");
         }
     }
 }

@@ -275,6 +275,10 @@ pub(super) struct Solve {
     this_top: [bool; 2],
     /// The constraints of the held kinks, kept from one step to the next.
     pub(super) held: Constraints,
+    /// Where a warm start names two rims, each one's radial direction at
+    /// its warm point (pair frame, any length): where the closed form
+    /// starts on the rims' angles (see `feature_seed`).
+    pub(super) rim_radials: [Vector3<f64>; 2],
 }
 
 impl Solve {
@@ -394,6 +398,11 @@ impl ConvexPair<'_> {
         }
         for edge in &solve.edges[..solve.edge_count] {
             held.add(*edge);
+        }
+        if let [Feature::Rim(_), Feature::Rim(_)] = features {
+            let radial =
+                |k: usize, x: Vector3<f64>| self.in_pair_frame(k, Vector3::new(x.x, x.y, 0.0));
+            solve.rim_radials = [radial(0, first_a), radial(1, first_b)];
         }
         let guess = self.last_direction(&solve, features, [first_a, first_b], &mean);
         // Projected first and normalised once: the guess's length is not

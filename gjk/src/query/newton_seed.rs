@@ -601,8 +601,10 @@ impl ConvexPair<'_> {
     /// The close of the steps at the converged direction `solve.u`: the
     /// seed from the supports there, unless a held side or face turns out
     /// not to hold the answer (then it is let go and the steps go on from
-    /// the direction turned off it), or the supports do not name the
-    /// `features` a closed form assumed.
+    /// the direction turned off it, moved onto the kinks still held: a
+    /// step from off them is moved back by as much, after the test that
+    /// judged it converged), or the supports do not name the `features` a
+    /// closed form assumed.
     fn close_at(&self, solve: &mut Solve, stop_d: f64, features: Option<[Feature; 2]>) -> Close {
         let u = solve.u;
         let d_b = -rotate_back(&self.rotation, &u);
@@ -616,7 +618,13 @@ impl ConvexPair<'_> {
         let tops = [a.0, b.0].map(|code| cylinder::is_top(code as u32));
         if solve.side != [false; 2] && self.leave_false_sides(solve, &support.y, tops) {
             solve.held = solve.constraints(&self.axes());
-            return Close::Reopened;
+            return match solve.held.project(&solve.u) {
+                Some(u) => {
+                    solve.u = u;
+                    Close::Reopened
+                }
+                None => Close::Failed,
+            };
         }
         match self.seed_of_supports(solve, a, b, support, stop_d) {
             Closing::Seeded(seeding) => Close::Done(seeding),

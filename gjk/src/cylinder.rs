@@ -92,6 +92,12 @@ pub(crate) fn is_top(code: u32) -> bool {
     code & TOP != 0
 }
 
+/// Whether `code` is a rim point (not a cap's centre).
+#[inline(always)]
+pub(crate) fn on_rim(code: u32) -> bool {
+    code & !TOP != 0
+}
+
 /// The point of `code` on the cylinder of radius `r`, half-height `h`
 /// (its body frame, centred at the origin).
 #[inline(always)]

@@ -359,10 +359,17 @@ impl ConvexPair<'_> {
             let first = index(&pairs[0]);
             if shape.cylinder_dimensions().is_some() {
                 solve.side[k] = pairs.iter().any(|p| index(p) == cylinder::other_cap(first));
+                let top = cylinder::is_top(first);
+                // Several points of one cap that `warm_cap_seed` found not
+                // to hold the answer are a rim's too: a run that crept
+                // along the rim, its points a sliver apart, ended there.
+                let one_cap = |p: &[u32; 2]| cylinder::is_top(index(p)) == top;
                 features[k] = if solve.side[k] {
                     Feature::Side
-                } else if pairs.iter().all(|p| index(p) == first) {
-                    Feature::Rim(cylinder::is_top(first))
+                } else if pairs.iter().all(|p| index(p) == first)
+                    || (cylinder::on_rim(first) && pairs.iter().all(one_cap))
+                {
+                    Feature::Rim(top)
                 } else {
                     Feature::Other
                 };

@@ -45,7 +45,10 @@ pub(super) fn push_vertex<const AVX2: bool>(simplex: &mut Simplex, keep: u8, poi
     simplex.push(keep, point);
 }
 
-/// Seeds a run may take (see `newton_seed`).
+/// Seeds a run may take (see `newton_seed`), besides a warm start's: a
+/// warm seed that names features the answer has left (a rim that moved
+/// from an edge to the next) leaves the run as far from the answer as a
+/// cold start, and it needs as many.
 const MAX_SEEDS: u32 = 2;
 
 /// Plain iterations after a seed before the next.
@@ -198,7 +201,7 @@ impl ConvexPair<'_> {
                     return self.certified_run::<AVX2>(simplex, &state, done);
                 }
                 Some(Seeding::Start(seed)) => {
-                    (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS - 1);
+                    (next_seed, seeds_left) = (1 + RESEED_AFTER, MAX_SEEDS);
                     (seed_share, seed_floor) = (RESEED_SHARE, RESEED_SLACKS * self.slack);
                     state.lower = seed.lower;
                     reset_simplex::<AVX2>(simplex, &seed.points[..seed.len]);

@@ -575,19 +575,21 @@ fn warm_motion_against(other: &Bracketed) -> (u32, u32) {
 }
 
 /// Random motions of boxes, point clouds' hulls and thin cylinders past a
-/// cylinder, each query from the previous answer: a warm query seldom
-/// takes more than two iterations beyond its cold one (where the answer
-/// changes feature, or the shapes nearly touch and the cold run crawls
-/// too), and every warm answer agrees with the cold one. Before a run that
-/// crept along a rim was read as the rim's, and before a warm seed that
-/// named features the answer had left still left the run both of a cold
-/// run's seeds, 12 of these 48 161 separated warm steps took more than two
-/// iterations beyond their cold query and 23 took 20 or more; now 9 and 11.
+/// cylinder, each query asked cold and from the previous answer: near
+/// contact a cold run can crawl along a rim, an iteration a digit, and a
+/// warm one seldom takes more than two iterations beyond its cold one;
+/// every warm answer agrees with the cold one. Of these 48 161 separated
+/// warm steps, before Newton's steps halved an overshoot into directions
+/// that do not separate the shapes (near contact they are a narrow cone),
+/// 188 cold queries took 20 or more iterations, now 113. Beyond cold + 2
+/// and of 20 or more iterations warm: 12 and 23 before a run that crept
+/// along a rim was read as the rim's and a warm seed no longer counted
+/// against the run's two; 9 and 11 after; 5 and 3 with the halving.
 #[test]
-fn warm_motions_past_a_cylinder_stay_near_their_cold_iterations() {
+fn motions_past_a_cylinder_seldom_crawl_warm_or_cold() {
     let mut rng = Rng(0x5eed_7a11_0000_0001);
     let (opts, id) = (Options::default(), Isometry3::identity());
-    let (mut steps, mut slower, mut crawled) = (0u32, 0u32, 0u32);
+    let (mut steps, mut slower, mut crawled, mut cold_crawled) = (0u32, 0u32, 0u32, 0u32);
     for _ in 0..200 {
         let cylinder = cyl(rng.range(0.1, 1.1), rng.range(0.1, 1.1), 0.0);
         let other: Shape = match rng.range(0.0, 3.0) as u32 {
@@ -628,18 +630,17 @@ fn warm_motions_past_a_cylinder_stay_near_their_cold_iterations() {
                 steps += 1;
                 slower += u32::from(hot.iterations > cold.iterations + 2);
                 crawled += u32::from(hot.iterations >= 20);
+                cold_crawled += u32::from(cold.iterations >= 20);
             }
             warm = Some(hot.warm_start);
         }
     }
     assert!(steps > 40_000, "{steps} separated warm steps");
+    assert!(slower <= 6, "{slower} of {steps} slower than cold + 2");
+    assert!(crawled <= 5, "{crawled} of {steps} took 20 or more");
     assert!(
-        slower <= steps / 2000,
-        "{slower} of {steps} slower than cold + 2"
-    );
-    assert!(
-        crawled <= steps / 2500,
-        "{crawled} of {steps} took 20 or more"
+        cold_crawled <= 140,
+        "{cold_crawled} of {steps} took 20 or more cold"
     );
 }
 

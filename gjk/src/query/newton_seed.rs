@@ -73,6 +73,10 @@ pub(super) struct Certificate {
 /// Newton steps before the seed is given up.
 const MAX_STEPS: u32 = 12;
 
+/// How often a step that overshot the directions separating the shapes is
+/// halved before the seed is given up.
+const MAX_HALVINGS: u32 = 3;
+
 /// The sine of the angle to a cylinder's axis below which a direction is
 /// tried against its cap (see `cap_seed`): Newton's steps close in on a
 /// cap's answer without reaching it.
@@ -548,6 +552,10 @@ impl ConvexPair<'_> {
         // Whether the supports may be the answer: at the start (a warm
         // start at the same pose) and after a step below `NEAR_STEP`.
         let mut near = true;
+        // The last step taken (the direction before it, and the step) and
+        // how often it was halved.
+        let mut taken: Option<(Vector3<f64>, Vector3<f64>)> = None;
+        let mut halvings = 0;
         for _ in 0..MAX_STEPS {
             let Some(touches) = self.touches(&solve.u) else {
                 // Along an axis: only its cap can hold the answer.
@@ -580,7 +588,22 @@ impl ConvexPair<'_> {
                 continue;
             }
             last = Some(touches);
-            let mut step = newton_step(&solve.u, &solve.held, &touches)?;
+            let Some(mut step) = newton_step(&solve.u, &solve.held, &touches) else {
+                // The step overshot into directions along which the
+                // shapes' projections overlap (near contact the directions
+                // that separate them are a narrow cone): half of it, from
+                // where it was taken.
+                let (from, overshot) = taken?;
+                if halvings == MAX_HALVINGS {
+                    return None;
+                }
+                halvings += 1;
+                let half = overshot * 0.5;
+                solve.u = solve.held.project(&(from + half))?;
+                taken = Some((from, half));
+                last = None;
+                continue;
+            };
             let landed = stop_at_side(solve, &touches, &mut step);
             if landed {
                 solve.held = solve.constraints(&self.axes());
@@ -592,6 +615,7 @@ impl ConvexPair<'_> {
             let small = step.norm_squared() < converged_step * converged_step;
             near = step.norm_squared() < NEAR_STEP * NEAR_STEP;
             let converged = !landed && (small || solve.held.len == 2);
+            taken = Some((solve.u, step));
             solve.u = solve.held.project(&(solve.u + step))?;
             if !converged {
                 continue;

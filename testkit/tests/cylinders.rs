@@ -581,7 +581,8 @@ fn warm_motion_against(other: &Bracketed) -> (u32, u32) {
 /// every warm answer agrees with the cold one. Of these 48 161 separated
 /// warm steps, before Newton's steps halved an overshoot into directions
 /// that do not separate the shapes (near contact they are a narrow cone),
-/// 188 cold queries took 20 or more iterations, now 113. Beyond cold + 2
+/// 188 cold queries took 20 or more iterations, then 113, and 101 once a
+/// face whose seed projects past its outer edge was let go. Beyond cold + 2
 /// and of 20 or more iterations warm: 12 and 23 before a run that crept
 /// along a rim was read as the rim's and a warm seed no longer counted
 /// against the run's two; 9 and 11 after; 5 and 3 with the halving.
@@ -639,7 +640,7 @@ fn motions_past_a_cylinder_seldom_crawl_warm_or_cold() {
     assert!(slower <= 6, "{slower} of {steps} slower than cold + 2");
     assert!(crawled <= 5, "{crawled} of {steps} took 20 or more");
     assert!(
-        cold_crawled <= 140,
+        cold_crawled <= 110,
         "{cold_crawled} of {steps} took 20 or more cold"
     );
 }

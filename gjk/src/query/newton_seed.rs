@@ -865,7 +865,10 @@ impl ConvexPair<'_> {
     /// start on the wrong half of the face and close in on a rim's point
     /// linearly, an iteration a digit. The missing corner is the support
     /// at the face's direction tilted across the edge that the projection
-    /// lies past.
+    /// lies past. Where the projection lies off the face (past an edge
+    /// with no corner beyond it, or past an outer edge of the face's other
+    /// half), the keys of that edge and the direction across it: the face
+    /// does not hold the answer (see `let_go_of_face`).
     /// Shape `face` (0 for A) holds the face; `other` is the other
     /// shape's point; `u` the face's unit direction (A's support at `u`).
     #[cold]
@@ -889,7 +892,7 @@ impl ConvexPair<'_> {
             };
             (!known.contains(&index(&corner))).then_some(corner)
         })?;
-        Some(([known[i], known[j]], away))
+        Some(([index(&i), index(&j)], away))
     }
 
     /// Lets go of a held face of shape `face` that does not hold the
@@ -970,46 +973,66 @@ fn certifies(u: &Vector3<f64>, y: &Vector3<f64>, f: f64, slack: f64, stop_d: f64
 /// origin's projection on its plane: when the projection lies past one of
 /// its edges, the corner opposite that edge is replaced by
 /// `corner(opposite, away)` (`away` the unit direction across the edge,
-/// in the plane), if the new triangle holds the projection. Otherwise the
-/// seed stays as it is (the run certifies from any start); when `corner`
-/// gives none, the edge's corners and `away`.
+/// in the plane), if the new triangle holds the projection. When `corner`
+/// gives none, the edge's corners and `away`: nothing lies past that edge.
+/// When the new triangle lies past another of its own edges, that edge's
+/// corners and the direction across it: the projection is past both
+/// halves of a face, off the face. Otherwise the seed stays as it is (the
+/// run certifies from any start).
 fn turn_triangle(
     points: &mut [Vertex; 3],
     u: &Vector3<f64>,
     corner: impl FnOnce(usize, Vector3<f64>) -> Option<Vertex>,
-) -> Option<(usize, usize, Vector3<f64>)> {
+) -> Option<(Vertex, Vertex, Vector3<f64>)> {
     let projection = u * u.dot(&points[0].y);
     let weights = triangle_weights(points.map(|p| p.y), &projection)?;
+    let (k, least) = least_weight(&weights);
+    if least >= -HOLDS_SLACK {
+        return None;
+    }
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let away = away_across(points, u, k)?;
+    let Some(corner) = corner(k, away) else {
+        return Some((points[i], points[j], away));
+    };
+    let mut turned = *points;
+    turned[k] = corner;
+    let weights = triangle_weights(turned.map(|p| p.y), &projection)?;
+    let (m, least) = least_weight(&weights);
+    if least >= -HOLDS_SLACK {
+        *points = turned;
+        return None;
+    }
+    // Past the new corner's weight is back across the edge the turn
+    // crossed: not a face's outer edge.
+    if m == k {
+        return None;
+    }
+    let away = away_across(&turned, u, m)?;
+    Some((turned[(m + 1) % 3], turned[(m + 2) % 3], away))
+}
+
+/// The least of a triangle's three weights, and its corner.
+fn least_weight(weights: &[f64; 3]) -> (usize, f64) {
     let (k, &least) = weights
         .iter()
         .enumerate()
         .min_by(|x, y| x.1.total_cmp(y.1))
         .expect("three weights");
-    if least >= -HOLDS_SLACK {
-        return None;
-    }
-    // Towards the edge from the corner opposite it, across the edge.
+    (k, least)
+}
+
+/// The unit direction in the plane across `u` (unit) from triangle
+/// `points`' corner `k` across the edge opposite it, outwards; `None` for
+/// a degenerate edge.
+fn away_across(points: &[Vertex; 3], u: &Vector3<f64>, k: usize) -> Option<Vector3<f64>> {
     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
     let edge = points[j].y - points[i].y;
     let out = points[i].y - points[k].y;
     let away = out - edge * (edge.dot(&out) / edge.norm_squared());
     let away = away - u * u.dot(&away);
     let norm = away.norm();
-    if !(norm > 0.0 && norm.is_finite()) {
-        return None;
-    }
-    let away = away / norm;
-    let Some(corner) = corner(k, away) else {
-        return Some((i, j, away));
-    };
-    let mut turned = *points;
-    turned[k] = corner;
-    if triangle_weights(turned.map(|p| p.y), &projection)
-        .is_some_and(|w| w.iter().all(|&x| x >= -HOLDS_SLACK))
-    {
-        *points = turned;
-    }
-    None
+    (norm > 0.0 && norm.is_finite()).then(|| away / norm)
 }
 
 /// How far outside a seed face's triangle its point's projection may lie,
@@ -1193,8 +1216,8 @@ mod tests {
 
     use super::super::numerical_algorithm::RunOutcome;
     use super::super::pair::{ConvexPair, PiecePlacement};
-    use super::Seeding;
-    use crate::johnson::Simplex;
+    use super::{Seeding, turn_triangle};
+    use crate::johnson::{Simplex, Vertex};
     use crate::shape::tests::Rng;
     use crate::{Convex, Options, Precision};
 
@@ -1441,5 +1464,73 @@ mod tests {
             Some(&[[7, 1 << 31], [1 << 30, 12345]]),
         );
         assert!((far.norm - plain.norm).abs() <= 1e-12);
+    }
+
+    /// A seed triangle of a unit square face (in the plane `z = 1`, `u`
+    /// along `z`), the origin's projection at `(x, y)`: inside the first
+    /// half, the seed stays; in the other half, it turns to the fourth
+    /// corner; past an outer edge of the other half, off the face, the
+    /// edge's corners and the outward direction come back; past an outer
+    /// edge of the first half, where the support across the edge finds no
+    /// new corner, the same.
+    #[test]
+    fn seed_triangles_turn_to_the_half_or_off_the_face() {
+        // The face's corners less the projection: the origin projects
+        // onto the face at `p`.
+        let corner = |x: f64, y: f64, key: u32| Vertex {
+            y: Vector3::new(x, y, 1.0),
+            ia: 0,
+            ib: key,
+        };
+        let u = Vector3::new(0.0, 0.0, -1.0);
+        // Keys 0 to 3 at (0, 0), (1, 0), (1, 1), (0, 1); the seed is the
+        // half (0, 1, 3), the fourth corner 2.
+        let square = |p: (f64, f64)| {
+            [(0.0, 0.0, 0), (1.0, 0.0, 1), (0.0, 1.0, 3)]
+                .map(|(x, y, k)| corner(x - p.0, y - p.1, k))
+        };
+        let fourth = |p: (f64, f64), from: &[Vertex; 3]| {
+            let mut known = from.map(|v| v.ib);
+            known.sort_unstable();
+            (known == [0, 1, 3]).then(|| corner(1.0 - p.0, 1.0 - p.1, 2))
+        };
+        let keys = |v: &[Vertex; 3]| {
+            let mut k = v.map(|v| v.ib);
+            k.sort_unstable();
+            k
+        };
+        // Inside the seed's half.
+        let p = (0.2, 0.3);
+        let mut points = square(p);
+        let seed = points;
+        assert!(turn_triangle(&mut points, &u, |_, _| fourth(p, &seed)).is_none());
+        assert_eq!(keys(&points), [0, 1, 3]);
+        // In the other half: turned to it.
+        let p = (0.8, 0.7);
+        let mut points = square(p);
+        let seed = points;
+        assert!(turn_triangle(&mut points, &u, |_, _| fourth(p, &seed)).is_none());
+        assert_eq!(keys(&points), [1, 2, 3]);
+        // Past the other half's edge from (1, 0) to (1, 1): off the face,
+        // outwards along x.
+        let p = (1.3, 0.6);
+        let mut points = square(p);
+        let seed = points;
+        let (i, j, away) =
+            turn_triangle(&mut points, &u, |_, _| fourth(p, &seed)).expect("off the face");
+        let mut edge = [i.ib, j.ib];
+        edge.sort_unstable();
+        assert_eq!(edge, [1, 2]);
+        assert!((away - Vector3::x()).norm() < 1e-12, "{away:?}");
+        assert_eq!(keys(&points), [0, 1, 3], "the seed stays");
+        // Past the seed's own outer edge from (0, 0) to (1, 0), where the
+        // support across it finds no new corner.
+        let p = (0.4, -0.5);
+        let mut points = square(p);
+        let (i, j, away) = turn_triangle(&mut points, &u, |_, _| None).expect("off the face");
+        let mut edge = [i.ib, j.ib];
+        edge.sort_unstable();
+        assert_eq!(edge, [0, 1]);
+        assert!((away + Vector3::y()).norm() < 1e-12, "{away:?}");
     }
 }

@@ -225,10 +225,7 @@ fn line_newton(p: f64, q: f64, g1: f64, g2: f64, r: f64) -> Option<(f64, f64)> {
         if step.is_nan() || step.abs() > LARGEST_STEP {
             return None;
         }
-        // The turn by `step` radians: `tan(step)` along the tangent, to
-        // the cube's order, then back onto the circle.
-        let along = step * (1.0 + step * step * (1.0 / 3.0));
-        let k = inverse_hypot_one(along * along);
+        let (along, k) = turn_by(step);
         (cos, sin) = ((cos - sin * along) * k, (sin + cos * along) * k);
         if newton.abs() < cubic_converged(root) {
             return Some((cos, sin));
@@ -284,10 +281,9 @@ fn rim_pair_newton(
         if largest.is_nan() || largest > LARGEST_STEP {
             return None;
         }
-        // Each radial turned by its step, as `line_newton` turns.
         let turn = |n: Vector3<f64>, t: Vector3<f64>, step: f64| {
-            let along = step * (1.0 + step * step * (1.0 / 3.0));
-            (n + t * along) * inverse_hypot_one(along * along)
+            let (along, k) = turn_by(step);
+            (n + t * along) * k
         };
         (n_a, n_b) = (turn(n_a, t_a, step_a), turn(n_b, t_b, step_b));
         // Newton's error squares: the next is far below the run's need.
@@ -302,6 +298,16 @@ fn rim_pair_newton(
 /// [`rim_pair_newton`] has converged: the next, of its square's order, is
 /// below the quantisation of a cylinder's support codes.
 const ANGLE_CONVERGED: f64 = 1e-6;
+
+/// The turn of a unit vector `n` by `step` radians towards its unit
+/// tangent `t`: `(along, k)` with `(n + t·along)·k` the turned vector,
+/// `along` being `tan(step)` to the cube's order and `k` the scale back
+/// onto the circle.
+#[inline(always)]
+fn turn_by(step: f64) -> (f64, f64) {
+    let along = step * (1.0 + step * step * (1.0 / 3.0));
+    (along, inverse_hypot_one(along * along))
+}
 
 /// `1 / √(1 + x2)`, the length's inverse of a unit vector plus a step of
 /// squared length `x2` across it: for a small step (a warm start's) by

@@ -429,10 +429,12 @@ impl ConvexPair<'_> {
     /// direction is `u`, B's `-u`); a rim's lies in the plane of its axis
     /// and rim direction, which a held edge cuts to a line, and into which
     /// two rims move the direction of the mean of the warm start's points
-    /// (`mean`) at the new pose. Otherwise the mean's direction. Along a motion the nearest points slide: the mean's direction
-    /// turns by their slide over their distance, the features' by the
-    /// slide over the curvatures' radii, far less where the shapes are
-    /// near. `first` holds each shape's first warm point (body frame).
+    /// (`mean`) at the new pose. Otherwise the mean's direction. Along a
+    /// motion the nearest points slide: the mean's direction turns by
+    /// their slide over their distance, the features' by the slide over
+    /// the curvatures' radii, far less where the shapes are near. `first`
+    /// holds each shape's first warm point (body frame); two rims' radial
+    /// directions are already in `solve.rim_radials`.
     fn last_direction(
         &self,
         solve: &Solve,
@@ -455,7 +457,8 @@ impl ConvexPair<'_> {
             [Feature::Rim(_), Feature::Rim(_)] => {
                 let onto =
                     |x: Vector3<f64>, n: Vector3<f64>| x - n * (n.dot(&x) / n.norm_squared());
-                onto(onto(-mean, rim_plane(0)), rim_plane(1))
+                let plane = |k: usize| self.axes()[k].cross(&solve.rim_radials[k]);
+                onto(onto(-mean, plane(0)), plane(1))
             }
             _ => -mean,
         }

@@ -1,0 +1,573 @@
+"""gjkd for OMPL: a robot's collision checks for OMPL's planners, answered by a
+gjkd server.
+
+OMPL (pip ``ompl`` 2.x) asks a planner's two questions through a state
+validity checker ("is this configuration free?") and a motion validator
+("is the straight motion between two configurations free?"). Here both are
+answered by one scene request each to a gjkd server (:class:`RobotChecker`),
+and :func:`simple_setup` wires them into an ``og.SimpleSetup`` with the
+joint bounds of the robot's URDF::
+
+    import gjkd
+    import gjkd.ompl
+
+    with gjkd.Server(service="plan", scene="scene.toml") as server, \\
+            gjkd.Client(server.service) as client:
+        checker = gjkd.ompl.RobotChecker(
+            client, "panda", "panda.urdf", srdf="panda.srdf",
+            package_path=["packages"], margin=0.01,
+            joints=[f"panda_joint{i}" for i in range(1, 8)],
+            fixed={"panda_finger_joint1": 0.04},
+        )
+        setup = gjkd.ompl.simple_setup(checker)
+        path = gjkd.ompl.plan(setup, start, goal, time=1.0)  # (n, 7) or None
+
+What a state is valid against: every link of the robot at more than
+``margin`` from every other object the server holds, and from every other
+link of the robot, except the allowed pairs (the SRDF's
+``disable_collisions`` pairs and the links joined by a joint, as gjkd reads
+them). A pair is reported when its certified lower bound is at most the
+margin, so a state is never accepted on an uncertain answer.
+
+The motion validator checks the straight joint-space segment at OMPL's
+resolution (``si.getStateValidityCheckingResolution()`` of the space's
+extent, OMPL's discrete motion validator's steps), all of them in one path
+request. It is sampled: an obstacle thinner than a step can be missed.
+:meth:`RobotChecker.motion_valid` is the one place the certified continuous
+check will replace.
+
+Errors: every method of :class:`RobotChecker` raises the package's
+exceptions (:class:`gjkd.Error` and its subclasses). Inside OMPL's callbacks
+an exception must not unwind through the planner, so the OMPL adapters
+catch it, report the state or motion invalid (never accept what was not
+checked), keep the first exception in :attr:`RobotChecker.error`, and stop
+the planner at its next termination check; :func:`plan` then raises it.
+
+``ompl`` is imported only by the functions that need it (:func:`simple_setup`,
+:func:`plan`, :func:`clearance_objective`); :class:`RobotChecker` works
+without it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ElementTree
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from ._errors import Error, InvalidInput
+from ._native import Client, Robot, SceneRows
+
+__all__ = [
+    "RobotChecker",
+    "allowed_link_pairs",
+    "clearance_objective",
+    "plan",
+    "simple_setup",
+]
+
+_PathLike = Union[str, "os.PathLike[str]"]
+_F64 = npt.NDArray[np.float64]
+
+# Where the shadow copy of the robot waits between requests: far from any
+# scene a robot plans in, so that no other client's question meets it.
+_PARKED = [1.0e6, 1.0e6, 1.0e6, 0.0, 0.0, 0.0, 1.0]
+
+
+def _read(path: Optional[_PathLike], text: Optional[str]) -> Optional[str]:
+    if text is not None:
+        return text
+    if path is None:
+        return None
+    with open(path, encoding="utf-8") as f:
+        return f.read()
+
+
+def allowed_link_pairs(urdf_text: str, srdf_text: Optional[str]) -> set[frozenset[str]]:
+    """The link pairs a robot's collision checks skip, by link name: the
+    SRDF's ``disable_collisions`` pairs and every pair of links joined by a
+    joint (the rule gjkd's server applies to a robot's own links).
+
+    Raises:
+        gjkd.InvalidInput: the URDF or SRDF is not XML.
+    """
+    pairs: set[frozenset[str]] = set()
+    try:
+        for joint in ElementTree.fromstring(urdf_text).iter("joint"):
+            parent, child = joint.find("parent"), joint.find("child")
+            if parent is not None and child is not None:
+                pairs.add(frozenset((parent.get("link", ""), child.get("link", ""))))
+    except ElementTree.ParseError as e:
+        raise InvalidInput(f"URDF: {e}", field="urdf") from e
+    if srdf_text is not None:
+        try:
+            for d in ElementTree.fromstring(srdf_text).iter("disable_collisions"):
+                pairs.add(frozenset((d.get("link1", ""), d.get("link2", ""))))
+        except ElementTree.ParseError as e:
+            raise InvalidInput(f"SRDF: {e}", field="srdf") from e
+    return pairs
+
+
+class RobotChecker:
+    """A robot's state, motion and clearance checks against everything a
+    gjkd server holds, one scene request per call.
+
+    Registers the robot (``name``) from its URDF, and a shadow copy
+    (``name + "~self"``) parked far away: a scene question pairs a group's
+    members with every object outside the group but never with each other,
+    so each request moves the shadow's links to the robot's poses too, and
+    the robot's links meet the shadow's wherever a self-collision pair is
+    not allowed (each such pair once; a link and its own shadow, and the
+    allowed pairs, are passed as allowed). Both are removed by
+    :meth:`close`.
+
+    Args:
+        client: a connected :class:`gjkd.Client`.
+        name: the robot's name on the server (its links are
+            ``name/link``).
+        urdf, urdf_text, srdf, srdf_text, package_path, base: as
+            :meth:`gjkd.Client.register_robot`.
+        margin: a state is valid when every pair checked is farther apart
+            than this (``>= 0``).
+        joints: the joints planned, in the order of OMPL's state (default:
+            every moving joint, in the URDF's order).
+        fixed: positions of the joints not planned, by name (default: 0
+            clamped into the joint's limits).
+        resolution: the motion validator's step, as a fraction of the
+            space's extent (OMPL's default 0.01); :func:`simple_setup` sets
+            the same on OMPL's space information.
+
+    Raises:
+        gjkd.Error: the robot cannot be registered (see
+            :meth:`gjkd.Client.register_robot`), a joint name is unknown, or
+            the margin or resolution is not a finite number in range.
+
+    Counters: :attr:`state_checks`, :attr:`edge_checks` and
+    :attr:`edge_steps` count the questions answered (for benchmarks).
+    """
+
+    def __init__(
+        self,
+        client: Client,
+        name: str,
+        urdf: Optional[_PathLike] = None,
+        *,
+        urdf_text: Optional[str] = None,
+        srdf: Optional[_PathLike] = None,
+        srdf_text: Optional[str] = None,
+        package_path: Sequence[_PathLike] = (),
+        base: Optional[npt.ArrayLike] = None,
+        margin: float = 0.0,
+        joints: Optional[Sequence[str]] = None,
+        fixed: Optional[Mapping[str, float]] = None,
+        resolution: float = 0.01,
+    ) -> None:
+        if not (math.isfinite(margin) and margin >= 0.0):
+            raise InvalidInput(f"margin must be a finite number >= 0, not {margin}", field="margin")
+        if not (math.isfinite(resolution) and 0.0 < resolution <= 1.0):
+            raise InvalidInput(
+                f"resolution must be in (0, 1], not {resolution}", field="resolution"
+            )
+        try:
+            text = _read(urdf, urdf_text)
+            srdf_str = _read(srdf, srdf_text)
+        except OSError as e:
+            raise InvalidInput(f"cannot read {e.filename}: {e.strerror}", field="urdf") from e
+        if text is None:
+            raise InvalidInput("a URDF is needed: urdf or urdf_text", field="urdf")
+        allowed = allowed_link_pairs(text, srdf_str)
+        paths = list(package_path)
+        if urdf is not None:
+            # Relative mesh paths are read next to the URDF file, also for
+            # the shadow, which is registered from the same file.
+            robot = client.register_robot(
+                name, urdf, srdf_text=srdf_str, package_path=paths, base=base
+            )
+        else:
+            robot = client.register_robot(
+                name, urdf_text=text, srdf_text=srdf_str, package_path=paths, base=base
+            )
+        try:
+            if urdf is not None:
+                shadow = client.register_robot(
+                    name + "~self", urdf, srdf_text=srdf_str, package_path=paths, base=_PARKED
+                )
+            else:
+                shadow = client.register_robot(
+                    name + "~self",
+                    urdf_text=text,
+                    srdf_text=srdf_str,
+                    package_path=paths,
+                    base=_PARKED,
+                )
+        except Error:
+            client.remove(robot.id)
+            raise
+        self.client = client
+        self.robot: Robot = robot
+        self.shadow: Robot = shadow
+        self.margin = float(margin)
+        self.resolution = float(resolution)
+        self.error: Optional[BaseException] = None
+        self.state_checks = 0
+        self.edge_checks = 0
+        self.edge_steps = 0
+        try:
+            self._choose_joints(joints, fixed)
+        except Error:
+            self.close()
+            raise
+        self._plan_pairs(allowed)
+        self._rows = SceneRows(256)
+
+    def _choose_joints(
+        self, joints: Optional[Sequence[str]], fixed: Optional[Mapping[str, float]]
+    ) -> None:
+        names = self.robot.joint_names
+        lower, upper = self.robot.lower, self.robot.upper
+        chosen = list(names) if joints is None else list(joints)
+        for j in chosen + list(fixed or {}):
+            if j not in names:
+                raise InvalidInput(f"the robot has no moving joint {j!r}", field="joints")
+        self.joint_names: list[str] = chosen
+        self._index = np.array([names.index(j) for j in chosen], dtype=np.intp)
+        self._full = np.clip(np.zeros(len(names)), lower, upper)
+        for j, v in (fixed or {}).items():
+            self._full[names.index(j)] = float(v)
+        # A continuous joint has no limits: OMPL's real vector space needs
+        # bounds, and one turn either way covers every orientation.
+        self.lower: _F64 = np.where(np.isfinite(lower), lower, -math.pi)[self._index]
+        self.upper: _F64 = np.where(np.isfinite(upper), upper, math.pi)[self._index]
+        self.extent = float(np.linalg.norm(self.upper - self.lower))
+
+    def _plan_pairs(self, allowed: set[frozenset[str]]) -> None:
+        names = self.robot.link_names
+        ids, shadow_ids = self.robot.link_ids, self.shadow.link_ids
+        links = [i for i in range(len(names)) if ids[i] != 0]
+        # Link i meets shadow link j only for i < j and a pair not allowed.
+        meets = {
+            (i, j)
+            for i in links
+            for j in links
+            if i < j and frozenset((names[i], names[j])) not in allowed
+        }
+        partners = sorted({j for _, j in meets})
+        allow = [
+            (int(ids[i]), int(shadow_ids[j]))
+            for j in partners
+            for i in links
+            if (i, j) not in meets
+        ]
+        # The shadow's links that never take part stay parked.
+        self._links = np.array(links, dtype=np.intp)
+        self._partners = np.array(partners, dtype=np.intp)
+        self._objects = np.concatenate([ids[links], shadow_ids[partners]]).astype(np.uint64)
+        self._allow = np.array(allow, dtype=np.uint64).reshape(-1, 2)
+        self.self_pairs = len(meets)
+
+    # -- positions ---------------------------------------------------------
+
+    @property
+    def dof(self) -> int:
+        """The number of joints planned (the length of OMPL's state)."""
+        return len(self.joint_names)
+
+    def positions(self, q: npt.ArrayLike) -> _F64:
+        """The robot's whole ``(dof_robot,)`` position array for the planned
+        joints' ``q``, the others at their fixed positions."""
+        full = self._full.copy()
+        full[self._index] = np.asarray(q, dtype=np.float64)
+        return full
+
+    def _poses(self, qs: _F64) -> _F64:
+        """``(S * objects, 7)`` poses of the robot's and the shadow's moved
+        links at each row of ``qs``."""
+        out = np.empty((len(qs), len(self._objects), 7))
+        n = len(self._links)
+        for s, q in enumerate(qs):
+            poses = self.robot.link_poses(self.positions(q))
+            out[s, :n] = poses[self._links]
+            out[s, n:] = poses[self._partners]
+        return out.reshape(-1, 7)
+
+    def _steps(self, qs: npt.ArrayLike) -> _F64:
+        a = np.asarray(qs, dtype=np.float64)
+        if a.ndim == 1:
+            a = a[None, :]
+        if a.ndim != 2 or a.shape[1] != self.dof or a.shape[0] == 0:
+            raise InvalidInput(
+                f"positions must be ({self.dof},) or (S, {self.dof}), not {a.shape}",
+                field="positions",
+            )
+        if not np.all(np.isfinite(a)):
+            raise InvalidInput("positions must be finite", field="positions")
+        return a
+
+    def _ask(self, qs: _F64, question: str) -> Any:
+        return self.client.path(
+            self.robot.id,
+            self._objects,
+            self._poses(qs),
+            out=self._rows,
+            question=question,
+            margin=self.margin,
+            allow=self._allow,
+        )
+
+    # -- the questions ------------------------------------------------------
+
+    def is_valid(self, q: npt.ArrayLike) -> bool:
+        """Whether the robot at ``q`` (the planned joints) is farther than the
+        margin from everything (one request)."""
+        self.state_checks += 1
+        return bool(self._ask(self._steps(q), "first_hit").first_hit is None)
+
+    def are_valid(self, qs: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Whether each row of ``(S, dof)`` ``qs`` is valid: one request for
+        all of them (more only if the rows of one answer do not fit)."""
+        steps = self._steps(qs)
+        self.state_checks += len(steps)
+        valid = np.ones(len(steps), dtype=bool)
+        start = 0
+        while start < len(steps):
+            s = self._ask(steps[start:], "within")
+            hit = self._rows.step[: s.written].astype(np.intp) + start
+            valid[hit] = False
+            if not s.truncated:
+                break
+            # Rows come step by step: the last step written is invalid
+            # already, the ones after it are asked again.
+            start = int(hit.max()) + 1
+        return valid
+
+    def segment(self, q0: npt.ArrayLike, q1: npt.ArrayLike) -> _F64:
+        """The states the motion validator checks between ``q0`` and ``q1``:
+        ``n = ceil(|q1 - q0| / (resolution * extent))`` steps (OMPL's
+        discrete motion validator's count), ``q1`` and the ``n - 1`` between,
+        not ``q0`` (a planner's edge starts at a state already valid)."""
+        a, b = self._steps(q0)[0], self._steps(q1)[0]
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / (self.resolution * self.extent)))
+        t = np.arange(1, n + 1, dtype=np.float64)[:, None] / n
+        out: _F64 = a + t * (b - a)
+        out[-1] = b
+        return out
+
+    def motion_valid(self, q0: npt.ArrayLike, q1: npt.ArrayLike) -> bool:
+        """Whether the straight motion from ``q0`` to ``q1`` is valid, checked
+        at the states of :meth:`segment` in one request (stopping at the
+        first state within the margin). Sampled, until gjkd's certified
+        continuous check replaces this one call."""
+        steps = self.segment(q0, q1)
+        self.edge_checks += 1
+        self.edge_steps += len(steps)
+        return bool(self._ask(steps, "first_hit").first_hit is None)
+
+    def clearance(self, q: npt.ArrayLike) -> float:
+        """The distance from the robot at ``q`` to its nearest other object
+        or non-allowed link (one request); ``inf`` when nothing qualifies."""
+        s = self._ask(self._steps(q), "clearance")
+        d = self._rows.distance[: s.written]
+        ok = (self._rows.b[: s.written] != 0) & (self._rows.error[: s.written] == 0)
+        return float(d[ok].min()) if ok.any() else math.inf
+
+    # -- lifetime -------------------------------------------------------------
+
+    def close(self) -> None:
+        """Removes the robot and its shadow from the server."""
+        for r in (getattr(self, "robot", None), getattr(self, "shadow", None)):
+            if r is not None:
+                try:
+                    self.client.remove(r.id)
+                except Error:
+                    pass
+
+    def __enter__(self) -> RobotChecker:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def raise_error(self) -> None:
+        """Raises (and forgets) the first exception an OMPL callback caught."""
+        e, self.error = self.error, None
+        if e is not None:
+            raise e
+
+
+# -- OMPL ---------------------------------------------------------------------
+
+
+def _ompl() -> tuple[Any, Any]:
+    try:
+        from ompl import base as ob
+        from ompl import geometric as og
+    except ImportError as e:
+        raise ImportError("gjkd.ompl needs OMPL's Python bindings 2.x: pip install ompl") from e
+    return ob, og
+
+
+_ADAPTERS: dict[str, Any] = {}
+
+
+def _adapters() -> dict[str, Any]:
+    """OMPL's callback classes, made on first use (they subclass OMPL's)."""
+    if _ADAPTERS:
+        return _ADAPTERS
+    ob, _ = _ompl()
+
+    class StateValidity(ob.StateValidityChecker):  # type: ignore[misc]
+        """OMPL's state validity checker over a :class:`RobotChecker`."""
+
+        def __init__(self, si: Any, checker: RobotChecker) -> None:
+            super().__init__(si)
+            self.checker = checker
+            self.n = checker.dof
+
+        def isValid(self, state: Any) -> bool:  # noqa: N802 (OMPL's name)
+            c = self.checker
+            if c.error is not None:
+                return False
+            try:
+                return c.is_valid(state[0 : self.n])
+            except Exception as e:  # noqa: BLE001 (kept, raised by plan())
+                c.error = e
+                return False
+
+        def clearance(self, state: Any) -> float:
+            c = self.checker
+            if c.error is not None:
+                return 0.0
+            try:
+                return c.clearance(state[0 : self.n])
+            except Exception as e:  # noqa: BLE001
+                c.error = e
+                return 0.0
+
+    class Motion(ob.MotionValidator):  # type: ignore[misc]
+        """OMPL's motion validator over a :class:`RobotChecker`."""
+
+        def __init__(self, si: Any, checker: RobotChecker) -> None:
+            super().__init__(si)
+            self.checker = checker
+            self.n = checker.dof
+
+        def checkMotion(self, s1: Any, s2: Any) -> bool:  # noqa: N802 (OMPL's name)
+            c = self.checker
+            if c.error is not None:
+                return False
+            try:
+                return c.motion_valid(s1[0 : self.n], s2[0 : self.n])
+            except Exception as e:  # noqa: BLE001
+                c.error = e
+                return False
+
+    class ClearanceObjective(ob.StateCostIntegralObjective):  # type: ignore[misc]
+        """Cost 1 / clearance integrated along the path (OMPL's demo's
+        clearance objective): lower for paths farther from everything."""
+
+        def __init__(self, si: Any, checker: RobotChecker) -> None:
+            super().__init__(si, True)
+            self.checker = checker
+            self.n = checker.dof
+
+        def stateCost(self, state: Any) -> Any:  # noqa: N802 (OMPL's name)
+            c = self.checker
+            try:
+                d = c.clearance(state[0 : self.n]) if c.error is None else 0.0
+            except Exception as e:  # noqa: BLE001
+                c.error = e
+                d = 0.0
+            return ob.Cost(1.0 / (max(d, 0.0) + 1e-9))
+
+    _ADAPTERS.update(
+        StateValidity=StateValidity, Motion=Motion, ClearanceObjective=ClearanceObjective
+    )
+    return _ADAPTERS
+
+
+def simple_setup(checker: RobotChecker, *, planner: Optional[str] = "RRTConnect") -> Any:
+    """An ``og.SimpleSetup`` planning ``checker``'s joints: a real vector
+    space bounded by the URDF's limits, ``checker`` as the state validity
+    checker and the motion validator, the checking resolution set to
+    ``checker.resolution``, and the planner ``og.<planner>`` (``None``:
+    OMPL's choice).
+
+    Raises:
+        ImportError: ``ompl`` cannot be imported.
+    """
+    ob, og = _ompl()
+    a = _adapters()
+    space = ob.RealVectorStateSpace(checker.dof)
+    bounds = ob.RealVectorBounds(checker.dof)
+    for i in range(checker.dof):
+        bounds.setLow(i, float(checker.lower[i]))
+        bounds.setHigh(i, float(checker.upper[i]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    validity = a["StateValidity"](si, checker)
+    motion = a["Motion"](si, checker)
+    si.setStateValidityChecker(validity)
+    si.setMotionValidator(motion)
+    si.setStateValidityCheckingResolution(checker.resolution)
+    si.setup()
+    ss = og.SimpleSetup(si)
+    if planner is not None:
+        ss.setPlanner(getattr(og, planner)(si))
+    # OMPL holds the callbacks by C++ pointers: keep the Python objects.
+    checker._ompl_keep = (space, si, validity, motion)  # type: ignore[attr-defined]
+    return ss
+
+
+def clearance_objective(ss: Any, checker: RobotChecker) -> Any:
+    """An optimisation objective for ``ss`` rewarding clearance (the
+    integral of 1 / clearance along the path, each state one request);
+    set it with ``ss.setOptimizationObjective``."""
+    _ompl()
+    obj = _adapters()["ClearanceObjective"](ss.getSpaceInformation(), checker)
+    checker._ompl_objective = obj  # type: ignore[attr-defined]
+    return obj
+
+
+def plan(
+    ss: Any,
+    checker: RobotChecker,
+    start: npt.ArrayLike,
+    goal: npt.ArrayLike,
+    *,
+    time: float = 1.0,
+    simplify: bool = False,
+) -> Optional[_F64]:
+    """Plans from ``start`` to ``goal`` (the planned joints) for at most
+    ``time`` seconds; returns the path's ``(n, dof)`` states, or ``None``
+    when no exact solution was found.
+
+    Raises:
+        gjkd.Error: a check failed during planning (the first such error; the
+            planner was stopped, and nothing it returned is used).
+    """
+    ob, _ = _ompl()
+    si = ss.getSpaceInformation()
+    states = []
+    for q in (start, goal):
+        s = si.allocState()
+        v = checker._steps(q)[0]
+        for i in range(checker.dof):
+            s[i] = float(v[i])
+        states.append(s)
+    ss.clear()
+    ss.setStartAndGoalStates(states[0], states[1])
+    checker.error = None
+    timed = ob.timedPlannerTerminationCondition(float(time))
+    failed = ob.PlannerTerminationCondition(lambda: checker.error is not None)
+    ss.solve(ob.plannerOrTerminationCondition(timed, failed))
+    checker.raise_error()
+    if not ss.haveExactSolutionPath():
+        return None
+    if simplify:
+        ss.simplifySolution()
+        checker.raise_error()
+    path = ss.getSolutionPath()
+    return np.array([list(s[0 : checker.dof]) for s in path.getStates()], dtype=np.float64)

@@ -121,8 +121,8 @@ class RobotChecker:
     so each request moves the shadow's links to the robot's poses too, and
     the robot's links meet the shadow's wherever a self-collision pair is
     not allowed (each such pair once; a link and its own shadow, and the
-    allowed pairs, are passed as allowed). Both are removed by
-    :meth:`close`.
+    allowed pairs, are passed as allowed). :meth:`close` removes both
+    robots' links.
 
     Args:
         client: a connected :class:`gjkd.Client`.
@@ -204,7 +204,9 @@ class RobotChecker:
                     base=_PARKED,
                 )
         except Error:
-            client.remove(robot.id)
+            for i in robot.link_ids:
+                if i != 0:
+                    client.remove(int(i))
             raise
         self.client = client
         self.robot: Robot = robot
@@ -222,6 +224,11 @@ class RobotChecker:
             raise
         self._plan_pairs(allowed)
         self._rows = SceneRows(256)
+        info = client.server_info() or {}
+        # A request holds at most max_batch items: the allowed pairs, then
+        # per step a pose per moved link (and room for the step's end).
+        room = int(info.get("max_batch", 1024)) - len(self._allow)
+        self.steps_per_request = max(1, room // (len(self._objects) + 1))
 
     def _choose_joints(
         self, joints: Optional[Sequence[str]], fixed: Optional[Mapping[str, float]]
@@ -278,7 +285,7 @@ class RobotChecker:
     def positions(self, q: npt.ArrayLike) -> _F64:
         """The robot's whole ``(dof_robot,)`` position array for the planned
         joints' ``q``, the others at their fixed positions."""
-        full = self._full.copy()
+        full: _F64 = self._full.copy()
         full[self._index] = np.asarray(q, dtype=np.float64)
         return full
 
@@ -307,6 +314,8 @@ class RobotChecker:
         return a
 
     def _ask(self, qs: _F64, question: str) -> Any:
+        """One request: ``question`` at each row of ``qs`` (at most
+        :attr:`steps_per_request` rows)."""
         return self.client.path(
             self.robot.id,
             self._objects,
@@ -333,14 +342,16 @@ class RobotChecker:
         valid = np.ones(len(steps), dtype=bool)
         start = 0
         while start < len(steps):
-            s = self._ask(steps[start:], "within")
+            s = self._ask(steps[start : start + self.steps_per_request], "within")
             hit = self._rows.step[: s.written].astype(np.intp) + start
             valid[hit] = False
-            if not s.truncated:
-                break
-            # Rows come step by step: the last step written is invalid
-            # already, the ones after it are asked again.
-            start = int(hit.max()) + 1
+            # Rows come step by step: when they did not all fit, the last
+            # step written is invalid already and the ones after it are
+            # asked again.
+            if s.truncated:
+                start = int(hit.max()) + 1
+            else:
+                start += self.steps_per_request
         return valid
 
     def segment(self, q0: npt.ArrayLike, q1: npt.ArrayLike) -> _F64:
@@ -358,16 +369,23 @@ class RobotChecker:
     def motion_valid(self, q0: npt.ArrayLike, q1: npt.ArrayLike) -> bool:
         """Whether the straight motion from ``q0`` to ``q1`` is valid, checked
         at the states of :meth:`segment` in one request (stopping at the
-        first state within the margin). Sampled, until gjkd's certified
-        continuous check replaces this one call."""
+        first state within the margin; an edge of more than
+        :attr:`steps_per_request` states takes more requests). Sampled,
+        until gjkd's certified continuous check replaces this one call."""
         steps = self.segment(q0, q1)
         self.edge_checks += 1
-        self.edge_steps += len(steps)
-        return bool(self._ask(steps, "first_hit").first_hit is None)
+        for k in range(0, len(steps), self.steps_per_request):
+            chunk = steps[k : k + self.steps_per_request]
+            s = self._ask(chunk, "first_hit")
+            self.edge_steps += s.steps
+            if s.first_hit is not None:
+                return False
+        return True
 
     def clearance(self, q: npt.ArrayLike) -> float:
         """The distance from the robot at ``q`` to its nearest other object
-        or non-allowed link (one request); ``inf`` when nothing qualifies."""
+        or non-allowed link (one request): 0 where shapes overlap, ``inf``
+        when nothing qualifies."""
         s = self._ask(self._steps(q), "clearance")
         d = self._rows.distance[: s.written]
         ok = (self._rows.b[: s.written] != 0) & (self._rows.error[: s.written] == 0)
@@ -376,13 +394,18 @@ class RobotChecker:
     # -- lifetime -------------------------------------------------------------
 
     def close(self) -> None:
-        """Removes the robot and its shadow from the server."""
+        """Removes the robot's and the shadow's link objects from the server
+        (a robot's name stays taken there: the server removes objects, not
+        robots)."""
         for r in (getattr(self, "robot", None), getattr(self, "shadow", None)):
-            if r is not None:
-                try:
-                    self.client.remove(r.id)
-                except Error:
-                    pass
+            if r is None:
+                continue
+            for i in r.link_ids:
+                if i != 0:
+                    try:
+                        self.client.remove(int(i))
+                    except Error:
+                        pass
 
     def __enter__(self) -> RobotChecker:
         return self
@@ -418,7 +441,7 @@ def _adapters() -> dict[str, Any]:
         return _ADAPTERS
     ob, _ = _ompl()
 
-    class StateValidity(ob.StateValidityChecker):  # type: ignore[misc]
+    class StateValidity(ob.StateValidityChecker):  # type: ignore[misc, name-defined]
         """OMPL's state validity checker over a :class:`RobotChecker`."""
 
         def __init__(self, si: Any, checker: RobotChecker) -> None:
@@ -446,7 +469,7 @@ def _adapters() -> dict[str, Any]:
                 c.error = e
                 return 0.0
 
-    class Motion(ob.MotionValidator):  # type: ignore[misc]
+    class Motion(ob.MotionValidator):  # type: ignore[misc, name-defined]
         """OMPL's motion validator over a :class:`RobotChecker`."""
 
         def __init__(self, si: Any, checker: RobotChecker) -> None:
@@ -464,7 +487,7 @@ def _adapters() -> dict[str, Any]:
                 c.error = e
                 return False
 
-    class ClearanceObjective(ob.StateCostIntegralObjective):  # type: ignore[misc]
+    class ClearanceObjective(ob.StateCostIntegralObjective):  # type: ignore[misc, name-defined]
         """Cost 1 / clearance integrated along the path (OMPL's demo's
         clearance objective): lower for paths farther from everything."""
 

@@ -1,0 +1,236 @@
+"""OMPL plans the vendored Panda through MotionBenchMaker's scenes with two
+collision checkers: gjkd (``gjkd.ompl``, a server) and pinocchio + coal in
+process (``baseline.py``), the same planner and settings for both.
+
+    python python/bench/plan.py            # 100 problems a scene
+    python python/bench/plan.py --quick    # 4 problems a scene
+
+Per checker: RRTConnect's planning time (OMPL's own measure; median and
+90th percentile), success rate, state checks and edge checks per second of
+planning, and every returned path re-checked densely by an exact check
+independent of gjkd (pinocchio + coal on the URDF's own meshes, margin 0,
+at a tenth of OMPL's resolution): the paths that touch an obstacle or
+collide with themselves. The problems alternate checkers, one problem at a
+time, so that both see the same machine load. gjkd's edge check is still
+the sampled path at OMPL's resolution (until the certified continuous check
+lands). Needs ``pip install ompl pin coal`` besides the gjkd package.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import statistics
+import sys
+from typing import Any, Optional
+
+import numpy as np
+from baseline import PinCoal
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+from scenes import PACKAGES, PANDA_SRDF, Problem, load_problems, panda_urdf, read_scene
+
+import gjkd
+import gjkd.ompl
+
+SCENES = ["box", "cage", "table_pick", "table_under_pick", "bookshelf_small"]
+
+
+def register(client: gjkd.Client, problem: Problem) -> list[int]:
+    """The problem's obstacles on the server; their ids."""
+    ids = []
+    for o in read_scene(problem.scene_file):
+        if o.kind == "box":
+            ids.append(client.register_box(o.size["half_extents"], pose=o.pose))
+        elif o.kind == "cylinder":
+            half = o.size["length"] / 2
+            ids.append(client.register_cylinder(o.size["radius"], half, pose=o.pose))
+        else:
+            ids.append(client.register_sphere(o.size["radius"], pose=o.pose))
+    return ids
+
+
+def dense(path: np.ndarray, step: float) -> np.ndarray:
+    """The path's states at most ``step`` apart (joint-space norm)."""
+    out = [path[:1]]
+    for a, b in zip(path[:-1], path[1:]):
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
+        t = np.arange(1, n + 1)[:, None] / n
+        out.append(a + t * (b - a))
+    return np.concatenate(out)
+
+
+def touches(truth: PinCoal, path: Optional[np.ndarray], step: float) -> Optional[str]:
+    """The first colliding pair along ``path`` checked densely, or None."""
+    if path is None:
+        return None
+    for q in dense(path, step):
+        if not truth.is_valid(q):
+            return truth.first_collision(q) or "collision"
+    return None
+
+
+def run_gjkd(
+    ss: Any, checker: gjkd.ompl.RobotChecker, p: Problem, limit: float
+) -> tuple[Optional[np.ndarray], dict[str, Any]]:
+    checker.state_checks = checker.edge_checks = checker.edge_steps = 0
+    path = gjkd.ompl.plan(ss, checker, p.start, p.goal, time=limit)
+    return path, {
+        "time": ss.getLastPlanComputationTime(),
+        "states": checker.state_checks + checker.edge_steps,
+        "edges": checker.edge_checks,
+    }
+
+
+def run_baseline(
+    p: Problem, margin: float, fingers: float, limit: float
+) -> tuple[Optional[np.ndarray], dict[str, Any], PinCoal]:
+    checker = PinCoal(read_scene(p.scene_file), margin, fingers)
+    space = ob.RealVectorStateSpace(7)
+    bounds = ob.RealVectorBounds(7)
+    for i in range(7):
+        bounds.setLow(i, float(checker.model.lowerPositionLimit[i]))
+        bounds.setHigh(i, float(checker.model.upperPositionLimit[i]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: checker.is_valid(s[0:7]))
+    si = ss.getSpaceInformation()
+    ss.setPlanner(og.RRTConnect(si))
+    start, goal = ss.getStateSpace().allocState(), ss.getStateSpace().allocState()
+    for i in range(7):
+        start[i], goal[i] = float(p.start[i]), float(p.goal[i])
+    ss.setStartAndGoalStates(start, goal)
+    ss.solve(limit)
+    path = None
+    if ss.haveExactSolutionPath():
+        path = np.array([list(s[0:7]) for s in ss.getSolutionPath().getStates()])
+    stats = {
+        "time": ss.getLastPlanComputationTime(),
+        "states": checker.checks,
+        "edges": si.getMotionValidator().getCheckedMotionCount(),
+    }
+    return path, stats, checker
+
+
+def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    times = sorted(r["time"] for r in rows if r["solved"])
+    total = sum(r["time"] for r in rows) or math.nan
+    return {
+        "problems": len(rows),
+        "solved": sum(r["solved"] for r in rows),
+        "median_ms": 1e3 * statistics.median(times) if times else math.nan,
+        "p90_ms": 1e3 * times[min(len(times) - 1, int(0.9 * len(times)))] if times else math.nan,
+        "states_per_s": sum(r["states"] for r in rows) / total,
+        "edges_per_s": sum(r["edges"] for r in rows) / total,
+        "touching": sum(r["touch"] is not None for r in rows),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="4 problems a scene, 2 s each")
+    parser.add_argument("--problems", type=int, default=100, help="problems a scene")
+    parser.add_argument("--time", type=float, default=5.0, help="planning time limit, s")
+    parser.add_argument("--margin", type=float, default=0.0, help="collision margin, m")
+    parser.add_argument("--scenes", nargs="*", default=SCENES)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--wait", default="adaptive", help="the gjkd server's wait mode")
+    parser.add_argument("--json", help="write every problem's figures here")
+    args = parser.parse_args()
+    if args.quick:
+        args.problems, args.time = 4, 2.0
+    ou.setLogLevel(ou.LOG_WARN)
+    ou.RNG.setSeed(args.seed)
+    problems, robot = load_problems(args.scenes, args.problems)
+    fingers = float(robot["fixed"]["panda_finger_joint1"])
+    results: dict[str, list[dict[str, Any]]] = {"gjkd": [], "pinocchio+coal": []}
+    invalid: dict[str, list[str]] = {"gjkd": [], "pinocchio+coal": []}
+    service = f"gjkd-plan-{os.getpid()}"
+    with (
+        gjkd.Server(service=service, wait=args.wait) as server,
+        gjkd.Client(server.service, timeout=10.0) as client,
+    ):
+        checker = gjkd.ompl.RobotChecker(
+            client,
+            "panda",
+            urdf_text=panda_urdf(fingers),
+            srdf=PANDA_SRDF,
+            package_path=[PACKAGES],
+            margin=args.margin,
+            joints=robot["joints"],
+            fixed=robot["fixed"],
+        )
+        ss = gjkd.ompl.simple_setup(checker)
+        for k, p in enumerate(problems):
+            ids = register(client, p)
+            for q, what in ((p.start, "start"), (p.goal, "goal")):
+                if not checker.is_valid(q):
+                    invalid["gjkd"].append(f"{p.scene}/{p.index} {what}")
+            path, stats = run_gjkd(ss, checker, p, args.time)
+            for i in ids:
+                client.remove(i)
+            bpath, bstats, truth = run_baseline(p, args.margin, fingers, args.time)
+            for q, what in ((p.start, "start"), (p.goal, "goal")):
+                if not truth.is_valid(q):
+                    why = truth.first_collision(q)
+                    invalid["pinocchio+coal"].append(f"{p.scene}/{p.index} {what} {why}")
+            if args.margin != 0.0:
+                truth = PinCoal(read_scene(p.scene_file), 0.0, fingers)
+            step = 0.001 * checker.extent
+            for name, pth, st in (("gjkd", path, stats), ("pinocchio+coal", bpath, bstats)):
+                results[name].append(
+                    {
+                        "scene": p.scene,
+                        "index": p.index,
+                        "solved": pth is not None,
+                        "touch": touches(truth, pth, step),
+                        **st,
+                    }
+                )
+            g, b = results["gjkd"][-1], results["pinocchio+coal"][-1]
+            print(
+                f"[{k + 1}/{len(problems)}] {p.scene}/{p.index}: "
+                f"gjkd {g['solved']} {1e3 * g['time']:.1f} ms, "
+                f"pinocchio+coal {b['solved']} {1e3 * b['time']:.1f} ms",
+                file=sys.stderr,
+            )
+        checker.close()
+    print(f"RRTConnect, {args.time:g} s limit, margin {args.margin:g}, seed {args.seed}")
+    head = "| scene | checker | solved | median ms | p90 ms | states/s | edges/s | paths touching |"
+    print(head)
+    print("|---|---|---|---|---|---|---|---|")
+    for scene in [*args.scenes, "all"]:
+        for name, rows in results.items():
+            sel = [r for r in rows if scene in ("all", r["scene"])]
+            s = summary(sel)
+            print(
+                f"| {scene} | {name} | {s['solved']}/{s['problems']} | {s['median_ms']:.1f} "
+                f"| {s['p90_ms']:.1f} | {s['states_per_s']:.0f} | {s['edges_per_s']:.0f} "
+                f"| {s['touching']} |"
+            )
+    g, b = summary(results["gjkd"]), summary(results["pinocchio+coal"])
+    print(f"median planning time, gjkd / pinocchio+coal: {g['median_ms'] / b['median_ms']:.2f}")
+    both = [
+        (x["time"], y["time"])
+        for x, y in zip(results["gjkd"], results["pinocchio+coal"])
+        if x["solved"] and y["solved"]
+    ]
+    if both:
+        ratio = statistics.median(x / y for x, y in both)
+        print(f"median of per-problem ratios (both solved, {len(both)}): {ratio:.2f}")
+    for name, rows in results.items():
+        for r in rows:
+            if r["touch"] is not None:
+                print(f"{name}: {r['scene']}/{r['index']} path touches: {r['touch']}")
+    for name, bad in invalid.items():
+        print(f"{name}: {len(bad)} invalid starts or goals" + "".join(f"\n  {x}" for x in bad))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"args": vars(args), "results": results, "invalid": invalid}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -272,6 +272,8 @@ class RobotChecker:
         self._links = np.array(links, dtype=np.intp)
         self._partners = np.array(partners, dtype=np.intp)
         self._objects = np.concatenate([ids[links], shadow_ids[partners]]).astype(np.uint64)
+        # The shadow's links take the poses of the robot's of the same index.
+        self._select = np.concatenate([self._links, self._partners])
         self._allow = np.array(allow, dtype=np.uint64).reshape(-1, 2)
         self.self_pairs = len(meets)
 
@@ -292,12 +294,12 @@ class RobotChecker:
     def _poses(self, qs: _F64) -> _F64:
         """``(S * objects, 7)`` poses of the robot's and the shadow's moved
         links at each row of ``qs``."""
+        full = np.repeat(self._full[None, :], len(qs), axis=0)
+        full[:, self._index] = qs
         out = np.empty((len(qs), len(self._objects), 7))
-        n = len(self._links)
-        for s, q in enumerate(qs):
-            poses = self.robot.link_poses(self.positions(q))
-            out[s, :n] = poses[self._links]
-            out[s, n:] = poses[self._partners]
+        link_poses, select = self.robot.link_poses, self._select
+        for s in range(len(qs)):
+            out[s] = link_poses(full[s])[select]
         return out.reshape(-1, 7)
 
     def _steps(self, qs: npt.ArrayLike) -> _F64:

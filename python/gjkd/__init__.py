@@ -24,6 +24,10 @@ poses, out=rows)`` (a question at every step of a candidate motion) and
 ``client.path_joints(robot, robot, positions, out=rows)`` (the same along a
 robot's joint positions).
 
+:mod:`gjkd.ompl` (imported on its own: ``import gjkd.ompl``) plugs a robot
+on a server into OMPL's planners: a state validity checker, a motion
+validator and a clearance, one scene request each.
+
 Example::
 
     import numpy as np

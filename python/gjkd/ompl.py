@@ -122,7 +122,8 @@ class RobotChecker:
     the robot's links meet the shadow's wherever a self-collision pair is
     not allowed (each such pair once; a link and its own shadow, and the
     allowed pairs, are passed as allowed). :meth:`close` removes both
-    robots' links.
+    robots' links. The checker moves nothing on the server: other clients'
+    questions see the robot where its joints were last set.
 
     Args:
         client: a connected :class:`gjkd.Client`.
@@ -180,29 +181,21 @@ class RobotChecker:
             raise InvalidInput("a URDF is needed: urdf or urdf_text", field="urdf")
         allowed = allowed_link_pairs(text, srdf_str)
         paths = list(package_path)
-        if urdf is not None:
-            # Relative mesh paths are read next to the URDF file, also for
-            # the shadow, which is registered from the same file.
-            robot = client.register_robot(
-                name, urdf, srdf_text=srdf_str, package_path=paths, base=base
-            )
-        else:
-            robot = client.register_robot(
-                name, urdf_text=text, srdf_text=srdf_str, package_path=paths, base=base
-            )
-        try:
+
+        def register(robot_name: str, pose: Optional[npt.ArrayLike]) -> Robot:
+            # From the file when there is one: relative mesh paths are read
+            # next to it.
             if urdf is not None:
-                shadow = client.register_robot(
-                    name + "~self", urdf, srdf_text=srdf_str, package_path=paths, base=_PARKED
+                return client.register_robot(
+                    robot_name, urdf, srdf_text=srdf_str, package_path=paths, base=pose
                 )
-            else:
-                shadow = client.register_robot(
-                    name + "~self",
-                    urdf_text=text,
-                    srdf_text=srdf_str,
-                    package_path=paths,
-                    base=_PARKED,
-                )
+            return client.register_robot(
+                robot_name, urdf_text=text, srdf_text=srdf_str, package_path=paths, base=pose
+            )
+
+        robot = register(name, base)
+        try:
+            shadow = register(name + "~self", _PARKED)
         except Error:
             for i in robot.link_ids:
                 if i != 0:

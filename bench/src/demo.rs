@@ -2,7 +2,7 @@
 //!
 //! It starts `gjkd serve` as a child process on a private service name,
 //! registers the Section 8 scene (a compound object moving and turning
-//! through five fixed obstacles, from `gjkd_testkit::paper::section8`) through the
+//! through five fixed obstacles, from `gjkd_paper::section8`) through the
 //! client library, sweeps the path at T = 10, 100 and 1000 steps, and prints
 //! the distance to each obstacle along the path and the time of cold-started
 //! sweeps against sweeps warm-started from the server's per-pair cache, beside
@@ -22,10 +22,12 @@ use std::time::{Duration, Instant};
 
 use gjk::Options;
 use gjkd_client::{Client, QueryOptions};
-use gjkd_testkit::paper::{self, Motion, OBSTACLES};
+use gjkd_paper::{self as paper, Motion, OBSTACLES};
 
 pub use crate::served_sweep::DemoError;
-use crate::served_sweep::{Buffers, PAPER_RATIOS, Registered, register, sweep};
+use crate::served_sweep::{
+    Buffers, PAPER_RATIOS, PathBuffers, Registered, SERVER_ARGS, path_sweep, register, sweep,
+};
 pub use crate::server_process::ServerProcess;
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -51,8 +53,7 @@ pub struct DemoArgs {
 /// disagrees with the in-process computation.
 pub fn run(steps: &[usize], repeats: usize) -> Result<(), DemoError> {
     let service = format!("gjkd-demo-{}", std::process::id());
-    let mut server = ServerProcess::spawn(&service, &crate::collision_sweep::SERVER_ARGS)
-        .map_err(DemoError::Spawn)?;
+    let mut server = ServerProcess::spawn(&service, &SERVER_ARGS).map_err(DemoError::Spawn)?;
     let outcome = run_with_server(&service, steps, repeats);
     let clean = server.stop();
     let () = outcome?;
@@ -237,7 +238,6 @@ fn collision_row(
     repeats: usize,
     cold: Duration,
 ) -> Result<(), DemoError> {
-    use crate::collision_sweep::{PathBuffers, path_sweep};
     if !crate::scene_call::available() {
         let _ = writeln!(
             out,

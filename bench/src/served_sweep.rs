@@ -1,7 +1,7 @@
 //! The paper's Section 8 sweep through a served `gjkd serve`: the scene
 //! registered through the client library, and each sweep sent as few
-//! batches as the server's batch limit allows (`gjkd demo` and
-//! `gjkd bench sweep` time it).
+//! batches as the server's batch limit allows, or as one path request
+//! (`gjkd demo` and `gjkd bench sweep` time both).
 
 use std::time::{Duration, Instant};
 
@@ -9,8 +9,11 @@ use gjk::Shape;
 use gjkd_client::{
     Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions, Status,
 };
-use gjkd_testkit::paper::{Motion, OBSTACLES};
+use gjkd_paper::{Motion, OBSTACLES};
+use gjkd_proto::{PathMode, SceneKind, SceneReply, SceneRequest, SceneRow};
 use nalgebra::Isometry3;
+
+use crate::{BenchError, scene_call};
 
 /// The paper's Table 1: time without warm start over time with it, for
 /// T = 10, 100, 1000.
@@ -72,6 +75,8 @@ pub(crate) fn register(client: &mut Client, motion: &Motion) -> Result<Registere
 }
 
 /// One sweep through the server: distances per step, total iterations.
+// Some fields are read by `gjkd bench sweep` only (feature `measure`).
+#[cfg_attr(not(feature = "measure"), allow(dead_code))]
 pub(crate) struct ServedSweep {
     pub(crate) distances: Vec<[f64; OBSTACLES]>,
     /// Per step, the obstacles proved within the query's margin (or at
@@ -146,5 +151,108 @@ pub(crate) fn sweep(
         hits,
         iterations,
         elapsed,
+    })
+}
+
+/// Arguments of the servers the sweep runs through: a batch limit that
+/// holds a whole T = 1 000 path in one request.
+pub const SERVER_ARGS: [&str; 5] = ["--wait", "spin", "--no-persist", "--max-batch", "8192"];
+
+/// One path request's outcome.
+// Some fields are read by `gjkd bench sweep` only (feature `measure`).
+#[cfg_attr(not(feature = "measure"), allow(dead_code))]
+pub(crate) struct PathSweep {
+    /// Per step, the obstacles within the margin, as bits.
+    pub(crate) hits: Vec<u8>,
+    /// [`PathMode::FirstHit`]: the step that hit first.
+    pub(crate) first_hit: Option<usize>,
+    /// Round trip of the request.
+    pub(crate) elapsed: Duration,
+    /// Pair queries that ran GJK, and pairs answered from motion bounds.
+    pub(crate) work: (u64, u64),
+}
+
+/// Reusable buffers of the path requests.
+pub(crate) struct PathBuffers {
+    items: Vec<Item>,
+    rows: Vec<SceneRow>,
+}
+
+impl PathBuffers {
+    /// Room for paths of up to `steps` steps.
+    pub(crate) fn new(steps: usize) -> Self {
+        PathBuffers {
+            items: Vec::with_capacity(steps + 1),
+            rows: vec![SceneRow::default(); (steps + 1) * OBSTACLES],
+        }
+    }
+}
+
+/// The sweep of `steps` steps as one path request in `mode`: the moving
+/// object's pose per step, flagged to end it; the obstacles within margin 0.
+///
+/// # Errors
+/// The client's, a scene error, or a truncated answer.
+pub(crate) fn path_sweep(
+    client: &mut Client,
+    motion: &Motion,
+    scene: &Registered,
+    steps: usize,
+    mode: PathMode,
+    buf: &mut PathBuffers,
+) -> Result<PathSweep, BenchError> {
+    let mut call =
+        |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| scene_call::query(client, r, i, rows);
+    path_sweep_with(&mut call, motion, scene, steps, mode, buf)
+}
+
+/// How a scene request is sent: through a client, or to the engine in
+/// process.
+pub(crate) type SceneCall<'a> =
+    dyn FnMut(&SceneRequest, &[Item], &mut [SceneRow]) -> Result<SceneReply, BenchError> + 'a;
+
+/// [`path_sweep`] with the request sent by `call`.
+pub(crate) fn path_sweep_with(
+    call: &mut SceneCall<'_>,
+    motion: &Motion,
+    scene: &Registered,
+    steps: usize,
+    mode: PathMode,
+    buf: &mut PathBuffers,
+) -> Result<PathSweep, BenchError> {
+    let steps = steps.max(1);
+    // Poses are computed before the clock starts, as in the demo.
+    let poses: Vec<Isometry3<f64>> = (0..=steps)
+        .map(|t| motion.pose(t as f64 / steps as f64))
+        .collect();
+    buf.items.clear();
+    for pose in &poses {
+        buf.items
+            .push(Item::set_pose(scene.moving, pose).ending_step());
+    }
+    buf.rows
+        .resize((steps + 1) * OBSTACLES, SceneRow::default());
+    let mut request = SceneRequest::new(SceneKind::Within, scene.moving.raw());
+    request.path = mode as u32;
+    request.margin = 0.0;
+    request.max_rows = buf.rows.len() as u32;
+    let start = Instant::now();
+    let reply = call(&request, &buf.items, &mut buf.rows)?;
+    let elapsed = start.elapsed();
+    if reply.total > u64::from(request.max_rows) {
+        return Err(BenchError::Other("a path answer was truncated".into()));
+    }
+    let mut hits = vec![0u8; steps + 1];
+    for row in &buf.rows[..reply.total as usize] {
+        let obstacle = scene.obstacles.iter().position(|o| o.raw() == row.b);
+        if let (Some(i), Some(h)) = (obstacle, hits.get_mut(row.step as usize)) {
+            *h |= 1 << i;
+        }
+    }
+    Ok(PathSweep {
+        hits,
+        first_hit: (reply.first_hit != u32::MAX).then_some(reply.first_hit as usize),
+        elapsed,
+        work: (reply.gjk_runs, reply.bounded),
     })
 }

@@ -1,3 +1,5 @@
+//! # gjkd-paper
+//!
 //! The test data of the 1986 paper, rebuilt deterministically: the family of
 //! twelve polytopes and twenty pairs of Section 7 ("Numerical Experiments") and
 //! a collision sweep modelled on Section 8 ("An Example of Collision
@@ -8,7 +10,7 @@
 //! sees the same geometry.
 //!
 //! ```
-//! use gjkd_testkit::paper::{self, Case};
+//! use gjkd_paper::{self as paper, Case};
 //! use gjk::{distance, Options, Shape};
 //!
 //! let family = paper::family();
@@ -26,6 +28,8 @@
 //! drawn, what "expected relative translation 10/3" is measured on, how deep the
 //! intersecting cases go, and the whole scene of Section 8 (the paper's Figure 3,
 //! due to Canny, is not reproduced in the text).
+
+#![warn(missing_docs)]
 
 use std::f64::consts::PI;
 

@@ -245,11 +245,23 @@ fn a_corrupt_state_file_is_set_aside_never_half_loaded() {
         drop(client);
         server.terminate();
         let dir = path.parent().expect("dir");
-        let aside: Vec<_> = std::fs::read_dir(dir)
-            .expect("list")
-            .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().contains(".corrupt-"))
-            .collect();
+        let store_name = path
+            .file_name()
+            .expect("name")
+            .to_string_lossy()
+            .into_owned();
+        let kept = |prefix: String| -> Vec<_> {
+            std::fs::read_dir(dir)
+                .expect("list")
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+                .collect()
+        };
+        // The pose journal, which names the objects lost, goes aside with it.
+        let poses = kept(format!("{store_name}.poses.corrupt-"));
+        assert_eq!(poses.len(), 1, "{what}: the journal is kept aside");
+        std::fs::remove_file(poses[0].path()).expect("clean");
+        let aside = kept(format!("{store_name}.corrupt-"));
         assert_eq!(aside.len(), 1, "{what}: the bad file is kept aside");
         assert_eq!(
             std::fs::read(aside[0].path()).expect("read"),

@@ -43,8 +43,10 @@ use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use redb::{ReadableDatabase, ReadableTable, TableDefinition};
 use tracing::{error, info, warn};
 
+use super::aside::aside_name;
 pub use super::backends::WriteFaults;
 use super::backends::{Backend, Copy};
+use super::journal;
 use crate::engine::records::{Snapshot, StoredObject};
 use crate::engine::tokens::TokenKey;
 use crate::persist::legacy;
@@ -131,6 +133,10 @@ pub struct Opened {
     pub fresh: bool,
     /// Files renamed aside because they were damaged, or migrated.
     pub set_aside: Vec<PathBuf>,
+    /// The objects lost with a store set aside (unreadable, or empty while
+    /// its pose journal names objects), in id order: those its file and its
+    /// pose journal name. Logged at ERROR.
+    pub lost: Vec<u64>,
 }
 
 impl Database {
@@ -164,26 +170,54 @@ impl Database {
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes)
             .map_err(io("cannot read", &path))?;
-        let stored = match verify(bytes) {
-            Ok(stored) => stored,
-            Err(reason) => {
-                let lost = std::fs::read(&path).ok().and_then(readable_ids);
-                let moved_to = set_aside_file(&path, &reason)?;
-                let (count, ids) = match &lost {
-                    Some(ids) => (
-                        ids.len().to_string(),
-                        ids.iter().take(32).map(|id| format!("{id:#x}")).collect(),
+        // The objects the pose journal beside the store names: the evidence
+        // of what a store that cannot be read, or is empty, held.
+        let journaled = || journal::ids_in(&journal::path_for(&path));
+        let damage = match verify(bytes) {
+            Ok(Some(stored)) => Ok(Some(stored)),
+            Ok(None) if migrated.is_some() => Ok(None),
+            Ok(None) => match journaled() {
+                ids if ids.is_empty() => Ok(None),
+                ids => Err((
+                    format!(
+                        "the file is empty while its pose journal names {} objects",
+                        ids.len()
                     ),
-                    None => ("unknown".to_owned(), Vec::new()),
+                    Some(Vec::new()),
+                    ids,
+                )),
+            },
+            Err(reason) => Err((
+                reason,
+                std::fs::read(&path).ok().and_then(readable_ids),
+                journaled(),
+            )),
+        };
+        let mut lost = Vec::new();
+        let stored = match damage {
+            Ok(stored) => stored,
+            Err((reason, readable, journaled)) => {
+                let moved_to = set_aside_file(&path, &reason)?;
+                set_aside.push(moved_to.clone());
+                set_aside.extend(set_aside_journal(&path, &reason)?);
+                let known = readable.is_some() || !journaled.is_empty();
+                lost = readable.unwrap_or_default();
+                lost.extend(&journaled);
+                lost.sort_unstable();
+                lost.dedup();
+                let count = if known {
+                    lost.len().to_string()
+                } else {
+                    "unknown".to_owned()
                 };
+                let ids: Vec<String> = lost.iter().take(32).map(|id| format!("{id:#x}")).collect();
                 error!(
                     file = %path.display(),
                     moved_to = %moved_to.display(),
                     lost_objects = %count,
                     lost_ids = ?ids,
-                    "the object store is damaged ({reason}): set aside as it was, starting with no objects; the objects it held (as far as it can be read) are lost to this server"
+                    "the object store is damaged ({reason}): set aside as it was, starting with no objects; the objects it held (as far as it and its pose journal can be read) are lost to this server"
                 );
-                set_aside.push(moved_to);
                 drop(file);
                 file = open_locked(&path)?;
                 None
@@ -217,6 +251,7 @@ impl Database {
                 snapshot,
                 fresh,
                 set_aside,
+                lost,
             },
         ))
     }
@@ -689,25 +724,6 @@ fn take_old_lock(path: &Path) -> Result<File, StoreError> {
     }
 }
 
-/// `<file>.<tag>-<unix seconds>`, with a suffix if that exists already.
-pub(crate) fn aside_name(path: &Path, tag: &str) -> PathBuf {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    (0..)
-        .map(|n| {
-            let mut a = path.as_os_str().to_owned();
-            a.push(format!(".{tag}-{secs}"));
-            if n > 0 {
-                a.push(format!(".{n}"));
-            }
-            PathBuf::from(a)
-        })
-        .find(|a| !a.exists())
-        .unwrap_or_else(|| path.with_extension(tag))
-}
-
 /// Renames a damaged file to `<file>.corrupt-<unix seconds>`, never over an
 /// earlier one.
 ///
@@ -722,6 +738,23 @@ fn set_aside_file(path: &Path, reason: &dyn std::fmt::Display) -> Result<PathBuf
         source: std::io::Error::new(e.kind(), format!("{reason}; rename failed: {e}")),
     })?;
     Ok(aside)
+}
+
+/// Renames the pose journal of the store at `path` aside with it, if it has
+/// one: its slots name the objects lost, and a fresh store must not take
+/// their poses for its own.
+///
+/// # Errors
+/// When it cannot be moved.
+fn set_aside_journal(
+    path: &Path,
+    reason: &dyn std::fmt::Display,
+) -> Result<Option<PathBuf>, StoreError> {
+    let journal = journal::path_for(path);
+    if !journal.exists() {
+        return Ok(None);
+    }
+    set_aside_file(&journal, reason).map(Some)
 }
 
 #[cfg(test)]

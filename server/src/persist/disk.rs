@@ -131,7 +131,7 @@ pub fn open_state(
 /// Logs the objects whose pose the journal at `path` could not verify, after
 /// keeping a copy of the journal as it was `found` (it is rewritten next).
 fn report_unverified_poses(path: &std::path::Path, found: &[u8], ids: &[u64]) {
-    let kept = super::database::aside_name(path, "corrupt");
+    let kept = super::aside::aside_name(path, "corrupt");
     let write = |kept: &std::path::Path| {
         use std::io::Write;
         use std::os::unix::fs::OpenOptionsExt;

@@ -107,7 +107,7 @@ impl Journal {
             if current > 0 {
                 // Kept as found before it is started afresh; the objects it
                 // held poses for are reported by the store.
-                let kept = crate::persist::database::aside_name(path, "corrupt");
+                let kept = super::aside::aside_name(path, "corrupt");
                 std::fs::copy(path, &kept)?;
                 tracing::error!(
                     file = %path.display(),
@@ -118,7 +118,13 @@ impl Journal {
             file.set_len(0)?;
         }
         let slots = current.saturating_sub(HEADER) / SLOT;
-        let map = map(&file, slots.max(INITIAL_SLOTS))?;
+        // Room for the first objects up front; on a disk without it, only
+        // what the file holds: the server must start on a full disk too,
+        // the journal growing (or failing to, see `write`) as poses come.
+        let map = match map(&file, slots.max(INITIAL_SLOTS)) {
+            Err(e) if e.raw_os_error() == Some(libc::ENOSPC) => map(&file, slots)?,
+            mapped => mapped?,
+        };
         let mut j = Journal {
             file,
             path: path.to_path_buf(),
@@ -201,6 +207,33 @@ impl Journal {
         };
         pose.to_isometry()
     }
+}
+
+/// The ids of the objects the journal file at `path` holds a whole record
+/// of, in id order (none when there is no file or it is not a journal of
+/// this version). A removed object's record stays until its slot is
+/// reused, so these are objects registered at some time, not all still
+/// stored.
+pub fn ids_in(path: &Path) -> Vec<u64> {
+    let Ok(bytes) = std::fs::read(path) else {
+        return Vec::new();
+    };
+    if bytes.len() < HEADER || bytes[..8] != MAGIC || bytes[8..12] != VERSION.to_le_bytes() {
+        return Vec::new();
+    }
+    let mut ids: Vec<u64> = bytes[HEADER..]
+        .chunks_exact(SLOT)
+        .filter_map(|slot| {
+            let mut w = [0u64; 9];
+            for (x, chunk) in w.iter_mut().zip(slot.chunks_exact(8)) {
+                *x = u64::from_le_bytes(chunk.try_into().unwrap_or_default());
+            }
+            (w[0] != 0 && w[8] == check(&w[..8])).then_some(w[0])
+        })
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids
 }
 
 /// A shared writable mapping of the first `slots` slots of `file`, grown to

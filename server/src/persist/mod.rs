@@ -5,6 +5,7 @@
 //! [`Durability`](crate::engine::durability::Durability)) and
 //! [`open_state`] opens the store of a persisting server.
 
+pub mod aside;
 mod backends;
 pub mod database;
 mod disk;

@@ -3,6 +3,7 @@
 
 use super::attach;
 use super::database::{Database, WriteFaults};
+use super::journal;
 use crate::engine::state::test_support::*;
 use crate::engine::state::{BULK_REMOVAL, Limits, State};
 use gjkd_proto::{
@@ -277,5 +278,61 @@ fn a_removal_then_a_registration_reloads() {
     assert_eq!(r.object(b).expect("there").slot, slot);
     let c = register_box(&mut r, 1);
     assert!(c > b && c > a, "ids are not reused");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A store file cut to zero bytes while its pose journal names objects is
+/// not a new store: it is set aside with its journal, and the objects the
+/// journal names are reported lost (they were opened as a new, empty store
+/// with nothing said above INFO).
+#[test]
+fn an_empty_store_file_whose_journal_names_objects_is_set_aside() {
+    let (dir, path, mut s) = stored("empty-store");
+    let ids: Vec<u64> = (0..3).map(|_| register_box(&mut s, 1)).collect();
+    drop(s);
+    std::fs::File::create(&path).expect("truncate to zero bytes");
+    let (db, opened) = Database::open(&path, 9).expect("reopen");
+    assert_eq!(opened.lost, ids);
+    assert!(opened.fresh && opened.snapshot.objects.is_empty());
+    let [store, poses] = opened.set_aside.as_slice() else {
+        panic!("the store and its journal set aside: {opened:?}");
+    };
+    assert_eq!(std::fs::metadata(store).expect("kept").len(), 0);
+    assert_eq!(journal::ids_in(poses), ids, "the journal kept as it was");
+    assert!(journal::ids_in(&journal::path_for(&path)).is_empty());
+    drop(db);
+    // The new store is a store: the next start finds it whole.
+    assert!(reload(&path).objects.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A store that cannot be read reports the ids its journal names too (its
+/// own pages name none here), and its journal goes aside with it.
+#[test]
+fn an_unreadable_store_reports_the_objects_its_journal_names() {
+    let (dir, path, mut s) = stored("garbage-store");
+    let ids: Vec<u64> = (0..2).map(|_| register_box(&mut s, 1)).collect();
+    drop(s);
+    std::fs::write(&path, b"not a database at all").expect("overwrite");
+    let (_, opened) = Database::open(&path, 9).expect("reopen");
+    assert_eq!(opened.lost, ids);
+    assert_eq!(opened.set_aside.len(), 2, "{opened:?}");
+    assert_eq!(
+        std::fs::read(&opened.set_aside[0]).expect("kept"),
+        b"not a database at all"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An empty store with no journal, or a journal naming nothing, is a new
+/// store as before: nothing is set aside.
+#[test]
+fn an_empty_store_without_journaled_objects_is_new() {
+    let dir = scratch("empty-no-journal");
+    let path = dir.join("objects");
+    std::fs::File::create(&path).expect("empty file");
+    let (db, opened) = Database::open(&path, 9).expect("open");
+    assert!(opened.fresh && opened.set_aside.is_empty() && opened.lost.is_empty());
+    drop(db);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -13,22 +13,20 @@
 //! Beside them the paper's Table 1 ratio (cold over warm-started sweeps).
 //! The steps that hit are compared between the two ways.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use gjkd_client::{Client, Item, ObjectId, QueryOptions};
-use gjkd_proto::{PathMode, SceneKind, SceneReply, SceneRequest, SceneRow};
+use gjkd_proto::{PathMode, SceneRequest, SceneRow};
 use gjkd_testkit::paper::{self, Motion, OBSTACLES};
-use nalgebra::Isometry3;
 
-use crate::demo::{Buffers, PAPER_RATIOS, Registered, ServerProcess, register, sweep};
 use crate::scene_inprocess::InProcess;
-use crate::scene_robot::load_average;
+use crate::served_sweep::{
+    Buffers, DemoError, PAPER_RATIOS, PathBuffers, Registered, SERVER_ARGS, path_sweep,
+    path_sweep_with, register, sweep,
+};
+use crate::server_process::ServerProcess;
 use crate::stats::Csv;
 use crate::{BenchError, CommonArgs, io, out_dir, scene_call};
-
-/// Arguments of the servers the sweep runs through: a batch limit that
-/// holds a whole T = 1 000 path in one request.
-pub const SERVER_ARGS: [&str; 5] = ["--wait", "spin", "--no-persist", "--max-batch", "8192"];
 
 /// Flags of `gjkd bench sweep`.
 #[derive(clap::Args, Debug)]
@@ -41,103 +39,6 @@ pub struct SweepArgs {
     /// Repetitions of each timed sweep (the median is reported).
     #[arg(long, default_value_t = 15)]
     repeats: usize,
-}
-
-/// One path request's outcome.
-pub(crate) struct PathSweep {
-    /// Per step, the obstacles within the margin, as bits.
-    pub(crate) hits: Vec<u8>,
-    /// [`PathMode::FirstHit`]: the step that hit first.
-    pub(crate) first_hit: Option<usize>,
-    /// Round trip of the request.
-    pub(crate) elapsed: Duration,
-    /// Pair queries that ran GJK, and pairs answered from motion bounds.
-    pub(crate) work: (u64, u64),
-}
-
-/// Reusable buffers of the path requests.
-pub(crate) struct PathBuffers {
-    items: Vec<Item>,
-    rows: Vec<SceneRow>,
-}
-
-impl PathBuffers {
-    /// Room for paths of up to `steps` steps.
-    pub(crate) fn new(steps: usize) -> Self {
-        PathBuffers {
-            items: Vec::with_capacity(steps + 1),
-            rows: vec![SceneRow::default(); (steps + 1) * OBSTACLES],
-        }
-    }
-}
-
-/// The sweep of `steps` steps as one path request in `mode`: the moving
-/// object's pose per step, flagged to end it; the obstacles within margin 0.
-///
-/// # Errors
-/// The client's, a scene error, or a truncated answer.
-pub(crate) fn path_sweep(
-    client: &mut Client,
-    motion: &Motion,
-    scene: &Registered,
-    steps: usize,
-    mode: PathMode,
-    buf: &mut PathBuffers,
-) -> Result<PathSweep, BenchError> {
-    let mut call =
-        |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| scene_call::query(client, r, i, rows);
-    path_sweep_with(&mut call, motion, scene, steps, mode, buf)
-}
-
-/// How a scene request is sent: through a client, or to the engine in
-/// process.
-type SceneCall<'a> =
-    dyn FnMut(&SceneRequest, &[Item], &mut [SceneRow]) -> Result<SceneReply, BenchError> + 'a;
-
-/// [`path_sweep`] with the request sent by `call`.
-fn path_sweep_with(
-    call: &mut SceneCall<'_>,
-    motion: &Motion,
-    scene: &Registered,
-    steps: usize,
-    mode: PathMode,
-    buf: &mut PathBuffers,
-) -> Result<PathSweep, BenchError> {
-    let steps = steps.max(1);
-    // Poses are computed before the clock starts, as in the demo.
-    let poses: Vec<Isometry3<f64>> = (0..=steps)
-        .map(|t| motion.pose(t as f64 / steps as f64))
-        .collect();
-    buf.items.clear();
-    for pose in &poses {
-        buf.items
-            .push(Item::set_pose(scene.moving, pose).ending_step());
-    }
-    buf.rows
-        .resize((steps + 1) * OBSTACLES, SceneRow::default());
-    let mut request = SceneRequest::new(SceneKind::Within, scene.moving.raw());
-    request.path = mode as u32;
-    request.margin = 0.0;
-    request.max_rows = buf.rows.len() as u32;
-    let start = Instant::now();
-    let reply = call(&request, &buf.items, &mut buf.rows)?;
-    let elapsed = start.elapsed();
-    if reply.total > u64::from(request.max_rows) {
-        return Err(BenchError::Other("a path answer was truncated".into()));
-    }
-    let mut hits = vec![0u8; steps + 1];
-    for row in &buf.rows[..reply.total as usize] {
-        let obstacle = scene.obstacles.iter().position(|o| o.raw() == row.b);
-        if let (Some(i), Some(h)) = (obstacle, hits.get_mut(row.step as usize)) {
-            *h |= 1 << i;
-        }
-    }
-    Ok(PathSweep {
-        hits,
-        first_hit: (reply.first_hit != u32::MAX).then_some(reply.first_hit as usize),
-        elapsed,
-        work: (reply.gjk_runs, reply.bounded),
-    })
 }
 
 /// Runs the benchmark.
@@ -214,7 +115,7 @@ fn measure_steps(
     let (mut engine, engine_ids) = in_process(motion)?;
     let mut engine_call =
         |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| engine.query(r, i, rows);
-    let demo = |e: crate::demo::DemoError| BenchError::Other(e.to_string());
+    let demo = |e: DemoError| BenchError::Other(e.to_string());
     let margin0 = QueryOptions {
         margin: Some(0.0),
         ..QueryOptions::cold()
@@ -293,7 +194,7 @@ fn measure(service: &str, args: &SweepArgs) -> Result<(), BenchError> {
          the T + 1 steps, is any obstacle within margin 0? Median of {repeats} runs, as seen by the client.\n\
          Machine: {}; load average {}.\n",
         crate::machine(),
-        load_average()
+        crate::load_average()
     );
     println!(
         "{:>6} {:>12} {:>12} {:>12} {:>9} {:>9} {:>12} {:>8} {:>7} {:>8}",

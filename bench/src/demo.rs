@@ -2,7 +2,7 @@
 //!
 //! It starts `gjkd serve` as a child process on a private service name,
 //! registers the Section 8 scene (a compound object moving and turning
-//! through five fixed obstacles, from `gjkd_testkit::paper::section8`) through the
+//! through five fixed obstacles, from `gjkd_paper::section8`) through the
 //! client library, sweeps the path at T = 10, 100 and 1000 steps, and prints
 //! the distance to each obstacle along the path and the time of cold-started
 //! sweeps against sweeps warm-started from the server's per-pair cache, beside
@@ -18,221 +18,17 @@
 //! simplex the previous step left for that pair, exactly as in the paper.
 
 use std::io::Write;
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use gjk::{Options, Shape};
-use gjkd_client::{
-    Client, ClientError, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions, Status,
+use gjk::Options;
+use gjkd_client::{Client, QueryOptions};
+use gjkd_paper::{self as paper, Motion, OBSTACLES};
+
+pub use crate::served_sweep::DemoError;
+use crate::served_sweep::{
+    Buffers, PAPER_RATIOS, PathBuffers, Registered, SERVER_ARGS, path_sweep, register, sweep,
 };
-use gjkd_testkit::paper::{self, Motion, OBSTACLES};
-use nalgebra::Isometry3;
-
-/// The paper's Table 1: time without warm start over time with it, for
-/// T = 10, 100, 1000.
-pub const PAPER_RATIOS: [(usize, f64); 3] = [(10, 1.7), (100, 2.9), (1000, 3.1)];
-
-/// What can stop the demo.
-#[derive(Debug, thiserror::Error)]
-pub enum DemoError {
-    /// The server process could not be started.
-    #[error("cannot start the server: {0}")]
-    Spawn(std::io::Error),
-    /// A client call failed.
-    #[error("client: {0}")]
-    Client(#[from] ClientError),
-    /// An answer failed or disagreed with the in-process computation.
-    #[error("{0}")]
-    Check(String),
-}
-
-/// A `gjkd serve` child process, stopped with SIGTERM when dropped.
-pub struct ServerProcess {
-    child: Child,
-    /// The service name it serves.
-    pub service: String,
-}
-
-impl ServerProcess {
-    /// Starts `gjkd serve --service SERVICE` plus `extra` arguments, using
-    /// the current executable (which must be `gjkd`).
-    ///
-    /// # Errors
-    /// When the process cannot be spawned.
-    pub fn spawn(service: &str, extra: &[&str]) -> std::io::Result<Self> {
-        let exe = std::env::current_exe()?;
-        let child = Command::new(exe)
-            .arg("serve")
-            .arg("--service")
-            .arg(service)
-            .args(extra)
-            .env(
-                "RUST_LOG",
-                std::env::var("GJKD_DEMO_LOG").unwrap_or_else(|_| "warn".into()),
-            )
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .spawn()?;
-        Ok(ServerProcess {
-            child,
-            service: service.to_owned(),
-        })
-    }
-
-    /// The child's process id.
-    pub fn id(&self) -> u32 {
-        self.child.id()
-    }
-
-    /// Sends SIGTERM and waits up to five seconds for a clean exit, then
-    /// kills. Returns whether it exited cleanly.
-    pub fn stop(&mut self) -> bool {
-        if let Ok(Some(status)) = self.child.try_wait() {
-            return status.success();
-        }
-        if let Ok(pid) = libc::pid_t::try_from(self.child.id()) {
-            // SAFETY: kill(2) with a pid we spawned and have not reaped yet.
-            unsafe {
-                libc::kill(pid, libc::SIGTERM);
-            }
-        }
-        let deadline = Instant::now() + Duration::from_secs(5);
-        while Instant::now() < deadline {
-            if let Ok(Some(status)) = self.child.try_wait() {
-                return status.success();
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        false
-    }
-}
-
-impl Drop for ServerProcess {
-    fn drop(&mut self) {
-        self.stop();
-    }
-}
-
-/// The scene as registered with the server.
-pub(crate) struct Registered {
-    pub(crate) moving: ObjectId,
-    pub(crate) obstacles: [ObjectId; OBSTACLES],
-}
-
-pub(crate) fn register(client: &mut Client, motion: &Motion) -> Result<Registered, DemoError> {
-    let Shape::Compound(moving) = motion.moving() else {
-        return Err(DemoError::Check(
-            "the moving object is not a compound".into(),
-        ));
-    };
-    let pieces: Vec<Piece<'_>> = moving
-        .pieces()
-        .iter()
-        .map(|(offset, convex)| Piece {
-            offset: *offset,
-            geometry: Geometry::Polytope {
-                vertices: convex.vertices(),
-                radius: convex.radius(),
-            },
-        })
-        .collect();
-    let moving = client.register_named("KA", &Geometry::Compound(&pieces), &motion.pose(0.0))?;
-    let mut obstacles = [ObjectId::from_raw(0); OBSTACLES];
-    for (i, (shape, pose)) in motion.obstacles().iter().enumerate() {
-        let Shape::Convex(c) = shape else {
-            return Err(DemoError::Check(format!(
-                "obstacle {} is not convex",
-                i + 1
-            )));
-        };
-        let geometry = Geometry::Polytope {
-            vertices: c.vertices(),
-            radius: c.radius(),
-        };
-        obstacles[i] = client.register_named(&format!("K{}", i + 1), &geometry, pose)?;
-    }
-    Ok(Registered { moving, obstacles })
-}
-
-/// One sweep through the server: distances per step, total iterations.
-pub(crate) struct ServedSweep {
-    pub(crate) distances: Vec<[f64; OBSTACLES]>,
-    /// Per step, the obstacles proved within the query's margin (or at
-    /// distance 0 without one), as bits.
-    pub(crate) hits: Vec<u8>,
-    iterations: u64,
-    pub(crate) elapsed: Duration,
-}
-
-/// Reusable buffers, so that timing measures the server and not `Vec` growth.
-pub(crate) struct Buffers {
-    pub(crate) items: Vec<Item>,
-    pub(crate) results: Vec<ItemResult>,
-}
-
-pub(crate) fn sweep(
-    client: &mut Client,
-    motion: &Motion,
-    scene: &Registered,
-    steps: usize,
-    options: &QueryOptions,
-    max_batch: usize,
-    buffers: &mut Buffers,
-) -> Result<ServedSweep, DemoError> {
-    let steps = steps.max(1);
-    let per_batch = (max_batch / OBSTACLES).max(1);
-    // Poses are computed before the clock starts: the paper times the
-    // distance computations, not the path.
-    let poses: Vec<Isometry3<f64>> = (0..=steps)
-        .map(|t| motion.pose(t as f64 / steps as f64))
-        .collect();
-    let mut distances = Vec::with_capacity(steps + 1);
-    let mut hits = Vec::with_capacity(steps + 1);
-    let mut iterations = 0u64;
-    let mut elapsed = Duration::ZERO;
-    for chunk in poses.chunks(per_batch) {
-        buffers.items.clear();
-        for pose in chunk {
-            for &o in &scene.obstacles {
-                buffers
-                    .items
-                    .push(Item::distance(scene.moving, o, options).with_pose_a(pose));
-            }
-        }
-        let n = buffers.items.len();
-        buffers.results.resize(n, ItemResult::default());
-        let start = Instant::now();
-        client.query_batch(&buffers.items, &mut buffers.results[..n])?;
-        elapsed += start.elapsed();
-        for step in buffers.results[..n].chunks(OBSTACLES) {
-            let mut d = [0.0; OBSTACLES];
-            let mut hit = 0u8;
-            for (i, (slot, r)) in d.iter_mut().zip(step).enumerate() {
-                let a = r
-                    .answer()
-                    .map_err(|e| DemoError::Check(format!("query failed: {e}")))?;
-                *slot = a.distance;
-                iterations += u64::from(a.iterations);
-                let within = match a.status {
-                    Some(Status::Closer) => true,
-                    Some(Status::Farther) => false,
-                    _ => a.distance <= options.margin.unwrap_or(0.0),
-                };
-                hit |= u8::from(within) << i;
-            }
-            distances.push(d);
-            hits.push(hit);
-        }
-    }
-    Ok(ServedSweep {
-        distances,
-        hits,
-        iterations,
-        elapsed,
-    })
-}
+pub use crate::server_process::ServerProcess;
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -257,8 +53,7 @@ pub struct DemoArgs {
 /// disagrees with the in-process computation.
 pub fn run(steps: &[usize], repeats: usize) -> Result<(), DemoError> {
     let service = format!("gjkd-demo-{}", std::process::id());
-    let mut server = ServerProcess::spawn(&service, &crate::collision_sweep::SERVER_ARGS)
-        .map_err(DemoError::Spawn)?;
+    let mut server = ServerProcess::spawn(&service, &SERVER_ARGS).map_err(DemoError::Spawn)?;
     let outcome = run_with_server(&service, steps, repeats);
     let clean = server.stop();
     let () = outcome?;
@@ -443,7 +238,6 @@ fn collision_row(
     repeats: usize,
     cold: Duration,
 ) -> Result<(), DemoError> {
-    use crate::collision_sweep::{PathBuffers, path_sweep};
     if !crate::scene_call::available() {
         let _ = writeln!(
             out,

@@ -26,28 +26,51 @@
 //! Each writes a table to stdout, CSV and SVG plots to `--out`, and shows a
 //! progress bar while it runs. Timing is never asserted anywhere: the tests
 //! cover only the logic (percentiles, fits, the Pareto front).
+//!
+//! The measurements are behind the default feature `measure`; without it
+//! (as the `gjkd` daemon links this crate unless built with its `bench`
+//! feature) only the demo is here, and `gjkd bench` says how to get them.
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "measure")]
 use std::path::PathBuf;
 
+#[cfg(feature = "measure")]
 pub mod collision_sweep;
 pub mod demo;
+#[cfg(feature = "measure")]
 pub mod extremes;
+#[cfg(feature = "measure")]
 pub mod latency;
+#[cfg(feature = "measure")]
 pub mod paper;
+#[cfg(feature = "measure")]
 pub mod plot;
+#[cfg(feature = "measure")]
 pub mod robot;
 pub mod robot_demo;
 pub mod scene_call;
+#[cfg(feature = "measure")]
 pub mod scene_inprocess;
+#[cfg(feature = "measure")]
 pub mod scene_parry;
+#[cfg(feature = "measure")]
 pub mod scene_robot;
+#[cfg(feature = "measure")]
 pub mod scene_world;
+pub mod served_sweep;
+pub mod server_process;
+#[cfg(feature = "measure")]
 pub mod stats;
+#[cfg(feature = "measure")]
 pub mod tradeoff;
+#[cfg(feature = "measure")]
+mod tradeoff_by_size;
+#[cfg(feature = "measure")]
 pub mod uds;
 
+#[cfg(feature = "measure")]
 /// `gjkd bench` and its subcommands.
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
@@ -55,6 +78,7 @@ pub struct BenchArgs {
     command: BenchCommand,
 }
 
+#[cfg(feature = "measure")]
 #[derive(clap::Subcommand, Debug)]
 enum BenchCommand {
     /// Round-trip latency: spin, block and adaptive servers, a Unix-socket
@@ -82,6 +106,7 @@ enum BenchCommand {
     UdsServer(uds::UdsServerArgs),
 }
 
+#[cfg(feature = "measure")]
 /// Flags every bench command has.
 #[derive(clap::Args, Clone, Debug)]
 pub struct CommonArgs {
@@ -114,6 +139,7 @@ pub enum BenchError {
     Other(String),
 }
 
+#[cfg(feature = "measure")]
 impl BenchError {
     /// An item's or a scene request's error code.
     pub(crate) fn from_code(code: gjkd_client::ErrorCode) -> Self {
@@ -121,11 +147,13 @@ impl BenchError {
     }
 }
 
+#[cfg(feature = "measure")]
 /// `Result::map_err` helper naming what was being done.
 pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T, BenchError> {
     r.map_err(|e| BenchError::Io(what.into(), e))
 }
 
+#[cfg(feature = "measure")]
 /// Runs one `gjkd bench` subcommand.
 ///
 /// # Errors
@@ -171,6 +199,7 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
     Ok(())
 }
 
+#[cfg(feature = "measure")]
 /// Creates the output directory.
 pub(crate) fn out_dir(common: &CommonArgs) -> Result<PathBuf, BenchError> {
     io(
@@ -197,4 +226,32 @@ pub fn machine() -> String {
         .map(|s| s.trim().to_owned())
         .unwrap_or_default();
     format!("{cpu}, {cores} cores, Linux {kernel}")
+}
+
+/// The 1-, 5- and 15-minute load averages, as `/proc/loadavg` gives them.
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// `gjkd bench` in a build without the measurements: takes any arguments.
+#[cfg(not(feature = "measure"))]
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    /// The measurement and its flags.
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    args: Vec<String>,
+}
+
+/// `gjkd bench` in a build without the measurements.
+///
+/// # Errors
+/// Always: says how to build them in.
+#[cfg(not(feature = "measure"))]
+pub fn run(args: BenchArgs) -> Result<(), BenchError> {
+    Err(BenchError::Other(format!(
+        "`bench {}`: this gjkd was built without the measurements; run them with `cargo run --release -p gjkd --features bench -- bench ...`",
+        args.args.join(" ")
+    )))
 }

@@ -2,7 +2,9 @@
 //! measurements (`gjkd bench`) and a state-file tool (`gjkd objects`).
 //!
 //! A thin command line: the daemon's commands come from `gjkd-server`, the
-//! demo and the measurements from `gjkd-bench`.
+//! demo and the measurements from `gjkd-bench` (the measurements only with
+//! this package's `bench` feature, so that an installed daemon links no
+//! test kit, plotting or progress crate).
 
 use std::process::ExitCode;
 
@@ -32,7 +34,8 @@ enum Command {
     /// Measurements: `latency`, `tradeoff` (speed against accuracy),
     /// `paper` (Section 7), `robot`, `scene-robot` (a robot among 1 000
     /// obstacles, beside parry3d-f64) and `sweep` (Section 8 as a collision
-    /// sweep). See docs/benchmarks.md.
+    /// sweep). See docs/benchmarks.md. Built in with the `bench` feature
+    /// (`cargo run --release -p gjkd --features bench -- bench ...`).
     Bench(gjkd_bench::BenchArgs),
     /// List the objects of a stopped server's state file, with whether each
     /// owner still runs; with --remove-departed, remove those whose

@@ -23,7 +23,9 @@
 
 pub mod check;
 pub mod input;
-pub mod paper;
+/// The paper's test data (crate `gjkd-paper`, apart so that `gjkd demo`
+/// does not link the test kit).
+pub use gjkd_paper as paper;
 #[cfg(feature = "parry")]
 pub mod parry;
 pub mod reference;

@@ -245,11 +245,23 @@ fn a_corrupt_state_file_is_set_aside_never_half_loaded() {
         drop(client);
         server.terminate();
         let dir = path.parent().expect("dir");
-        let aside: Vec<_> = std::fs::read_dir(dir)
-            .expect("list")
-            .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().contains(".corrupt-"))
-            .collect();
+        let store_name = path
+            .file_name()
+            .expect("name")
+            .to_string_lossy()
+            .into_owned();
+        let kept = |prefix: String| -> Vec<_> {
+            std::fs::read_dir(dir)
+                .expect("list")
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+                .collect()
+        };
+        // The pose journal, which names the objects lost, goes aside with it.
+        let poses = kept(format!("{store_name}.poses.corrupt-"));
+        assert_eq!(poses.len(), 1, "{what}: the journal is kept aside");
+        std::fs::remove_file(poses[0].path()).expect("clean");
+        let aside = kept(format!("{store_name}.corrupt-"));
         assert_eq!(aside.len(), 1, "{what}: the bad file is kept aside");
         assert_eq!(
             std::fs::read(aside[0].path()).expect("read"),
@@ -283,7 +295,7 @@ fn a_state_file_in_use_is_not_shared() {
     drop(client);
     let mut first = first;
     first.terminate();
-    let (_, opened) = gjkd_server::database::Database::open(&path, 1).expect("intact");
+    let (_, opened) = gjkd_server::persist::database::Database::open(&path, 1).expect("intact");
     assert!(opened.set_aside.is_empty() && !opened.fresh);
     let snap = opened.snapshot;
     assert!(snap.objects.is_empty());

@@ -146,3 +146,60 @@ fn a_full_disk_refuses_changes_serves_the_rest_and_recovers_without_restart() {
     drop(client);
     server.terminate();
 }
+
+/// A server started on a disk too small for a new store starts and serves;
+/// it refuses registrations with `StorageFull` until there is room, then
+/// accepts them without a restart. (It exited, unable to open its pose
+/// journal.)
+#[test]
+fn a_server_starts_on_a_disk_too_small_for_a_new_store() {
+    let Some(tmpfs) = Tmpfs::mount("64k") else {
+        eprintln!("cannot mount a tmpfs (not root?): nothing checked");
+        return;
+    };
+    let store = tmpfs.0.join("objects");
+    let store_arg = store.to_str().expect("utf-8").to_owned();
+    let mut server = Server::start(
+        "small-disk",
+        &["--wait", "block", "--state-file", &store_arg],
+    );
+    let mut client = server.client(Duration::from_secs(5));
+    assert_eq!(client.stats().expect("served").objects, 0);
+    let mut refused = false;
+    for _ in 0..200 {
+        let r = client.register_sphere(0.25);
+        if storage_full(&r) {
+            refused = true;
+            break;
+        }
+        r.expect("either registered or StorageFull");
+    }
+    assert!(refused, "no StorageFull on a 64 KiB disk");
+    let objects = client.stats().expect("stats").objects;
+
+    // Room again (the file system grown in place): accepted at once.
+    let status = std::process::Command::new("mount")
+        .args(["-o", "remount,size=4m"])
+        .arg(&tmpfs.0)
+        .status()
+        .expect("remount");
+    assert!(status.success());
+    let a = client
+        .register_sphere(0.5)
+        .expect("registered once there is room");
+    let b = client
+        .register_cuboid(Vector3::new(0.5, 0.5, 0.5), 0.0)
+        .expect("registered");
+    client
+        .set_pose(b, &Isometry3::translation(3.0, 0.0, 0.0))
+        .expect("pose");
+    let d = client.distance(a, b, &QueryOptions::cold()).expect("query");
+    assert!((d.distance - 2.0).abs() < 1e-12, "{d:?}");
+    assert_eq!(client.stats().expect("stats").objects, objects + 2);
+    server.kill9();
+    server.restart();
+    let stats = once_reached(|| client.stats());
+    assert_eq!(stats.objects, objects + 2, "kept across a crash");
+    drop(client);
+    server.terminate();
+}

@@ -8,8 +8,9 @@
 //! server library instead of inside it.
 //!
 //! - [`latency`]: round trips through real `gjkd serve` processes in each
-//!   wait mode, beside a Unix-socket server process and a plain function call, with
-//!   HdrHistogram percentiles.
+//!   wait mode, beside a Unix-socket server process, a bare iceoryx2 server
+//!   ([`raw_ipc`]) and a plain function call, with HdrHistogram percentiles;
+//!   quiet or beside competing busy processes ([`busy`]), pinned or not.
 //! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
 //!   and cold starts and early-exit margins, judged by an exact reference
 //!   ([`gjkd_testkit::reference`](mod@gjkd_testkit::reference)) that owes nothing to GJK.
@@ -31,12 +32,15 @@
 
 use std::path::PathBuf;
 
+pub mod busy;
 pub mod collision_sweep;
 pub mod demo;
 pub mod extremes;
 pub mod latency;
+pub mod latency_objects;
 pub mod paper;
 pub mod plot;
+pub mod raw_ipc;
 pub mod robot;
 pub mod robot_demo;
 pub mod scene_call;
@@ -80,6 +84,12 @@ enum BenchCommand {
     /// The socket server `latency` starts as a child process.
     #[command(hide = true)]
     UdsServer(uds::UdsServerArgs),
+    /// The bare iceoryx2 server `latency` starts as a child process.
+    #[command(hide = true)]
+    RawServer(raw_ipc::RawServerArgs),
+    /// A busy process `latency --competitors` starts.
+    #[command(hide = true)]
+    Busy(busy::BusyArgs),
 }
 
 /// Flags every bench command has.
@@ -131,10 +141,16 @@ pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T,
 /// # Errors
 /// What stopped it.
 pub fn run(args: BenchArgs) -> Result<(), BenchError> {
-    if let BenchCommand::UdsServer(a) = &args.command {
-        // A child of `latency`: it serves until killed and prints nothing
-        // but its ready line.
-        return uds::run_server(a);
+    // Children of `latency`: they serve or compute until stopped and print
+    // nothing but a ready line.
+    match &args.command {
+        BenchCommand::UdsServer(a) => return uds::run_server(a),
+        BenchCommand::RawServer(a) => return raw_ipc::run_server(a),
+        BenchCommand::Busy(a) => {
+            busy::run_busy(a);
+            return Ok(());
+        }
+        _ => {}
     }
     let start = std::time::Instant::now();
     let what = match args.command {
@@ -162,7 +178,9 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
             collision_sweep::run(&a)?;
             "sweep"
         }
-        BenchCommand::UdsServer(_) => unreachable!("handled above"),
+        BenchCommand::UdsServer(_) | BenchCommand::RawServer(_) | BenchCommand::Busy(_) => {
+            unreachable!("handled above")
+        }
     };
     println!(
         "\ngjkd bench {what}: finished in {:.1} s (wall time of the whole command)",

@@ -14,7 +14,7 @@
 //!
 //! The child registers the bench's objects itself, through the same admin
 //! handler and in the same order as the in-process baseline
-//! (`latency::local_state`), so the ids the client sends name the same
+//! (`latency_objects::local_state`), so the ids the client sends name the same
 //! objects on both sides; `gjkd bench latency` checks the first answer.
 
 use std::io::{Read, Write};
@@ -69,7 +69,7 @@ pub struct UdsServerArgs {
     #[arg(long)]
     cpu: Option<usize>,
     /// The largest batch the client will send: the server registers the
-    /// bench's objects for it (`latency::local_state`).
+    /// bench's objects for it (`latency_objects::local_state`).
     #[arg(long, default_value_t = 512)]
     max_batch: usize,
 }
@@ -90,9 +90,10 @@ pub fn run_server(args: &UdsServerArgs) -> Result<(), BenchError> {
         libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
     }
     if let Some(cpu) = args.cpu {
-        super::latency::pin(0, cpu);
+        gjkd_rt::pin_current_thread(cpu)
+            .map_err(|e| BenchError::Other(format!("uds-server --cpu {cpu}: {e}")))?;
     }
-    let (state, ..) = super::latency::local_state(args.max_batch.max(1));
+    let (state, ..) = super::latency_objects::local_state(args.max_batch.max(1));
     let _ = std::fs::remove_file(&args.socket);
     let listener = io(
         format!("bind {}", args.socket.display()),

@@ -8,7 +8,8 @@
 //! stored form of objects in [`stored`] and the migration of the old state
 //! file in [`legacy`]), the pose journal ([`journal`]), the offline
 //! `gjkd objects` command ([`offline`]), the iceoryx2 serving loop
-//! ([`server`]) and the daemon's commands with their flags ([`commands`]).
+//! ([`server`]) with its wait policy ([`wait`]), and the daemon's commands
+//! with their flags ([`commands`]).
 //! The `gjkd` binary (package `gjkd`) is a thin command line over these and
 //! the tools of `gjkd-bench`.
 //!
@@ -53,3 +54,4 @@ pub mod state;
 pub mod store;
 pub mod stored;
 pub mod tokens;
+pub mod wait;

@@ -19,6 +19,7 @@ use iceoryx2::prelude::*;
 use tracing::{debug, error, info, warn};
 
 use crate::state::{Limits, State};
+use crate::wait::{Idle, WaitPolicy};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
@@ -76,13 +77,6 @@ fn server_port_error<'a>(
 fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError {
     move |e| ServerError::Ipc(format!("{what}: {e:?}"))
 }
-
-/// How long `adaptive` keeps spinning after the last request before it
-/// sleeps. Long enough to cover a client's think time between queries of one
-/// control cycle, short enough that an idle server costs no CPU.
-pub const ADAPTIVE_SPIN: Duration = Duration::from_micros(50);
-/// While spinning idle, yield the core this often.
-const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 /// Longest sleep in `block` mode: the loop wakes this often to look at the
 /// shutdown flag (signal handlers cannot wake an iceoryx2 wait) and do
@@ -333,8 +327,7 @@ fn serve_until(
     waitset: &WaitSet<ipc::Service>,
     shutdown: &AtomicBool,
 ) {
-    let mut last_request = Instant::now();
-    let mut last_yield = Instant::now();
+    let mut wait = WaitPolicy::new(options.wait, Instant::now());
     let mut house = Housekeeping {
         last: Instant::now(),
         reap_after: Instant::now(),
@@ -357,13 +350,10 @@ fn serve_until(
         }
         let now = Instant::now();
         if served > 0 {
-            last_request = now;
-            // Yield only after POLITE_EVERY of idleness, not at the first
-            // idle turn after each reply.
-            last_yield = now;
+            wait.served(now);
         }
         let since = now.duration_since(house.last);
-        if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
+        if (now.duration_since(wait.last_request()) > IDLE_BEFORE_HOUSEKEEPING
             && since > HOUSEKEEPING_PERIOD)
             || since > HOUSEKEEPING_FORCED
         {
@@ -372,20 +362,13 @@ fn serve_until(
         if served > 0 {
             continue;
         }
-        let sleep = match options.wait {
-            WaitMode::Spin => false,
-            WaitMode::Block => true,
-            WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
-        };
-        if sleep {
-            block(waitset, endpoints);
-        } else if now.duration_since(last_yield) >= POLITE_EVERY {
-            // A client scheduled onto this core could not send while the
-            // server spins: give the core away now and then.
-            std::thread::yield_now();
-            last_yield = Instant::now();
-        } else {
-            std::hint::spin_loop();
+        // Never a yield: see `wait` for why.
+        match wait.idle(now) {
+            Idle::Sleep => {
+                block(waitset, endpoints);
+                wait.woke(Instant::now());
+            }
+            Idle::Spin => std::hint::spin_loop(),
         }
     }
 }

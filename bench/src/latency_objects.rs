@@ -7,7 +7,7 @@
 //! client.
 
 use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, ObjectId, Vertex, WaitMode, shape_kind};
-use gjkd_server::state::{Limits, State};
+use gjkd_server::engine::{Limits, State};
 use nalgebra::{Isometry3, Vector3};
 
 /// Half extents of every box.
@@ -56,4 +56,3 @@ pub(crate) fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<O
     state.handle(0, &set, &mut out);
     (state, a, b, boxes)
 }
-

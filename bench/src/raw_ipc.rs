@@ -238,7 +238,9 @@ impl RawClient {
             // The clock is read now and then, not every turn: the floor is
             // the transport's, not the clock's.
             if turns.is_multiple_of(1024) && Instant::now() > deadline {
-                return Err(BenchError::Other("raw iceoryx2 server did not answer".into()));
+                return Err(BenchError::Other(
+                    "raw iceoryx2 server did not answer".into(),
+                ));
             }
             std::hint::spin_loop();
         }

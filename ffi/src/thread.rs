@@ -86,6 +86,10 @@ mod tests {
             gjkd_set_realtime_priority(0),
             gjkd_status::GJKD_ERR_INVALID_ARGUMENT
         );
-        assert!(last_error().contains("out of range: 1 to 99"), "{}", last_error());
+        assert!(
+            last_error().contains("out of range: 1 to 99"),
+            "{}",
+            last_error()
+        );
     }
 }

@@ -200,7 +200,10 @@ mod tests {
     fn a_cpu_beyond_any_set_is_refused_by_number() {
         let err = pin_current_thread(1 << 20).expect_err("no such CPU");
         assert!(matches!(err, PinError::NoSuchCpu { cpu, .. } if cpu == 1 << 20));
-        assert!(err.to_string().contains("CPU 1048576 does not exist"), "{err}");
+        assert!(
+            err.to_string().contains("CPU 1048576 does not exist"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -245,7 +245,12 @@ mod tests {
     /// As `paced`, but the client shares the server's CPU: it cannot send
     /// while the server spins, so each request arrives `gap` after the
     /// server stops spinning (or after the answer, when it sleeps at once).
-    fn co_located(policy: &mut WaitPolicy, start: Instant, gap: Duration, n: u32) -> (Instant, u32) {
+    fn co_located(
+        policy: &mut WaitPolicy,
+        start: Instant,
+        gap: Duration,
+        n: u32,
+    ) -> (Instant, u32) {
         let mut now = start;
         let mut spun = 0;
         for _ in 0..n {

@@ -44,7 +44,10 @@ fn cpus_of(pid: u32) -> String {
 
 #[test]
 fn a_pinned_server_serves_from_its_cpu() {
-    let cpu = *gjkd_client::rt::allowed_cpus().expect("affinity").last().expect("a CPU");
+    let cpu = *gjkd_client::rt::allowed_cpus()
+        .expect("affinity")
+        .last()
+        .expect("a CPU");
     let server = Server::start("cpu", &["--cpu", &cpu.to_string()]);
     let mut client = server.client(Duration::from_secs(5));
     // The serving loop runs on the main thread, whose id is the pid.
@@ -65,7 +68,10 @@ fn a_cpu_that_does_not_exist_is_refused_by_number() {
     let out = serve_refused(&[], &["--cpu", "4000000"]);
     assert!(!out.status.success());
     let err = stderr(&out);
-    assert!(err.contains("--cpu 4000000: CPU 4000000 does not exist"), "{err}");
+    assert!(
+        err.contains("--cpu 4000000: CPU 4000000 does not exist"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -74,7 +80,10 @@ fn a_cpu_outside_the_allowed_set_is_refused_listing_the_allowed_ones() {
     let out = serve_refused(&[], &["--cpu", "1023"]);
     assert!(!out.status.success());
     let err = stderr(&out);
-    assert!(err.contains("--cpu 1023: CPU 1023 is not one this thread may run on (allowed: "), "{err}");
+    assert!(
+        err.contains("--cpu 1023: CPU 1023 is not one this thread may run on (allowed: "),
+        "{err}"
+    );
 }
 
 #[test]
@@ -82,7 +91,10 @@ fn a_priority_out_of_range_is_refused() {
     let out = serve_refused(&[], &["--priority", "0"]);
     assert!(!out.status.success());
     let err = stderr(&out);
-    assert!(err.contains("--priority 0: SCHED_FIFO priority 0 is out of range: 1 to 99"), "{err}");
+    assert!(
+        err.contains("--priority 0: SCHED_FIFO priority 0 is out of range: 1 to 99"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -105,7 +117,10 @@ fn a_priority_without_the_capability_names_it_and_the_limit() {
     let out = serve_refused(prefix, &["--priority", "10"]);
     assert!(!out.status.success(), "started: {}", stderr(&out));
     let err = stderr(&out);
-    assert!(err.contains("--priority 10: SCHED_FIFO priority 10 is not permitted"), "{err}");
+    assert!(
+        err.contains("--priority 10: SCHED_FIFO priority 10 is not permitted"),
+        "{err}"
+    );
     assert!(err.contains("CAP_SYS_NICE"), "{err}");
     assert!(err.contains("RLIMIT_RTPRIO of at least 10 (now 0"), "{err}");
 }

@@ -192,6 +192,38 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
     Ok(())
 }
 
+/// Starts this executable as `gjkd bench SUBCOMMAND ARGS [--cpu N]` (a
+/// child server of `latency`), with its stdout piped, and returns it with
+/// the first line it printed (its ready line, or what it said instead).
+pub(crate) fn spawn_child(
+    args: &[&std::ffi::OsStr],
+    cpu: Option<usize>,
+) -> std::io::Result<(std::process::Child, std::process::ChildStdout, String)> {
+    use std::io::Read;
+    let mut cmd = std::process::Command::new(std::env::current_exe()?);
+    cmd.arg("bench")
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped());
+    if let Some(cpu) = cpu {
+        cmd.args(["--cpu", &cpu.to_string()]);
+    }
+    let mut child = cmd.spawn()?;
+    let Some(mut stdout) = child.stdout.take() else {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(std::io::Error::other("no stdout pipe"));
+    };
+    // The child writes nothing but this line, so an unbuffered read of it
+    // leaves nothing behind in the pipe.
+    let mut line = String::new();
+    let mut byte = [0u8; 1];
+    while stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
+        line.push(char::from(byte[0]));
+    }
+    Ok((child, stdout, line))
+}
+
 /// Creates the output directory.
 pub(crate) fn out_dir(common: &CommonArgs) -> Result<PathBuf, BenchError> {
     io(

@@ -9,8 +9,8 @@
 //! pinned like the gjkd servers; it answers each request of `n` items with
 //! `n` default results until SIGTERM, then removes its service.
 
-use std::io::{Read, Write};
-use std::process::{Child, ChildStdout, Command, Stdio};
+use std::io::Write;
+use std::process::{Child, ChildStdout};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -132,24 +132,17 @@ impl RawServer {
     /// # Errors
     /// When the process cannot be spawned or exits before serving.
     pub fn spawn(service: &str, max_batch: usize, cpu: Option<usize>) -> std::io::Result<Self> {
-        let mut cmd = Command::new(std::env::current_exe()?);
-        cmd.args(["bench", "raw-server", "--service", service])
-            .args(["--max-batch", &max_batch.to_string()])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped());
-        if let Some(cpu) = cpu {
-            cmd.args(["--cpu", &cpu.to_string()]);
-        }
-        let mut child = cmd.spawn()?;
-        let mut stdout = child
-            .stdout
-            .take()
-            .ok_or_else(|| std::io::Error::other("no stdout pipe"))?;
-        let mut line = String::new();
-        let mut byte = [0u8; 1];
-        while stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
-            line.push(char::from(byte[0]));
-        }
+        let max_batch = max_batch.to_string();
+        let (mut child, stdout, line) = super::spawn_child(
+            &[
+                "raw-server".as_ref(),
+                "--service".as_ref(),
+                service.as_ref(),
+                "--max-batch".as_ref(),
+                max_batch.as_ref(),
+            ],
+            cpu,
+        )?;
         if line != READY {
             let _ = child.kill();
             let _ = child.wait();

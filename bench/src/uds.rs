@@ -20,7 +20,7 @@
 use std::io::{Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdout, Command, Stdio};
+use std::process::{Child, ChildStdout};
 
 use gjkd_proto::{ErrorCode, Item, ItemResult, ReplyHeader};
 
@@ -128,7 +128,8 @@ fn serve(listener: &UnixListener, mut state: State) {
 pub struct UdsServer {
     path: PathBuf,
     child: Child,
-    stdout: ChildStdout,
+    /// Kept open: closing it would make the child's writes fail.
+    _stdout: ChildStdout,
 }
 
 impl UdsServer {
@@ -138,31 +139,22 @@ impl UdsServer {
     /// # Errors
     /// When the process cannot be spawned or exits before listening.
     pub fn spawn(path: &Path, max_batch: usize, cpu: Option<usize>) -> std::io::Result<Self> {
-        let mut cmd = Command::new(std::env::current_exe()?);
-        cmd.args(["bench", "uds-server", "--socket"])
-            .arg(path)
-            .args(["--max-batch", &max_batch.to_string()])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped());
-        if let Some(cpu) = cpu {
-            cmd.args(["--cpu", &cpu.to_string()]);
-        }
-        let mut child = cmd.spawn()?;
-        let mut server = UdsServer {
+        let max_batch = max_batch.to_string();
+        let (child, stdout, line) = super::spawn_child(
+            &[
+                "uds-server".as_ref(),
+                "--socket".as_ref(),
+                path.as_ref(),
+                "--max-batch".as_ref(),
+                max_batch.as_ref(),
+            ],
+            cpu,
+        )?;
+        let server = UdsServer {
             path: path.to_owned(),
-            stdout: child
-                .stdout
-                .take()
-                .ok_or_else(|| std::io::Error::other("no stdout pipe"))?,
+            _stdout: stdout,
             child,
         };
-        let mut line = String::new();
-        // The child writes nothing else, so an unbuffered read of this one
-        // line leaves nothing behind in the pipe.
-        let mut byte = [0u8; 1];
-        while server.stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
-            line.push(char::from(byte[0]));
-        }
         if line != READY {
             return Err(std::io::Error::other(format!(
                 "gjkd bench uds-server did not start (said {line:?})"

@@ -56,11 +56,11 @@ impl Fixture {
         let name = service.clone();
         let pinned = std::env::var_os("GJKD_BENCH_NO_PIN").is_none();
         if pinned {
-            gjkd_bench::latency::pin(0, 0);
+            let _ = gjkd_rt::pin_current_thread(0);
         }
         let server = std::thread::spawn(move || {
             if pinned {
-                gjkd_bench::latency::pin(0, 1);
+                let _ = gjkd_rt::pin_current_thread(1);
             }
             let state = State::new(Limits::default(), WaitMode::Spin, 1);
             let options = ServeOptions {

@@ -1,22 +1,34 @@
 //! `gjkd bench latency`: the round trip a client sees, through every way of
-//! asking, on the same messages, in one run.
+//! asking, on the same messages, in one run; quiet or beside competing busy
+//! processes, pinned or not.
 //!
-//! Five transports answer the same requests with the same handler:
+//! Six transports answer the same requests:
 //!
 //! - `spin`, `block`, `adaptive`: a real `gjkd serve --wait MODE` child
 //!   process (this executable) and a [`gjkd_client::Client`];
+//! - `iceoryx2`: a bare iceoryx2 request-response server child
+//!   ([`super::raw_ipc`]), both sides busy-polling, no GJK: the floor of
+//!   the transport;
 //! - `uds`: a Unix-stream-socket server with blocking reads, also a child
-//!   process of its own (`gjkd bench uds-server`, [`super::uds`]), pinned
-//!   like the others;
-//! - `in-process`: [`State::handle`] called directly, the floor.
+//!   process of its own (`gjkd bench uds-server`, [`super::uds`]);
+//! - `in-process`: [`State::handle`] called directly, the GJK work alone.
 //!
 //! Each is asked a single pair (`Client::distance`, the pair at its stored
 //! poses) and batches of 1, 8, 64 and 512 distinct box pairs, each item with
 //! its own pose, warm-started as the server does by default; back to back,
-//! and with a gap (a busy-wait of `--gap-us`, 100 µs by default) between the
-//! end of one request and the start of the next, long enough for an
-//! `adaptive` server to fall asleep. Servers run one at a time, so a
-//! spinning server never steals the core of the one being measured.
+//! and paced: a busy-wait of each `--gap-us` (100 µs by default; a list)
+//! between the end of one request and the start of the next. Servers run
+//! one at a time, so a spinning server never steals the core of the one
+//! being measured.
+//!
+//! A condition is a number of competing busy processes (`--competitors`,
+//! [`super::busy`]; started before the condition, killed by process id
+//! after it) and a placement (`--pinning`: client on CPU 0 and servers on
+//! CPU 1, or wherever the scheduler puts them); every condition gets a
+//! table of its own. `--contention` measures the deployment guide's set in
+//! one command: single pairs at gaps of 10 µs, 100 µs and 1 ms (a 1 kHz
+//! control loop) and back to back, quiet and beside one busy process,
+//! pinned and not.
 //!
 //! Each configuration sends `--requests` requests (100 000 by default)
 //! unless that would take longer than `--max-seconds`; then it sends fewer,
@@ -27,16 +39,18 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use gjkd_client::{Client, Item, ItemResult, ObjectId, QueryOptions};
-use gjkd_proto::{AdminOp, AdminRequest, Vertex, WaitMode, shape_kind};
+use gjkd_server::engine::State;
 use hdrhistogram::Histogram;
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Vector3;
 
+use super::busy::Competitors;
+use super::latency_objects::{HALF, batch_pose, local_state, single_pose};
 use super::plot::{self, Axis, Chart, Mark, Series};
+use super::raw_ipc::{RawClient, RawServer};
 use super::stats::{Csv, Progress};
 use super::uds::{UdsClient, UdsServer};
 use super::{BenchError, CommonArgs, io, out_dir};
 use crate::demo::ServerProcess;
-use gjkd_server::engine::{Limits, State};
 
 /// Flags of `gjkd bench latency`.
 #[derive(clap::Args, Debug, Clone)]
@@ -47,19 +61,23 @@ pub struct LatencyArgs {
     #[arg(long, default_value_t = 100_000)]
     requests: u64,
     /// Longest a configuration may take: fewer requests are sent (never
-    /// fewer than --min-requests) when the estimate is longer.
-    #[arg(long, default_value_t = 4.0)]
-    max_seconds: f64,
-    /// Fewest requests per configuration.
-    #[arg(long, default_value_t = 10_000)]
-    min_requests: u64,
-    /// Gap between requests in the paced runs, microseconds.
-    #[arg(long, default_value_t = 100)]
-    gap_us: u64,
-    /// Batch sizes (besides the single pair).
-    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 8, 64, 512])]
+    /// fewer than --min-requests) when the estimate is longer. Default 4 s,
+    /// 1 s with --contention.
+    #[arg(long)]
+    max_seconds: Option<f64>,
+    /// Fewest requests per configuration. Default 10 000, 300 with
+    /// --contention.
+    #[arg(long)]
+    min_requests: Option<u64>,
+    /// Gaps between requests in the paced runs, microseconds (a list).
+    /// Default 100; 10,100,1000 with --contention.
+    #[arg(long, value_delimiter = ',')]
+    gap_us: Vec<u64>,
+    /// Batch sizes (besides the single pair). Default 1,8,64,512; none
+    /// with --contention.
+    #[arg(long, value_delimiter = ',')]
     batches: Vec<usize>,
-    /// Transports to measure (default: all).
+    /// Transports to measure (default: all; all but uds with --contention).
     #[arg(long, value_delimiter = ',', value_enum)]
     transports: Vec<Transport>,
     /// Rounds: every configuration is measured a share at a time in each
@@ -67,23 +85,219 @@ pub struct LatencyArgs {
     /// all transports alike.
     #[arg(long, default_value_t = 4)]
     rounds: usize,
-    /// Leave the scheduler free to place client and server: by default the
-    /// client is pinned to CPU 0 and every server to CPU 1, as `taskset`
-    /// would, so that a woken server is never queued behind its own spinning
-    /// client on one core.
+    /// Competing busy processes, one condition per count (a list). Default
+    /// 0; 0,1 with --contention.
+    #[arg(long, value_delimiter = ',')]
+    competitors: Vec<usize>,
+    /// Placements, one condition each (a list): `pinned` puts the client on
+    /// CPU 0 and every server on CPU 1, as `taskset` would, so that a woken
+    /// server is never queued behind its own spinning client on one core;
+    /// `unpinned` leaves the scheduler free. Default pinned; both with
+    /// --contention.
+    #[arg(long, value_delimiter = ',', value_enum)]
+    pinning: Vec<Pinning>,
+    /// Same as `--pinning unpinned`.
     #[arg(long)]
     no_pin: bool,
+    /// SCHED_FIFO priorities for the client thread and the servers, one
+    /// condition each (a list; 0: ordinary scheduling). Default 0.
+    #[arg(long, value_delimiter = ',')]
+    priority: Vec<i32>,
+    /// The deployment guide's tables: single pairs, back to back and at
+    /// 10 µs, 100 µs and 1 ms, quiet and beside one busy process, pinned and
+    /// unpinned (flags given explicitly still win).
+    #[arg(long)]
+    contention: bool,
 }
 
-/// Pins thread or process `pid` (0: the calling thread) to `cpu`; whether it
-/// worked.
-pub fn pin(pid: libc::pid_t, cpu: usize) -> bool {
-    // SAFETY: a zeroed cpu_set_t is the empty set; CPU_SET writes inside it;
-    // sched_setaffinity reads `size_of::<cpu_set_t>()` bytes of it.
-    unsafe {
-        let mut set: libc::cpu_set_t = std::mem::zeroed();
-        libc::CPU_SET(cpu, &mut set);
-        libc::sched_setaffinity(pid, std::mem::size_of::<libc::cpu_set_t>(), &set) == 0
+/// Where the client and the servers run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Pinning {
+    /// Client on CPU 0, servers on CPU 1.
+    Pinned,
+    /// Wherever the scheduler puts them.
+    Unpinned,
+}
+
+/// What runs beside the measurement, and where it runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Condition {
+    /// Competing busy processes.
+    pub competitors: usize,
+    /// Client on CPU 0, servers on CPU 1 (false: unpinned).
+    pub pinned: bool,
+    /// SCHED_FIFO priority of the client and the servers, if any.
+    pub priority: Option<i32>,
+}
+
+impl Condition {
+    /// The heading of its table.
+    pub fn label(&self) -> String {
+        let load = match self.competitors {
+            0 => "quiet".to_owned(),
+            1 => "1 competing busy process".to_owned(),
+            n => format!("{n} competing busy processes"),
+        };
+        let place = if self.pinned {
+            "pinned (client CPU 0, servers CPU 1)"
+        } else {
+            "unpinned"
+        };
+        match self.priority {
+            Some(p) => format!("{load}, {place}, SCHED_FIFO {p}"),
+            None => format!("{load}, {place}"),
+        }
+    }
+}
+
+/// The settings of one run, defaults filled in.
+#[derive(Clone, Debug)]
+struct Plan {
+    requests: u64,
+    max_seconds: f64,
+    min_requests: u64,
+    gaps: Vec<Duration>,
+    batches: Vec<usize>,
+    transports: Vec<Transport>,
+    rounds: usize,
+    conditions: Vec<Condition>,
+    quick: bool,
+}
+
+impl Plan {
+    fn new(args: &LatencyArgs) -> Self {
+        let c = args.contention;
+        let or = |v: &Vec<u64>, plain: &[u64], contention: &[u64]| -> Vec<u64> {
+            if !v.is_empty() {
+                v.clone()
+            } else if c {
+                contention.to_vec()
+            } else {
+                plain.to_vec()
+            }
+        };
+        let gaps = or(&args.gap_us, &[100], &[10, 100, 1000])
+            .into_iter()
+            .map(Duration::from_micros)
+            .collect();
+        let batches = if !args.batches.is_empty() {
+            args.batches.iter().map(|&n| n.max(1)).collect()
+        } else if c {
+            Vec::new()
+        } else {
+            vec![1, 8, 64, 512]
+        };
+        let competitors = if !args.competitors.is_empty() {
+            args.competitors.clone()
+        } else if c {
+            vec![0, 1]
+        } else {
+            vec![0]
+        };
+        let pinnings = if args.no_pin {
+            vec![Pinning::Unpinned]
+        } else if !args.pinning.is_empty() {
+            args.pinning.clone()
+        } else if c {
+            vec![Pinning::Pinned, Pinning::Unpinned]
+        } else {
+            vec![Pinning::Pinned]
+        };
+        let priorities: Vec<Option<i32>> = if args.priority.is_empty() {
+            vec![None]
+        } else {
+            args.priority
+                .iter()
+                .map(|&p| (p > 0).then_some(p))
+                .collect()
+        };
+        let mut conditions = Vec::new();
+        for &competitors in &competitors {
+            for &pinning in &pinnings {
+                for &priority in &priorities {
+                    conditions.push(Condition {
+                        competitors,
+                        pinned: pinning == Pinning::Pinned,
+                        priority,
+                    });
+                }
+            }
+        }
+        let transports = if args.transports.is_empty() {
+            // The socket server answers every condition alike (tens of µs,
+            // a blocking read): the contention tables leave it out.
+            Transport::ALL
+                .into_iter()
+                .filter(|&t| !c || t != Transport::Uds)
+                .collect()
+        } else {
+            Transport::ALL
+                .into_iter()
+                .filter(|t| args.transports.contains(t))
+                .collect()
+        };
+        let mut plan = Plan {
+            requests: args.requests,
+            max_seconds: args.max_seconds.unwrap_or(if c { 1.0 } else { 4.0 }),
+            min_requests: args.min_requests.unwrap_or(if c { 300 } else { 10_000 }),
+            gaps,
+            batches,
+            transports,
+            rounds: args.rounds.max(1),
+            conditions,
+            quick: args.common.quick,
+        };
+        if plan.quick {
+            plan.requests = plan.requests.min(2_000);
+            plan.min_requests = plan.min_requests.min(if c { 100 } else { 300 });
+            plan.max_seconds = plan.max_seconds.min(if c { 0.25 } else { 0.2 });
+            plan.rounds = 1;
+        }
+        plan
+    }
+
+    /// The command line that gives this plan, for the tables.
+    fn command(&self, args: &LatencyArgs) -> String {
+        let mut cmd = String::from("gjkd bench latency");
+        if args.contention {
+            cmd.push_str(" --contention");
+        }
+        if args.common.quick {
+            cmd.push_str(" --quick");
+        }
+        let list = |v: Vec<String>| v.join(",");
+        if !args.gap_us.is_empty() {
+            cmd.push_str(&format!(
+                " --gap-us {}",
+                list(args.gap_us.iter().map(u64::to_string).collect())
+            ));
+        }
+        if !args.competitors.is_empty() {
+            cmd.push_str(&format!(
+                " --competitors {}",
+                list(args.competitors.iter().map(usize::to_string).collect())
+            ));
+        }
+        if args.no_pin {
+            cmd.push_str(" --no-pin");
+        } else if !args.pinning.is_empty() {
+            cmd.push_str(&format!(
+                " --pinning {}",
+                list(
+                    args.pinning
+                        .iter()
+                        .map(|p| format!("{p:?}").to_lowercase())
+                        .collect()
+                )
+            ));
+        }
+        if !args.priority.is_empty() {
+            cmd.push_str(&format!(
+                " --priority {}",
+                list(args.priority.iter().map(i32::to_string).collect())
+            ));
+        }
+        cmd
     }
 }
 
@@ -109,7 +323,7 @@ pub fn core_round_trip_ns(a: usize, b: usize) -> Option<f64> {
     let deadline = Instant::now() + Duration::from_millis(250);
     std::thread::scope(|scope| {
         let echo = scope.spawn(move || {
-            let ok = pin(0, b);
+            let ok = gjkd_rt::pin_current_thread(b).is_ok();
             // An odd value is a ping; answer with the next even one. A
             // failed pin still answers, so the other side never hangs.
             loop {
@@ -125,7 +339,7 @@ pub fn core_round_trip_ns(a: usize, b: usize) -> Option<f64> {
             }
         });
         let ping = scope.spawn(move || {
-            let ok = pin(0, a);
+            let ok = gjkd_rt::pin_current_thread(a).is_ok();
             let mut times = Vec::with_capacity(BATCHES as usize);
             'batches: for k in 0..BATCHES {
                 let start = Instant::now();
@@ -149,18 +363,6 @@ pub fn core_round_trip_ns(a: usize, b: usize) -> Option<f64> {
     })
 }
 
-/// Lets the calling thread run on every CPU again.
-fn unpin() {
-    // SAFETY: as in `pin`, with every CPU the set can name.
-    unsafe {
-        let mut set: libc::cpu_set_t = std::mem::zeroed();
-        for cpu in 0..libc::CPU_SETSIZE as usize {
-            libc::CPU_SET(cpu, &mut set);
-        }
-        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
-    }
-}
-
 /// How requests are carried.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Transport {
@@ -170,18 +372,21 @@ pub enum Transport {
     Uds,
     /// iceoryx2, server busy-polling.
     Spin,
-    /// iceoryx2, server spinning 50 µs after each request, then sleeping.
+    /// iceoryx2, server spinning briefly after each request, then sleeping.
     Adaptive,
     /// iceoryx2, server sleeping on an event.
     Block,
+    /// A bare iceoryx2 server, both sides busy-polling, no GJK: the floor.
+    Iceoryx2,
 }
 
 impl Transport {
     /// All, in the order they are measured and shown.
-    pub const ALL: [Transport; 5] = [
+    pub const ALL: [Transport; 6] = [
         Transport::Spin,
         Transport::Adaptive,
         Transport::Block,
+        Transport::Iceoryx2,
         Transport::Uds,
         Transport::InProcess,
     ];
@@ -194,6 +399,7 @@ impl Transport {
             Transport::Spin => "spin",
             Transport::Adaptive => "adaptive",
             Transport::Block => "block",
+            Transport::Iceoryx2 => "iceoryx2",
         }
     }
 
@@ -228,6 +434,8 @@ impl Workload {
 
 /// One measured configuration.
 pub struct Row {
+    /// What ran beside it, and where.
+    pub condition: Condition,
     /// Transport.
     pub transport: Transport,
     /// Request shape.
@@ -248,22 +456,6 @@ impl Row {
             Some(g) => format!("gap {} µs", g.as_micros()),
         }
     }
-}
-
-const HALF: [f64; 3] = [0.5, 0.4, 0.3];
-
-/// The batch item `k`: box 0 against box `k + 1` at a pose of its own, so
-/// that every item is its own warm-start entry, as a robot's links against
-/// its obstacles would be.
-fn batch_pose(k: usize) -> Isometry3<f64> {
-    Isometry3::new(
-        Vector3::new(1.5 + 0.001 * k as f64, 0.2, -0.1),
-        Vector3::new(0.1, 0.003 * k as f64, 0.3),
-    )
-}
-
-fn single_pose() -> Isometry3<f64> {
-    Isometry3::new(Vector3::new(1.6, 0.3, 0.1), Vector3::new(0.2, 0.4, 0.1))
 }
 
 /// The requests, for a server that gave these ids.
@@ -303,6 +495,11 @@ enum Target {
         req: Requests,
         _server: UdsServer,
     },
+    Raw {
+        client: RawClient,
+        req: Requests,
+        _server: RawServer,
+    },
     Local {
         state: Box<State>,
         req: Requests,
@@ -328,6 +525,14 @@ impl Target {
                 let n = items.len();
                 io("uds round trip", client.query(items, &mut req.results[..n]))?;
             }
+            Target::Raw { client, req, .. } => {
+                let items = match w {
+                    Workload::Single => std::slice::from_ref(&req.single),
+                    Workload::Batch(n) => &req.batch[..n],
+                };
+                let n = items.len();
+                client.query(items, &mut req.results[..n])?;
+            }
             Target::Local { state, req } => {
                 let items = match w {
                     Workload::Single => std::slice::from_ref(&req.single),
@@ -342,50 +547,25 @@ impl Target {
     }
 }
 
-/// A state with the bench's objects, registered through the admin handler
-/// exactly as a client's requests would be. Deterministic: the socket server
-/// child builds the same one, so these ids name its objects too.
-pub(crate) fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<ObjectId>) {
-    let mut state = State::new(Limits::default(), WaitMode::Block, 0x5eed);
-    let mut reg = AdminRequest::new(AdminOp::Register);
-    reg.shape = shape_kind::CONVEX;
-    reg.piece_count = 1;
-    reg.pieces[0].vertex_count = 8;
-    let verts: Vec<Vertex> = (0..8)
-        .map(|i| Vertex {
-            x: if i & 1 == 0 { -HALF[0] } else { HALF[0] },
-            y: if i & 2 == 0 { -HALF[1] } else { HALF[1] },
-            z: if i & 4 == 0 { -HALF[2] } else { HALF[2] },
-        })
-        .collect();
-    let mut reg_one = || ObjectId::from_raw(state.handle_admin(1, &reg, &verts).id);
-    let a = reg_one();
-    let b = reg_one();
-    let boxes: Vec<ObjectId> = (0..=max_batch).map(|_| reg_one()).collect();
-    let mut set = [Item::set_pose(b, &single_pose())];
-    let mut out = [ItemResult::default()];
-    state.handle(0, &set, &mut out);
-    set[0] = Item::set_pose(a, &Isometry3::identity());
-    state.handle(0, &set, &mut out);
-    (state, a, b, boxes)
-}
-
 fn start(
     t: Transport,
     max_batch: usize,
     dir: &Path,
     server_cpu: Option<usize>,
+    priority: Option<i32>,
 ) -> Result<Target, BenchError> {
     if let Some(wait) = t.wait() {
         let service = format!("gjkd-bench-{}-{wait}", std::process::id());
-        let server = io(
-            "spawn gjkd serve",
-            ServerProcess::spawn(&service, &["--wait", wait]),
-        )?;
-        if let (Some(cpu), Ok(pid)) = (server_cpu, libc::pid_t::try_from(server.id())) {
-            // The serving loop runs on the process's main thread.
-            pin(pid, cpu);
+        let cpu = server_cpu.map(|c| c.to_string());
+        let prio = priority.map(|p| p.to_string());
+        let mut flags = vec!["--wait", wait, "--no-persist"];
+        if let Some(cpu) = &cpu {
+            flags.extend(["--cpu", cpu]);
         }
+        if let Some(prio) = &prio {
+            flags.extend(["--priority", prio]);
+        }
+        let server = io("spawn gjkd serve", ServerProcess::spawn(&service, &flags))?;
         let mut client = Client::builder(&service)
             .timeout(Duration::from_secs(5))
             .connect_timeout(Duration::from_secs(20))
@@ -408,6 +588,19 @@ fn start(
     }
     let (state, a, b, boxes) = local_state(max_batch);
     let req = Requests::new(a, b, &boxes, max_batch);
+    if t == Transport::Iceoryx2 {
+        let service = format!("gjkd-bench-{}-raw", std::process::id());
+        let server = io(
+            "start gjkd bench raw-server",
+            RawServer::spawn(&service, max_batch, server_cpu),
+        )?;
+        let client = RawClient::connect(&service, max_batch)?;
+        return Ok(Target::Raw {
+            client,
+            req,
+            _server: server,
+        });
+    }
     if t == Transport::Uds {
         let path = dir.join(format!("gjkd-bench-{}.sock", std::process::id()));
         let server = io(
@@ -470,12 +663,12 @@ fn measure(
 /// How many requests fit the time budget, from a timed warm-up (which also
 /// fills the server's warm-start cache).
 fn plan(
-    args: &LatencyArgs,
+    plan: &Plan,
     target: &mut Target,
     w: Workload,
     gap: Option<Duration>,
 ) -> Result<u64, BenchError> {
-    let warm = if args.common.quick { 50 } else { 500 };
+    let warm = if plan.quick { 50 } else { 500 };
     let t0 = Instant::now();
     let mut last = t0;
     for _ in 0..warm {
@@ -486,8 +679,8 @@ fn plan(
         last = Instant::now();
     }
     let per = t0.elapsed().as_secs_f64() / f64::from(warm);
-    let fit = (args.max_seconds / per) as u64;
-    Ok(fit.clamp(args.min_requests.min(args.requests), args.requests))
+    let fit = (plan.max_seconds / per) as u64;
+    Ok(fit.clamp(plan.min_requests.min(plan.requests), plan.requests))
 }
 
 /// Runs `gjkd bench latency`.
@@ -495,85 +688,123 @@ fn plan(
 /// # Errors
 /// When a server cannot be started or a request fails.
 pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
-    let mut args = args.clone();
-    if args.common.quick {
-        args.requests = args.requests.min(2_000);
-        args.min_requests = args.min_requests.min(300);
-        args.max_seconds = args.max_seconds.min(0.2);
-    }
+    let plan = Plan::new(args);
     let dir = out_dir(&args.common)?;
-    let max_batch = args.batches.iter().copied().max().unwrap_or(1).max(1);
+    let max_batch = plan.batches.iter().copied().max().unwrap_or(1).max(1);
     let mut workloads = vec![Workload::Single];
-    workloads.extend(args.batches.iter().map(|&n| Workload::Batch(n.max(1))));
-    let gaps = [None, Some(Duration::from_micros(args.gap_us))];
-    let transports: Vec<Transport> = if args.transports.is_empty() {
-        Transport::ALL.to_vec()
-    } else {
-        Transport::ALL
-            .into_iter()
-            .filter(|t| args.transports.contains(t))
-            .collect()
-    };
-    let total = transports.len() * workloads.len() * gaps.len();
+    workloads.extend(plan.batches.iter().map(|&n| Workload::Batch(n)));
+    let mut gaps = vec![None];
+    gaps.extend(plan.gaps.iter().copied().map(Some));
+    let per_condition = plan.transports.len() * workloads.len() * gaps.len();
     println!(
-        "gjkd bench latency: {} transports x {} request shapes x {} pacings, up to {} requests each (at most ~{} s per configuration)\nmachine: {}",
-        transports.len(),
+        "gjkd bench latency: {} conditions x {} transports x {} request shapes x {} pacings, up to {} requests each (at most ~{} s per configuration)\nmachine: {}",
+        plan.conditions.len(),
+        plan.transports.len(),
         workloads.len(),
         gaps.len(),
-        args.requests,
-        args.max_seconds,
+        plan.requests,
+        plan.max_seconds,
         super::machine()
     );
-    let pinned = !args.no_pin
-        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
-        && pin(0, 0);
-    let server_cpu = pinned.then_some(1);
-    println!(
-        "{}",
-        if pinned {
-            "client pinned to CPU 0, servers to CPU 1"
-        } else {
-            "not pinned: the scheduler places client and servers"
+    let two_cpus = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
+    let progress = Progress::new((plan.conditions.len() * per_condition * plan.rounds) as u64);
+    let mut rows = Vec::new();
+    let mut probes: Vec<f64> = Vec::new();
+    for &asked in &plan.conditions {
+        // Pinned only where it worked: a one-CPU machine or a cpuset without
+        // CPU 0 runs the condition unpinned, and its table says so.
+        let pinned = asked.pinned && two_cpus && gjkd_rt::pin_current_thread(0).is_ok();
+        if !pinned {
+            let _ = gjkd_rt::unpin_current_thread();
         }
-    );
-    let rounds = if args.common.quick {
-        1
-    } else {
-        args.rounds.max(1)
-    };
-    let progress = Progress::new((total * rounds) as u64);
+        let condition = Condition { pinned, ..asked };
+        let rt = match condition.priority {
+            Some(p) => Some(gjkd_rt::set_realtime_priority(p).map_err(|e| {
+                BenchError::Other(format!("--priority {p} for the client thread: {e}"))
+            })?),
+            None => None,
+        };
+        // The busy processes outlive the condition's estimate by a margin,
+        // and are killed by pid as soon as it is measured.
+        let budget = per_condition as f64 * plan.max_seconds * 2.0
+            + (plan.transports.len() * plan.rounds) as f64 * 5.0
+            + 30.0;
+        let competitors = Competitors::start(condition.competitors, budget)?;
+        if condition.competitors > 0 {
+            progress.println(format!(
+                "{}: busy processes {:?}",
+                condition.label(),
+                competitors.pids()
+            ));
+        }
+        let measured = measure_condition(
+            &plan,
+            condition,
+            &workloads,
+            &gaps,
+            max_batch,
+            &dir,
+            &progress,
+            &mut probes,
+        );
+        drop(competitors);
+        if rt.is_some() {
+            gjkd_rt::reset_priority()
+                .map_err(|e| BenchError::Other(format!("leave SCHED_FIFO: {e}")))?;
+        }
+        rows.extend(measured?);
+    }
+    progress.finish();
+    let _ = gjkd_rt::unpin_current_thread();
+    report(&rows, &dir, &plan, &plan.command(args), &probes)
+}
+
+/// Measures every configuration of one condition, in rounds.
+#[allow(clippy::too_many_arguments)]
+fn measure_condition(
+    plan: &Plan,
+    condition: Condition,
+    workloads: &[Workload],
+    gaps: &[Option<Duration>],
+    max_batch: usize,
+    dir: &Path,
+    progress: &Progress,
+    probes: &mut Vec<f64>,
+) -> Result<Vec<Row>, BenchError> {
+    let rounds = plan.rounds;
+    let server_cpu = condition.pinned.then_some(1);
     // Every configuration is measured a share at a time in each round, and
     // each round starts every server afresh: load that comes and goes on a
     // shared machine then falls on all transports alike, and the ratios
     // between them hold.
     let mut configs: Vec<(Transport, Option<Duration>, Workload)> = Vec::new();
-    for &t in &transports {
-        for gap in gaps {
-            for &w in &workloads {
+    for &t in &plan.transports {
+        for &gap in gaps {
+            for &w in workloads {
                 configs.push((t, gap, w));
             }
         }
     }
     let mut planned: Vec<u64> = vec![0; configs.len()];
     let mut hists: Vec<Option<Histogram<u64>>> = vec![None; configs.len()];
-    // The host's cross-core latency, before each round and after the last.
-    let mut probes: Vec<f64> = Vec::new();
+    // The host's cross-core latency, before each round of the quiet pinned
+    // condition and after its last.
+    let probing = !plan.quick && condition.competitors == 0 && condition.pinned;
     let probe = |probes: &mut Vec<f64>| {
-        if !args.common.quick
-            && let Some(ns) = core_round_trip_ns(0, 1)
-        {
+        if probing && let Some(ns) = core_round_trip_ns(0, 1) {
             probes.push(ns);
         }
     };
+    let label = condition.label();
     for round in 0..rounds {
-        probe(&mut probes);
-        for &t in &transports {
+        probe(probes);
+        for &t in &plan.transports {
             progress.step(format!(
-                "round {}/{rounds}, {}: starting",
+                "{label}, round {}/{rounds}, {}: starting",
                 round + 1,
                 t.name()
             ));
-            let mut target = start(t, max_batch, &dir, server_cpu)?;
+            let mut target = start(t, max_batch, dir, server_cpu, condition.priority)?;
             for (ci, &(ct, gap, w)) in configs.iter().enumerate() {
                 if ct != t {
                     continue;
@@ -582,7 +813,7 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
                     format!("gap {} µs", g.as_micros())
                 });
                 let what = format!(
-                    "round {}/{rounds}, {} {} {}",
+                    "{label}, round {}/{rounds}, {} {} {}",
                     round + 1,
                     t.name(),
                     w.name(),
@@ -592,7 +823,7 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
                 // The first round also sizes the configuration to the budget;
                 // later ones only warm the caches up.
                 if round == 0 {
-                    planned[ci] = plan(&args, &mut target, w, gap)?;
+                    planned[ci] = self::plan(plan, &mut target, w, gap)?;
                 } else {
                     for _ in 0..100 {
                         target.call(w)?;
@@ -612,31 +843,62 @@ pub fn run(args: &LatencyArgs) -> Result<(), BenchError> {
             drop(target);
         }
     }
-    let rows: Vec<Row> = configs
+    probe(probes);
+    Ok(configs
         .iter()
         .zip(hists)
         .filter_map(|(&(transport, gap, workload), hist)| {
             hist.map(|hist| Row {
+                condition,
                 transport,
                 workload,
                 gap,
                 hist,
             })
         })
-        .collect();
-    probe(&mut probes);
-    progress.finish();
-    if pinned {
-        unpin();
+        .collect())
+}
+
+/// The p50 or another quantile of `t`'s single pair at `gap`, µs, among
+/// `rows` (NaN when not measured).
+fn single_us(rows: &[&Row], t: Transport, gap: Option<Duration>, q: f64) -> f64 {
+    rows.iter()
+        .find(|r| r.transport == t && r.workload == Workload::Single && r.gap == gap)
+        .map_or(f64::NAN, |r| r.us(q))
+}
+
+/// The lines under a condition's table: each mode against `block` and
+/// `spin` against the floor, single pair, per pacing.
+fn condition_summary(rows: &[&Row], gaps: &[Option<Duration>]) -> String {
+    let mut out = String::new();
+    for &gap in gaps {
+        let label = gap.map_or("back to back".into(), |g| {
+            format!("gap {} µs", g.as_micros())
+        });
+        let u = |t, q| single_us(rows, t, gap, q);
+        let spin = u(Transport::Spin, 0.5);
+        let floor = u(Transport::Iceoryx2, 0.5) + u(Transport::InProcess, 0.5);
+        out.push_str(&format!(
+            "Single pair, {label}: p50 spin {spin:.2} µs ({:.2}x the floor: iceoryx2 {:.2} + in-process {:.2}), adaptive {:.2} µs (p99 {:.1}), block {:.2} µs (p99 {:.1}); adaptive / block: p50 {:.2}x, p99 {:.2}x\n",
+            spin / floor,
+            u(Transport::Iceoryx2, 0.5),
+            u(Transport::InProcess, 0.5),
+            u(Transport::Adaptive, 0.5),
+            u(Transport::Adaptive, 0.99),
+            u(Transport::Block, 0.5),
+            u(Transport::Block, 0.99),
+            u(Transport::Adaptive, 0.5) / u(Transport::Block, 0.5),
+            u(Transport::Adaptive, 0.99) / u(Transport::Block, 0.99),
+        ));
     }
-    report(&rows, &dir, &args, pinned, &probes)
+    out
 }
 
 fn report(
     rows: &[Row],
     dir: &Path,
-    args: &LatencyArgs,
-    pinned: bool,
+    plan: &Plan,
+    command: &str,
     probes: &[f64],
 ) -> Result<(), BenchError> {
     let mut csv = Csv::new(&[
@@ -650,87 +912,86 @@ fn report(
         "p99_9_us",
         "max_us",
         "mean_us",
+        "competitors",
+        "pinned",
+        "priority",
     ]);
-    let mut md = String::new();
-    md.push_str("| transport | request | pacing | requests | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
+    let f = |v: f64| format!("{v:.2}");
+    let mut gaps = vec![None];
+    gaps.extend(plan.gaps.iter().copied().map(Some));
+    let mut text = String::new();
+    let mut conditions: Vec<Condition> = Vec::new();
     for r in rows {
-        let f = |v: f64| format!("{v:.2}");
-        csv.row(&[
-            r.transport.name().to_owned(),
-            r.workload.name(),
-            r.pacing(),
-            r.hist.len().to_string(),
-            f(r.us(0.5)),
-            f(r.us(0.9)),
-            f(r.us(0.99)),
-            f(r.us(0.999)),
-            f(r.hist.max() as f64 / 1e3),
-            f(r.hist.mean() / 1e3),
-        ]);
-        md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            r.transport.name(),
-            r.workload.name(),
-            r.pacing(),
-            r.hist.len(),
-            f(r.us(0.5)),
-            f(r.us(0.9)),
-            f(r.us(0.99)),
-            f(r.us(0.999)),
-            f(r.hist.max() as f64 / 1e3),
-        ));
+        if !conditions.contains(&r.condition) {
+            conditions.push(r.condition);
+        }
     }
-    let p50 = |t: Transport, w: Workload, gapped: bool| {
-        rows.iter()
-            .find(|r| r.transport == t && r.workload == w && r.gap.is_some() == gapped)
-            .map_or(f64::NAN, |r| r.us(0.5))
-    };
-    let mut summary = String::new();
-    for (gapped, label) in [(false, "back to back"), (true, "with gaps")] {
-        let spin = p50(Transport::Spin, Workload::Single, gapped);
-        summary.push_str(&format!(
-            "\nSingle pair, {label}: p50 spin {spin:.2} µs, adaptive {:.2} µs ({:.2}x spin), block {:.2} µs ({:.2}x spin), UDS {:.2} µs ({:.1}x spin), in-process {:.2} µs\n",
-            p50(Transport::Adaptive, Workload::Single, gapped),
-            p50(Transport::Adaptive, Workload::Single, gapped) / spin,
-            p50(Transport::Block, Workload::Single, gapped),
-            p50(Transport::Block, Workload::Single, gapped) / spin,
-            p50(Transport::Uds, Workload::Single, gapped),
-            p50(Transport::Uds, Workload::Single, gapped) / spin,
-            p50(Transport::InProcess, Workload::Single, gapped),
-        ));
+    for condition in &conditions {
+        let sel: Vec<&Row> = rows.iter().filter(|r| r.condition == *condition).collect();
+        let Some(first) = sel.first() else { continue };
+        text.push_str(&format!("\n### {}\n\n", first.condition.label()));
+        text.push_str("| transport | request | pacing | requests | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
+        for r in &sel {
+            csv.row(&[
+                r.transport.name().to_owned(),
+                r.workload.name(),
+                r.pacing(),
+                r.hist.len().to_string(),
+                f(r.us(0.5)),
+                f(r.us(0.9)),
+                f(r.us(0.99)),
+                f(r.us(0.999)),
+                f(r.hist.max() as f64 / 1e3),
+                f(r.hist.mean() / 1e3),
+                r.condition.competitors.to_string(),
+                r.condition.pinned.to_string(),
+                r.condition.priority.unwrap_or(0).to_string(),
+            ]);
+            text.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                r.transport.name(),
+                r.workload.name(),
+                r.pacing(),
+                r.hist.len(),
+                f(r.us(0.5)),
+                f(r.us(0.9)),
+                f(r.us(0.99)),
+                f(r.us(0.999)),
+                f(r.hist.max() as f64 / 1e3),
+            ));
+        }
+        text.push('\n');
+        text.push_str(&condition_summary(&sel, &gaps));
     }
     if !probes.is_empty() {
         let list: Vec<String> = probes.iter().map(|ns| format!("{ns:.0}")).collect();
-        summary.push_str(&format!(
+        text.push_str(&format!(
             "\nCache-line round trip CPU 0 <-> CPU 1 before each round and after the last: {} ns (the host's state: this VM has shown ~65 ns and ~340 ns at different times, and the slow state doubles a single round trip)\n",
             list.join(", ")
         ));
     }
-    println!("\n{md}{summary}");
-    let mut doc = format!(
-        "Machine: {}\n\nCommand: `gjkd bench latency{}{}` (requests per configuration: up to {}, at most ~{} s each, at least {}, in {} rounds; gap {} µs; {})\n\n",
+    println!("{text}");
+    let doc = format!(
+        "Machine: {}\n\nCommand: `{command}` (requests per configuration: up to {}, at most ~{} s each, at least {}, in {} rounds)\n{text}",
         super::machine(),
-        if args.common.quick { " --quick" } else { "" },
-        if args.no_pin { " --no-pin" } else { "" },
-        args.requests,
-        args.max_seconds,
-        args.min_requests,
-        if args.common.quick { 1 } else { args.rounds },
-        args.gap_us,
-        if pinned {
-            "client on CPU 0, servers on CPU 1"
-        } else {
-            "threads not pinned"
-        }
+        plan.requests,
+        plan.max_seconds,
+        plan.min_requests,
+        plan.rounds,
     );
-    doc.push_str(&md);
-    doc.push_str(&summary);
     io("write latency.csv", csv.write(&dir.join("latency.csv")))?;
     io(
         "write latency.md",
         std::fs::write(dir.join("latency.md"), doc),
     )?;
-    plots(rows, dir)?;
+    // The plots show the first condition at the first gap: the classic
+    // figures; the other conditions are in the tables.
+    let first_gap = plan.gaps.first().copied();
+    let first: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.condition == rows[0].condition && (r.gap.is_none() || r.gap == first_gap))
+        .collect();
+    plots(&first, dir)?;
     println!(
         "wrote {0}/latency.csv, {0}/latency.md, {0}/latency-back-to-back.svg, {0}/latency-gaps.svg, {0}/latency-p50.svg",
         dir.display()
@@ -760,7 +1021,7 @@ fn us_ticks(v: &f64) -> String {
     }
 }
 
-fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
+fn plots(rows: &[&Row], dir: &Path) -> Result<(), BenchError> {
     let color = |t: Transport| Transport::ALL.iter().position(|&x| x == t).unwrap_or(0);
     let spectrum = |r: &Row| -> Vec<(f64, f64)> {
         let mut pts: Vec<(f64, f64)> = r
@@ -791,6 +1052,7 @@ fn plots(rows: &[Row], dir: &Path) -> Result<(), BenchError> {
         for w in workloads {
             let sel: Vec<&Row> = rows
                 .iter()
+                .copied()
                 .filter(|r| r.workload == w && r.gap.is_some() == gapped)
                 .collect();
             let series: Vec<Series> = sel
@@ -877,7 +1139,7 @@ mod tests {
         // The socket server is a child `gjkd` process: the e2e smoke test of
         // `gjkd bench latency` covers it.
         let dir = std::env::temp_dir();
-        let mut local = start(Transport::InProcess, 8, &dir, None).expect("local");
+        let mut local = start(Transport::InProcess, 8, &dir, None, None).expect("local");
         local.call(Workload::Batch(8)).expect("batch");
         local.call(Workload::Single).expect("single");
         let Target::Local { req, .. } = &local else {

@@ -8,8 +8,9 @@
 //! server library instead of inside it.
 //!
 //! - [`latency`]: round trips through real `gjkd serve` processes in each
-//!   wait mode, beside a Unix-socket server process and a plain function call, with
-//!   HdrHistogram percentiles.
+//!   wait mode, beside a Unix-socket server process, a bare iceoryx2 server
+//!   ([`raw_ipc`]) and a plain function call, with HdrHistogram percentiles;
+//!   quiet or beside competing busy processes ([`busy`]), pinned or not.
 //! - [`tradeoff`]: time against error over tolerances, iteration caps, warm
 //!   and cold starts and early-exit margins, judged by an exact reference
 //!   ([`gjkd_testkit::reference`](mod@gjkd_testkit::reference)) that owes nothing to GJK.
@@ -37,6 +38,7 @@
 use std::path::PathBuf;
 
 #[cfg(feature = "measure")]
+pub mod busy;
 pub mod collision_sweep;
 pub mod demo;
 #[cfg(feature = "measure")]
@@ -44,10 +46,12 @@ pub mod extremes;
 #[cfg(feature = "measure")]
 pub mod latency;
 #[cfg(feature = "measure")]
+pub mod latency_objects;
 pub mod paper;
 #[cfg(feature = "measure")]
 pub mod plot;
 #[cfg(feature = "measure")]
+pub mod raw_ipc;
 pub mod robot;
 pub mod robot_demo;
 pub mod scene_call;
@@ -104,6 +108,12 @@ enum BenchCommand {
     /// The socket server `latency` starts as a child process.
     #[command(hide = true)]
     UdsServer(uds::UdsServerArgs),
+    /// The bare iceoryx2 server `latency` starts as a child process.
+    #[command(hide = true)]
+    RawServer(raw_ipc::RawServerArgs),
+    /// A busy process `latency --competitors` starts.
+    #[command(hide = true)]
+    Busy(busy::BusyArgs),
 }
 
 #[cfg(feature = "measure")]
@@ -159,10 +169,16 @@ pub(crate) fn io<T>(what: impl Into<String>, r: std::io::Result<T>) -> Result<T,
 /// # Errors
 /// What stopped it.
 pub fn run(args: BenchArgs) -> Result<(), BenchError> {
-    if let BenchCommand::UdsServer(a) = &args.command {
-        // A child of `latency`: it serves until killed and prints nothing
-        // but its ready line.
-        return uds::run_server(a);
+    // Children of `latency`: they serve or compute until stopped and print
+    // nothing but a ready line.
+    match &args.command {
+        BenchCommand::UdsServer(a) => return uds::run_server(a),
+        BenchCommand::RawServer(a) => return raw_ipc::run_server(a),
+        BenchCommand::Busy(a) => {
+            busy::run_busy(a);
+            return Ok(());
+        }
+        _ => {}
     }
     let start = std::time::Instant::now();
     let what = match args.command {
@@ -190,7 +206,9 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
             collision_sweep::run(&a)?;
             "sweep"
         }
-        BenchCommand::UdsServer(_) => unreachable!("handled above"),
+        BenchCommand::UdsServer(_) | BenchCommand::RawServer(_) | BenchCommand::Busy(_) => {
+            unreachable!("handled above")
+        }
     };
     println!(
         "\ngjkd bench {what}: finished in {:.1} s (wall time of the whole command)",
@@ -200,6 +218,38 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
 }
 
 #[cfg(feature = "measure")]
+/// Starts this executable as `gjkd bench SUBCOMMAND ARGS [--cpu N]` (a
+/// child server of `latency`), with its stdout piped, and returns it with
+/// the first line it printed (its ready line, or what it said instead).
+pub(crate) fn spawn_child(
+    args: &[&std::ffi::OsStr],
+    cpu: Option<usize>,
+) -> std::io::Result<(std::process::Child, std::process::ChildStdout, String)> {
+    use std::io::Read;
+    let mut cmd = std::process::Command::new(std::env::current_exe()?);
+    cmd.arg("bench")
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped());
+    if let Some(cpu) = cpu {
+        cmd.args(["--cpu", &cpu.to_string()]);
+    }
+    let mut child = cmd.spawn()?;
+    let Some(mut stdout) = child.stdout.take() else {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(std::io::Error::other("no stdout pipe"));
+    };
+    // The child writes nothing but this line, so an unbuffered read of it
+    // leaves nothing behind in the pipe.
+    let mut line = String::new();
+    let mut byte = [0u8; 1];
+    while stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
+        line.push(char::from(byte[0]));
+    }
+    Ok((child, stdout, line))
+}
+
 /// Creates the output directory.
 pub(crate) fn out_dir(common: &CommonArgs) -> Result<PathBuf, BenchError> {
     io(

@@ -14,13 +14,13 @@
 //!
 //! The child registers the bench's objects itself, through the same admin
 //! handler and in the same order as the in-process baseline
-//! (`latency::local_state`), so the ids the client sends name the same
+//! (`latency_objects::local_state`), so the ids the client sends name the same
 //! objects on both sides; `gjkd bench latency` checks the first answer.
 
 use std::io::{Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdout, Command, Stdio};
+use std::process::{Child, ChildStdout};
 
 use gjkd_proto::{ErrorCode, Item, ItemResult, ReplyHeader};
 
@@ -69,7 +69,7 @@ pub struct UdsServerArgs {
     #[arg(long)]
     cpu: Option<usize>,
     /// The largest batch the client will send: the server registers the
-    /// bench's objects for it (`latency::local_state`).
+    /// bench's objects for it (`latency_objects::local_state`).
     #[arg(long, default_value_t = 512)]
     max_batch: usize,
 }
@@ -90,9 +90,10 @@ pub fn run_server(args: &UdsServerArgs) -> Result<(), BenchError> {
         libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
     }
     if let Some(cpu) = args.cpu {
-        super::latency::pin(0, cpu);
+        gjkd_rt::pin_current_thread(cpu)
+            .map_err(|e| BenchError::Other(format!("uds-server --cpu {cpu}: {e}")))?;
     }
-    let (state, ..) = super::latency::local_state(args.max_batch.max(1));
+    let (state, ..) = super::latency_objects::local_state(args.max_batch.max(1));
     let _ = std::fs::remove_file(&args.socket);
     let listener = io(
         format!("bind {}", args.socket.display()),
@@ -127,7 +128,8 @@ fn serve(listener: &UnixListener, mut state: State) {
 pub struct UdsServer {
     path: PathBuf,
     child: Child,
-    stdout: ChildStdout,
+    /// Kept open: closing it would make the child's writes fail.
+    _stdout: ChildStdout,
 }
 
 impl UdsServer {
@@ -137,31 +139,22 @@ impl UdsServer {
     /// # Errors
     /// When the process cannot be spawned or exits before listening.
     pub fn spawn(path: &Path, max_batch: usize, cpu: Option<usize>) -> std::io::Result<Self> {
-        let mut cmd = Command::new(std::env::current_exe()?);
-        cmd.args(["bench", "uds-server", "--socket"])
-            .arg(path)
-            .args(["--max-batch", &max_batch.to_string()])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped());
-        if let Some(cpu) = cpu {
-            cmd.args(["--cpu", &cpu.to_string()]);
-        }
-        let mut child = cmd.spawn()?;
-        let mut server = UdsServer {
+        let max_batch = max_batch.to_string();
+        let (child, stdout, line) = super::spawn_child(
+            &[
+                "uds-server".as_ref(),
+                "--socket".as_ref(),
+                path.as_ref(),
+                "--max-batch".as_ref(),
+                max_batch.as_ref(),
+            ],
+            cpu,
+        )?;
+        let server = UdsServer {
             path: path.to_owned(),
-            stdout: child
-                .stdout
-                .take()
-                .ok_or_else(|| std::io::Error::other("no stdout pipe"))?,
+            _stdout: stdout,
             child,
         };
-        let mut line = String::new();
-        // The child writes nothing else, so an unbuffered read of this one
-        // line leaves nothing behind in the pipe.
-        let mut byte = [0u8; 1];
-        while server.stdout.read(&mut byte)? == 1 && byte[0] != b'\n' {
-            line.push(char::from(byte[0]));
-        }
         if line != READY {
             return Err(std::io::Error::other(format!(
                 "gjkd bench uds-server did not start (said {line:?})"

@@ -131,6 +131,13 @@ pub use robots::{
 };
 pub use scene::{Group, ScenePair, SceneQuery, SceneSummary, Steps};
 
+/// Where and how urgently the calling thread runs: pin the thread that
+/// sends queries to a CPU of its own (`rt::pin_current_thread`) and, where
+/// permitted, give it a real-time priority (`rt::set_realtime_priority`),
+/// as `gjkd serve --cpu N --priority P` does for the server. Which to use
+/// when, with measured figures: `docs/deployment.md`.
+pub use gjkd_rt as rt;
+
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
@@ -595,10 +602,6 @@ const RETRY_PAUSE: Duration = Duration::from_millis(5);
 const HELLO_RETRY: Duration = Duration::from_millis(250);
 /// Yield (rather than sleep) this long before sleeping between polls.
 const YIELD_FOR: Duration = Duration::from_millis(2);
-/// While busy-polling, give the core away this often: a server the kernel
-/// woke onto this core cannot answer while the client holds it, and on a
-/// machine with few cores the client would spin out its whole `SPIN_FOR`.
-const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 impl Client {
     /// A builder for a client of the deployment named `service` (the server's
@@ -803,7 +806,6 @@ impl Client {
     ) -> Result<R, Waited> {
         let start = Instant::now();
         let mut next_check = start + LIVENESS_AFTER;
-        let mut last_yield = start;
         loop {
             match poll() {
                 Ok(Some(r)) => return Ok(r),
@@ -826,12 +828,11 @@ impl Client {
                 next_check = Instant::now() + LIVENESS_EVERY;
             }
             if waited < SPIN_FOR {
-                if now - last_yield >= POLITE_EVERY {
-                    std::thread::yield_now();
-                    last_yield = Instant::now();
-                } else {
-                    std::hint::spin_loop();
-                }
+                // No yield while spinning: beside a busy process, a yield
+                // hands it the CPU until its time slice ends, milliseconds
+                // later; a server woken onto this CPU preempts the spin by
+                // itself (it asks for short slices; docs/deployment.md).
+                std::hint::spin_loop();
             } else if waited < YIELD_FOR {
                 std::thread::yield_now();
             } else {

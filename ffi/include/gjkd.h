@@ -1345,6 +1345,28 @@ enum gjkd_status gjkd_path_joints(struct gjkd_client *client,
                                   size_t capacity,
                                   struct gjkd_scene_summary *summary);
 
+// Pins the calling thread to CPU `cpu`: from now on it runs there and
+// nowhere else (threads it starts later inherit the pin). Pin the thread
+// that sends queries to a CPU other than the server's (`gjkd serve --cpu
+// N`) and away from busy processes.
+//
+// Errors: `GJKD_ERR_INVALID_ARGUMENT` (no such CPU, or one outside this
+// process's cpuset: `gjkd_last_error()` lists the allowed ones),
+// `GJKD_ERR_IPC` (any other refusal by the kernel). On error the thread's
+// affinity is unchanged.
+enum gjkd_status gjkd_pin_thread(uint32_t cpu);
+
+// Runs the calling thread under `SCHED_FIFO` at `priority` (1 to 99): when
+// the server's answer wakes it, it preempts any ordinary process on its
+// CPU at once. Threads it starts later inherit it.
+//
+// Errors: `GJKD_ERR_INVALID_ARGUMENT` (outside 1 to 99),
+// `GJKD_ERR_PERMISSION_DENIED` (the process has neither the capability
+// `CAP_SYS_NICE` nor an `RLIMIT_RTPRIO` of at least `priority`;
+// `gjkd_last_error()` says how to grant either), `GJKD_ERR_IPC` (any
+// other refusal). On error nothing changed.
+enum gjkd_status gjkd_set_realtime_priority(int32_t priority);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

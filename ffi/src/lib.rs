@@ -34,6 +34,7 @@ mod robots;
 mod rows;
 mod scene;
 mod status;
+mod thread;
 mod types;
 
 pub use connect::*;
@@ -45,6 +46,7 @@ pub use robots::*;
 pub use rows::*;
 pub use scene::*;
 pub use status::gjkd_status;
+pub use thread::*;
 pub use types::*;
 
 /// The wire protocol version this library speaks; a server of another

@@ -8,6 +8,12 @@ Three ways to the same answers, all on numpy arrays:
   process and answers the same calls, bit for bit, with no server;
 - :class:`Server` runs a server in a child process.
 
+Latency on a busy host: ``gjkd.Server(wait=..., cpu=..., priority=...)``
+chooses the server's wait mode, its CPU and a real-time priority;
+:func:`pin_thread` and :func:`set_realtime_priority` do the same for the
+thread that sends queries. ``docs/deployment.md`` says which to use for a
+control loop, a planner or a batch job, with measured figures.
+
 Register shapes once (``register_sphere``, ``register_capsule``,
 ``register_box``, ``register_polytope``, ``register_compound``; each returns
 an int id), set poses (``set_pose``, ``set_poses``: ``[x, y, z, qx, qy, qz,
@@ -73,6 +79,8 @@ from ._native import (
     SceneRows,
     SceneSummary,
     Shape,
+    pin_thread,
+    set_realtime_priority,
 )
 from .server import Server
 
@@ -105,6 +113,8 @@ __all__ = [
     "Status",
     "Timeout",
     "local",
+    "pin_thread",
+    "set_realtime_priority",
 ]
 
 __version__ = "0.1.0"

@@ -559,3 +559,25 @@ def serve(args: list[str]) -> int:
 
 def error_codes() -> list[tuple[str, int, str]]:
     """Every error code as ``(name, value, description)``."""
+
+def pin_thread(cpu: int) -> None:
+    """Pins the calling thread to CPU ``cpu``: from now on it runs there and
+    nowhere else. Put the thread that sends queries on a CPU other than the
+    server's (``gjkd.Server(cpu=...)``) and away from busy processes.
+
+    Raises :class:`gjkd.InvalidInput` (``field`` ``"cpu"``) for a CPU that
+    does not exist or is outside this process's cpuset (the message lists
+    the allowed ones), :class:`gjkd.IpcError` for any other refusal. On
+    error the thread's affinity is unchanged."""
+
+def set_realtime_priority(priority: int) -> None:
+    """Runs the calling thread under ``SCHED_FIFO`` at ``priority`` (1 to
+    99): when the server's answer wakes it, it preempts any ordinary process
+    on its CPU at once.
+
+    Raises :class:`gjkd.InvalidInput` (``field`` ``"priority"``) outside 1
+    to 99, :class:`gjkd.AccessDenied` when the process has neither the
+    capability ``CAP_SYS_NICE`` nor an ``RLIMIT_RTPRIO`` of at least
+    ``priority`` (the message says how to grant either),
+    :class:`gjkd.IpcError` for any other refusal. On error nothing
+    changed."""

@@ -31,9 +31,20 @@ class Server:
 
     Args:
         service: the deployment name clients connect to (``gjkd.Client(service)``).
-        wait: the server's wait strategy: ``"spin"`` (lowest latency, keeps a
-            core busy), ``"block"`` (no busy core) or ``"adaptive"`` (spins
-            briefly after each request, then sleeps).
+        wait: the server's wait strategy: ``"adaptive"`` (the default:
+            spins briefly after each request, then sleeps until a client
+            wakes it; near ``"spin"`` for back-to-back requests and as fast
+            as ``"block"`` for paced ones, however busy the machine),
+            ``"spin"`` (lowest latency, keeps a core busy: only on a CPU of
+            its own) or ``"block"`` (no busy core at all).
+        cpu: pin the serving thread to this CPU (``gjkd serve --cpu``);
+            best one that no busy process and not the client uses.
+        priority: run the serving thread at this ``SCHED_FIFO`` priority (1
+            to 99, ``gjkd serve --priority``), so that a woken server
+            preempts ordinary processes at once. Needs ``CAP_SYS_NICE`` or
+            an ``RLIMIT_RTPRIO`` of at least ``priority``; without, the
+            server refuses to start and :meth:`start` raises
+            :class:`gjkd.Error` quoting its message, which names both.
         persist: keep registered objects in a state file across restarts
             (``state_file``, or the server's default path). Off by default:
             the server holds its objects in memory only.
@@ -51,6 +62,8 @@ class Server:
         service: str = "gjkd",
         *,
         wait: str = "adaptive",
+        cpu: Optional[int] = None,
+        priority: Optional[int] = None,
         persist: bool = False,
         state_file: Optional[PathLike] = None,
         scene: Optional[PathLike] = None,
@@ -61,6 +74,10 @@ class Server:
         self.service = service
         self.ready_timeout = ready_timeout
         flags = ["--service", service, "--wait", wait]
+        if cpu is not None:
+            flags += ["--cpu", str(cpu)]
+        if priority is not None:
+            flags += ["--priority", str(priority)]
         if persist:
             if state_file is not None:
                 flags += ["--state-file", os.path.abspath(state_file)]

@@ -15,6 +15,7 @@ mod runner;
 mod scene;
 mod server_lib;
 mod shape;
+mod thread;
 
 use pyo3::prelude::*;
 
@@ -51,6 +52,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<meshes::MeshInfo>()?;
     m.add_function(wrap_pyfunction!(serve, m)?)?;
     m.add_function(wrap_pyfunction!(error_codes, m)?)?;
+    m.add_function(wrap_pyfunction!(thread::pin_thread, m)?)?;
+    m.add_function(wrap_pyfunction!(thread::set_realtime_priority, m)?)?;
     m.add("DEFAULT_TOLERANCE", gjkd_proto::DEFAULT_TOLERANCE)?;
     m.add("DEFAULT_MAX_ITERATIONS", gjkd_proto::DEFAULT_MAX_ITERATIONS)?;
     m.add("MAX_PIECES", gjkd_proto::MAX_PIECES)?;

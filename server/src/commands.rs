@@ -54,6 +54,16 @@ pub struct ServeArgs {
     /// Wait strategy.
     #[arg(long, value_enum, default_value_t = Wait::Adaptive)]
     pub wait: Wait,
+    /// Pin the serving thread to this CPU (docs/deployment.md: best a CPU
+    /// no busy process shares, and not the client's).
+    #[arg(long, value_name = "N")]
+    pub cpu: Option<usize>,
+    /// Run the serving thread at this SCHED_FIFO real-time priority (1 to
+    /// 99): a woken server then preempts any ordinary process at once.
+    /// Needs CAP_SYS_NICE or RLIMIT_RTPRIO; with `--wait spin`, only on a
+    /// CPU of its own.
+    #[arg(long, value_name = "P")]
+    pub priority: Option<i32>,
     /// Most clients at once (one per `gjkd-client` `Client`; the limit holds
     /// for each of the query and admin services).
     #[arg(long, default_value_t = Limits::default().max_clients)]
@@ -149,6 +159,16 @@ pub fn serve_until(
     shutdown: &AtomicBool,
     ready: impl FnOnce(),
 ) -> Result<(), String> {
+    place_thread(args.cpu, args.priority)?;
+    if args.priority.is_none() && !matches!(args.wait, Wait::Spin) {
+        // A server that sleeps must be woken at once on a busy CPU: see
+        // `wait`. Asked for, not required: an old kernel ignores it.
+        if let Err(e) = gjkd_rt::request_short_slice(gjkd_rt::MIN_SLICE) {
+            tracing::warn!(
+                "cannot ask for short time slices ({e}): wake-ups beside busy processes may wait a slice"
+            );
+        }
+    }
     let limits = Limits {
         max_clients: args.max_clients.max(1),
         max_nodes: args.max_nodes.max(2),
@@ -181,6 +201,23 @@ pub fn serve_until(
         remove_departed: args.remove_departed,
     };
     run(&options, state, shutdown, ready).map_err(|e| e.to_string())
+}
+
+/// Pins the calling thread, which is about to serve, to `cpu` and gives it
+/// real-time `priority`, each when asked for; before anything is opened,
+/// so that a bad flag stops the start with nothing done.
+///
+/// # Errors
+/// The flag and why the kernel refused it.
+pub fn place_thread(cpu: Option<usize>, priority: Option<i32>) -> Result<(), String> {
+    if let Some(cpu) = cpu {
+        gjkd_rt::pin_current_thread(cpu).map_err(|e| format!("--cpu {cpu}: {e}"))?;
+    }
+    if let Some(priority) = priority {
+        gjkd_rt::set_realtime_priority(priority)
+            .map_err(|e| format!("--priority {priority}: {e}"))?;
+    }
+    Ok(())
 }
 
 /// The state of a persisting server (see `State::open`).

@@ -12,7 +12,8 @@
 //!   engine;
 //! - [`scene`]: the scene file (`--scene`) of named, read-only objects and
 //!   robots;
-//! - [`server`]: the iceoryx2 serving loop; [`offline`]: the offline
+//! - [`server`]: the iceoryx2 serving loop, with its wait policy in
+//!   [`wait`]; [`offline`]: the offline
 //!   `gjkd objects` command; [`commands`]: the daemon's commands with their
 //!   flags.
 //!
@@ -50,3 +51,4 @@ pub mod offline;
 pub mod persist;
 pub mod scene;
 pub mod server;
+pub mod wait;

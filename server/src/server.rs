@@ -20,6 +20,7 @@ use iceoryx2::prelude::*;
 use tracing::{debug, error, info, warn};
 
 use crate::engine::{Limits, State};
+use crate::wait::{Idle, WaitPolicy};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
@@ -77,13 +78,6 @@ fn server_port_error<'a>(
 fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ServerError {
     move |e| ServerError::Ipc(format!("{what}: {e:?}"))
 }
-
-/// How long `adaptive` keeps spinning after the last request before it
-/// sleeps. Long enough to cover a client's think time between queries of one
-/// control cycle, short enough that an idle server costs no CPU.
-pub const ADAPTIVE_SPIN: Duration = Duration::from_micros(50);
-/// While spinning idle, yield the core this often.
-const POLITE_EVERY: Duration = Duration::from_micros(10);
 
 /// Longest sleep in `block` mode: the loop wakes this often to look at the
 /// shutdown flag (signal handlers cannot wake an iceoryx2 wait) and do
@@ -334,8 +328,7 @@ fn serve_until(
     waitset: &WaitSet<ipc::Service>,
     shutdown: &AtomicBool,
 ) {
-    let mut last_request = Instant::now();
-    let mut last_yield = Instant::now();
+    let mut wait = WaitPolicy::new(options.wait, Instant::now());
     let mut house = Housekeeping {
         last: Instant::now(),
         reap_after: Instant::now(),
@@ -358,13 +351,10 @@ fn serve_until(
         }
         let now = Instant::now();
         if served > 0 {
-            last_request = now;
-            // Yield only after POLITE_EVERY of idleness, not at the first
-            // idle turn after each reply.
-            last_yield = now;
+            wait.served(now);
         }
         let since = now.duration_since(house.last);
-        if (now.duration_since(last_request) > IDLE_BEFORE_HOUSEKEEPING
+        if (now.duration_since(wait.last_request()) > IDLE_BEFORE_HOUSEKEEPING
             && since > HOUSEKEEPING_PERIOD)
             || since > HOUSEKEEPING_FORCED
         {
@@ -373,42 +363,25 @@ fn serve_until(
         if served > 0 {
             continue;
         }
-        wait_step(
-            options.wait,
-            now,
-            last_request,
-            &mut last_yield,
-            waitset,
-            endpoints,
-        );
+        wait_step(&mut wait, now, waitset, endpoints);
     }
 }
 
-/// What the loop does on a turn that found no request: sleeps until a
-/// client notifies (`block`, or `adaptive` idle past [`ADAPTIVE_SPIN`]), or
-/// spins, giving the core away every [`POLITE_EVERY`].
+/// What the loop does on a turn that found no request, as the wait policy
+/// says: sleeps until a client notifies, or spins, never yielding (see
+/// [`crate::wait`] for why).
 fn wait_step(
-    wait: WaitMode,
+    wait: &mut WaitPolicy,
     now: Instant,
-    last_request: Instant,
-    last_yield: &mut Instant,
     waitset: &WaitSet<ipc::Service>,
     endpoints: &Endpoints,
 ) {
-    let sleep = match wait {
-        WaitMode::Spin => false,
-        WaitMode::Block => true,
-        WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
-    };
-    if sleep {
-        block(waitset, endpoints);
-    } else if now.duration_since(*last_yield) >= POLITE_EVERY {
-        // A client scheduled onto this core could not send while the
-        // server spins: give the core away now and then.
-        std::thread::yield_now();
-        *last_yield = Instant::now();
-    } else {
-        std::hint::spin_loop();
+    match wait.idle(now) {
+        Idle::Sleep => {
+            block(waitset, endpoints);
+            wait.woke(Instant::now());
+        }
+        Idle::Spin => std::hint::spin_loop(),
     }
 }
 

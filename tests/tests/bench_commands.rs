@@ -53,9 +53,9 @@ fn latency_quick_writes_table_csv_and_plots() {
         "{stdout}"
     );
     let csv = std::fs::read_to_string(dir.join("latency.csv")).expect("latency.csv");
-    // Header + 5 transports x 3 request shapes x 2 pacings.
-    assert_eq!(csv.lines().count(), 1 + 5 * 3 * 2, "{csv}");
-    for t in ["spin", "adaptive", "block", "uds", "in-process"] {
+    // Header + 6 transports x 3 request shapes x 2 pacings.
+    assert_eq!(csv.lines().count(), 1 + 6 * 3 * 2, "{csv}");
+    for t in ["spin", "adaptive", "block", "iceoryx2", "uds", "in-process"] {
         assert!(
             csv.lines()
                 .any(|l| l.starts_with(&format!("{t},single,back-to-back")))
@@ -78,6 +78,75 @@ fn latency_quick_writes_table_csv_and_plots() {
         .map(|e| e.path())
         .collect();
     assert!(leftovers.is_empty(), "socket files left: {leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn latency_contention_runs_beside_busy_processes_and_kills_them() {
+    let dir = out_dir("contention");
+    let d = dir.to_str().expect("utf-8 temp dir");
+    let out = Command::new(gjkd_binary())
+        .args([
+            "bench",
+            "latency",
+            "--contention",
+            "--quick",
+            "--out",
+            d,
+            "--requests",
+            "40",
+            "--min-requests",
+            "20",
+            "--gap-us",
+            "20,100",
+            "--competitors",
+            "0,2",
+            "--pinning",
+            "unpinned",
+            "--transports",
+            "adaptive,iceoryx2,in-process",
+        ])
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run gjkd bench latency --contention");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    // One table per condition, each with its summary against the floor.
+    assert!(stdout.contains("### quiet, unpinned"), "{stdout}");
+    assert!(
+        stdout.contains("### 2 competing busy processes, unpinned"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("Single pair, gap 100 µs: p50 spin"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(dir.join("latency.csv")).expect("latency.csv");
+    // Header + 2 conditions x 3 transports x 3 pacings, single pairs only.
+    assert_eq!(csv.lines().count(), 1 + 2 * 3 * 3, "{csv}");
+    assert!(
+        csv.lines()
+            .any(|l| l.starts_with("iceoryx2,single,gap 20 µs,") && l.ends_with(",2,false,0")),
+        "{csv}"
+    );
+    // The busy processes were named by pid, and none outlived the run.
+    let line = stderr
+        .lines()
+        .find(|l| l.contains("busy processes ["))
+        .unwrap_or_else(|| panic!("no busy process reported: {stderr}"));
+    let pids: Vec<u32> = line[line.find('[').expect("[") + 1..line.find(']').expect("]")]
+        .split(", ")
+        .map(|p| p.parse().expect("pid"))
+        .collect();
+    assert_eq!(pids.len(), 2, "{line}");
+    for pid in pids {
+        let cmdline = std::fs::read(format!("/proc/{pid}/cmdline")).unwrap_or_default();
+        assert!(
+            !String::from_utf8_lossy(&cmdline).contains("busy"),
+            "busy process {pid} still runs"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -29,8 +29,8 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, criterion_group};
 use gjkd_client::{Client, Item, ItemResult, ObjectId, QueryOptions};
 use gjkd_proto::WaitMode;
+use gjkd_server::engine::{Limits, State};
 use gjkd_server::server::{ServeOptions, run};
-use gjkd_server::state::{Limits, State};
 use nalgebra::{Isometry3, Vector3};
 
 struct Fixture {

@@ -20,9 +20,9 @@ use gjkd_proto::{PathMode, SceneKind, SceneReply, SceneRequest, SceneRow};
 use gjkd_testkit::paper::{self, Motion, OBSTACLES};
 use nalgebra::Isometry3;
 
-use crate::demo::{Buffers, PAPER_RATIOS, Registered, ServerProcess, register, sweep};
 use crate::scene_inprocess::InProcess;
-use crate::scene_robot::load_average;
+use crate::served_sweep::{Buffers, DemoError, PAPER_RATIOS, Registered, register, sweep};
+use crate::server_process::ServerProcess;
 use crate::stats::Csv;
 use crate::{BenchError, CommonArgs, io, out_dir, scene_call};
 
@@ -214,7 +214,7 @@ fn measure_steps(
     let (mut engine, engine_ids) = in_process(motion)?;
     let mut engine_call =
         |r: &SceneRequest, i: &[Item], rows: &mut [SceneRow]| engine.query(r, i, rows);
-    let demo = |e: crate::demo::DemoError| BenchError::Other(e.to_string());
+    let demo = |e: DemoError| BenchError::Other(e.to_string());
     let margin0 = QueryOptions {
         margin: Some(0.0),
         ..QueryOptions::cold()
@@ -293,7 +293,7 @@ fn measure(service: &str, args: &SweepArgs) -> Result<(), BenchError> {
          the T + 1 steps, is any obstacle within margin 0? Median of {repeats} runs, as seen by the client.\n\
          Machine: {}; load average {}.\n",
         crate::machine(),
-        load_average()
+        crate::load_average()
     );
     println!(
         "{:>6} {:>12} {:>12} {:>12} {:>9} {:>9} {:>12} {:>8} {:>7} {:>8}",

@@ -36,7 +36,7 @@ use super::stats::{Csv, Progress};
 use super::uds::{UdsClient, UdsServer};
 use super::{BenchError, CommonArgs, io, out_dir};
 use crate::demo::ServerProcess;
-use gjkd_server::state::{Limits, State};
+use gjkd_server::engine::{Limits, State};
 
 /// Flags of `gjkd bench latency`.
 #[derive(clap::Args, Debug, Clone)]

@@ -44,8 +44,11 @@ pub mod scene_inprocess;
 pub mod scene_parry;
 pub mod scene_robot;
 pub mod scene_world;
+pub mod served_sweep;
+pub mod server_process;
 pub mod stats;
 pub mod tradeoff;
+mod tradeoff_by_size;
 pub mod uds;
 
 /// `gjkd bench` and its subcommands.
@@ -197,4 +200,11 @@ pub fn machine() -> String {
         .map(|s| s.trim().to_owned())
         .unwrap_or_default();
     format!("{cpu}, {cores} cores, Linux {kernel}")
+}
+
+/// The 1-, 5- and 15-minute load averages, as `/proc/loadavg` gives them.
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
 }

@@ -20,8 +20,8 @@ use std::time::Instant;
 use gjkd_client::{Client, Item, ItemResult, LimitMode, ObjectId, QueryOptions};
 use nalgebra::Isometry3;
 
-use crate::demo::ServerProcess;
 use crate::robot_demo::{joint_path, register_arm, register_obstacles};
+use crate::server_process::ServerProcess;
 use crate::stats::{Csv, percentile};
 use crate::{BenchError, CommonArgs, io, out_dir};
 

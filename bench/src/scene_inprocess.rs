@@ -1,12 +1,12 @@
-//! The scene engine called in process ([`gjkd_server::state::State::scene`]),
+//! The scene engine called in process ([`gjkd_server::engine::state::State::scene`]),
 //! without a server process or a round trip: what `gjkd bench
 //! scene-robot` sets beside the scene requests, to tell the engine's work
 //! from the transport's.
 
 use gjkd_client::{Item, ObjectId};
 use gjkd_proto::{SceneReply, SceneRequest, SceneRow, WaitMode};
-use gjkd_server::state::{Limits, State};
-use gjkd_server::store::{NewObject, Owner};
+use gjkd_server::engine::objects::{NewObject, Owner};
+use gjkd_server::engine::{Limits, State};
 use nalgebra::Isometry3;
 
 use crate::BenchError;

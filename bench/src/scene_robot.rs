@@ -32,10 +32,10 @@ use gjkd_testkit::parry::parry_pose;
 use nalgebra::Isometry3;
 use parry3d_f64::shape::Shape as ParryShape;
 
-use crate::demo::ServerProcess;
 use crate::scene_inprocess::InProcess;
 use crate::scene_parry::ParryScene;
 use crate::scene_world::{Arm, Obstacles, joint_path};
+use crate::server_process::ServerProcess;
 use crate::stats::{Csv, Progress, mean, percentile};
 use crate::{BenchError, CommonArgs, io, out_dir, scene_call};
 
@@ -567,7 +567,7 @@ fn report(
         args.margin * 100.0,
         s.margin,
         crate::machine(),
-        load_average()
+        crate::load_average()
     );
     println!(
         "{:<24} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>7}",
@@ -669,13 +669,6 @@ fn report_agreement(tallies: &[Tally; 4], shown: &[usize], steps: usize) {
     } else {
         println!("\n(no scene column: this build's client has no scene requests)");
     }
-}
-
-/// The 1-, 5- and 15-minute load averages, as `/proc/loadavg` gives them.
-pub fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "unknown".into())
 }
 
 #[cfg(test)]

@@ -25,7 +25,7 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 use gjkd_proto::{ErrorCode, Item, ItemResult, ReplyHeader};
 
 use super::{BenchError, io};
-use gjkd_server::state::State;
+use gjkd_server::engine::state::State;
 
 // The byte views below rely on these types having no padding (every byte is
 // a field's) and accepting any bit pattern (every field is an integer or a
@@ -286,7 +286,7 @@ impl UdsClient {
 mod tests {
     use super::*;
     use gjkd_proto::{AdminOp, AdminRequest, ObjectId, QueryOptions, Vertex, WaitMode, shape_kind};
-    use gjkd_server::state::Limits;
+    use gjkd_server::engine::state::Limits;
 
     #[test]
     fn answers_over_the_socket_equal_the_handler() {

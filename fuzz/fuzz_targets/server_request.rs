@@ -7,7 +7,7 @@
 
 use std::sync::Mutex;
 
-use gjkd_server::state::{Limits, State};
+use gjkd_server::engine::{Limits, State};
 use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, Vertex, WaitMode, shape_kind};
 use libfuzzer_sys::fuzz_target;
 

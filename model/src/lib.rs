@@ -38,6 +38,7 @@
 
 mod collada;
 pub mod kinematics;
+mod kinematics_error;
 pub mod mesh;
 pub mod paths;
 pub mod robot;

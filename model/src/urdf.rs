@@ -17,7 +17,7 @@
 
 use std::ops::Range;
 
-use crate::kinematics::KinematicsError;
+use crate::kinematics_error::KinematicsError;
 use crate::xml_prefixes::rename_unbound_prefixes;
 
 /// Parses URDF text, the elements gjkd never reads removed.

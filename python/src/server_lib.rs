@@ -12,15 +12,15 @@ use nalgebra::Isometry3;
 /// # Errors
 /// `NonFinitePose` or `BadQuaternion`.
 pub fn check_pose(p: &Pose) -> Result<Isometry3<f64>, ErrorCode> {
-    gjkd_server::requests::check_pose(p)
+    gjkd_server::engine::checks::check_pose(p)
 }
 
 /// The server's limits, with defaults.
-pub use gjkd_server::state::Limits;
+pub use gjkd_server::engine::state::Limits;
 
 /// The server's object store and request handlers, without any IPC.
 pub struct Store {
-    state: gjkd_server::state::State,
+    state: gjkd_server::engine::state::State,
 }
 
 /// The client identity `gjkd.Local` uses with the handlers: the owner of
@@ -31,7 +31,7 @@ impl Store {
     /// An empty store.
     pub fn new(limits: Limits) -> Self {
         Store {
-            state: gjkd_server::state::State::new(limits, WaitMode::Spin, 1),
+            state: gjkd_server::engine::state::State::new(limits, WaitMode::Spin, 1),
         }
     }
 

@@ -16,7 +16,7 @@ use gjk::{Convex, Shape};
 use gjkd_proto::{
     Item, ObjectId, SceneKind, SceneRequest, SceneRow, Status, WaitMode, scene_flags,
 };
-use gjkd_server::state::{Limits, NewObject, Owner, State};
+use gjkd_server::engine::state::{Limits, NewObject, Owner, State};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rot3, Vector};
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};

@@ -10,7 +10,7 @@
 use gjkd_proto::{
     Item, ItemResult, ObjectId, PathMode, QueryOptions, SceneKind, SceneRequest, SceneRow, WaitMode,
 };
-use gjkd_server::state::{Limits, NewObject, Owner, State};
+use gjkd_server::engine::state::{Limits, NewObject, Owner, State};
 
 const STEPS: usize = 1000;
 const PASSES: usize = 5;

@@ -12,9 +12,9 @@ use clap::{Args, ValueEnum};
 use gjkd_proto::{DEFAULT_SERVICE, MAX_PIECES, WaitMode};
 use tracing::info;
 
+use crate::engine::state::{Limits, State};
 use crate::scene::Scene;
 use crate::server::{ServeOptions, run};
-use crate::state::{Limits, State};
 
 /// How the server waits for requests (`--wait`).
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -119,7 +119,7 @@ pub fn objects(args: &ObjectsArgs) -> Result<(), String> {
     let path = args
         .state_file
         .clone()
-        .or_else(|| crate::stored::default_path(&args.service))
+        .or_else(|| crate::persist::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file")?;
     crate::offline::run(&path, args.remove_departed)
 }
@@ -188,9 +188,9 @@ fn open_state(args: &ServeArgs, limits: Limits) -> Result<State, String> {
     let path = args
         .state_file
         .clone()
-        .or_else(|| crate::stored::default_path(&args.service))
+        .or_else(|| crate::persist::default_path(&args.service))
         .ok_or("neither XDG_STATE_HOME nor HOME is set: give --state-file or --no-persist")?;
-    State::open(limits, args.wait.into(), &path, epoch())
+    crate::persist::open_state(limits, args.wait.into(), &path, epoch())
 }
 
 /// Upper half of every object id of this run: differs between runs so that a

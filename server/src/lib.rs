@@ -1,22 +1,29 @@
 //! # gjkd-server
 //!
-//! The gjkd distance server as a library: the server's state ([`state`]),
-//! its object store ([`store`]) and request handlers ([`requests`]), the
-//! per-pair warm-start cache ([`cache`]), scene files ([`scene`]), the
-//! scene service's engine ([`scene_query`]), the
-//! database that keeps objects across crashes ([`database`], with the
-//! stored form of objects in [`stored`] and the migration of the old state
-//! file in [`legacy`]), the pose journal ([`journal`]), the offline
-//! `gjkd objects` command ([`offline`]), the iceoryx2 serving loop
-//! ([`server`]) and the daemon's commands with their flags ([`commands`]).
+//! The gjkd distance server as a library, in layers whose arrows point one
+//! way (see `docs/architecture.md`):
+//!
+//! - [`engine`]: everything the server holds and answers, no IPC and no
+//!   file: the [`State`](engine::State) façade over the object store, the
+//!   warm-start cache, the robots and the group queries, with its request
+//!   handlers;
+//! - [`persist`]: the database that keeps objects across crashes, the pose
+//!   journal and the migration of the old state file, plugged into the
+//!   engine;
+//! - [`scene`]: the scene file (`--scene`) of named, read-only objects and
+//!   robots;
+//! - [`server`]: the iceoryx2 serving loop; [`offline`]: the offline
+//!   `gjkd objects` command; [`commands`]: the daemon's commands with their
+//!   flags.
+//!
 //! The `gjkd` binary (package `gjkd`) is a thin command line over these and
 //! the tools of `gjkd-bench`.
 //!
-//! The handlers are pure functions of the [`State`](state::State) and the
+//! The handlers are pure functions of the [`State`](engine::State) and the
 //! request's bytes, so they can be tested and fuzzed without any IPC:
 //!
 //! ```
-//! use gjkd_server::state::{Limits, State};
+//! use gjkd_server::engine::{Limits, State};
 //! use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Item, ItemResult, ObjectId, QueryOptions,
 //!     Vertex, WaitMode, shape_kind};
 //!
@@ -37,19 +44,9 @@
 
 #![warn(missing_docs)]
 
-pub mod cache;
 pub mod commands;
-pub mod database;
-pub mod journal;
-pub mod legacy;
+pub mod engine;
 pub mod offline;
-pub mod requests;
-pub mod robots;
+pub mod persist;
 pub mod scene;
-pub mod scene_query;
-pub mod scene_robots;
 pub mod server;
-pub mod state;
-pub mod store;
-pub mod stored;
-pub mod tokens;

@@ -15,8 +15,10 @@ use std::fmt::Write as _;
 use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 
-use crate::database::Database;
-use crate::stored::{Snapshot, StoredObject, StoredOwner, StoredPiece, StoredPose, StoredShape};
+use crate::engine::records::{
+    Snapshot, StoredObject, StoredOwner, StoredPiece, StoredPose, StoredShape,
+};
+use crate::persist::database::Database;
 
 /// `gjkd objects`: prints the table of the objects stored at `path` and,
 /// with `remove`, removes those whose owner is gone, printing their ids.
@@ -200,7 +202,7 @@ fn geometry(shape: &StoredShape) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stored::StoredConvex;
+    use crate::engine::records::StoredConvex;
 
     /// Object `index` of a store of epoch 3.
     fn object(index: u64, owner: StoredOwner, name: Option<&str>) -> StoredObject {

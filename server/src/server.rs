@@ -13,12 +13,13 @@ use gjkd_proto::{
     SceneRequest, SceneRow, Vertex, WaitMode, admin_service_name, query_service_name,
     scene_service_name, wake_service_name,
 };
+use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server as IoxServer;
 use iceoryx2::prelude::*;
 use tracing::{debug, error, info, warn};
 
-use crate::state::{Limits, State};
+use crate::engine::{Limits, State};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
@@ -372,21 +373,42 @@ fn serve_until(
         if served > 0 {
             continue;
         }
-        let sleep = match options.wait {
-            WaitMode::Spin => false,
-            WaitMode::Block => true,
-            WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
-        };
-        if sleep {
-            block(waitset, endpoints);
-        } else if now.duration_since(last_yield) >= POLITE_EVERY {
-            // A client scheduled onto this core could not send while the
-            // server spins: give the core away now and then.
-            std::thread::yield_now();
-            last_yield = Instant::now();
-        } else {
-            std::hint::spin_loop();
-        }
+        wait_step(
+            options.wait,
+            now,
+            last_request,
+            &mut last_yield,
+            waitset,
+            endpoints,
+        );
+    }
+}
+
+/// What the loop does on a turn that found no request: sleeps until a
+/// client notifies (`block`, or `adaptive` idle past [`ADAPTIVE_SPIN`]), or
+/// spins, giving the core away every [`POLITE_EVERY`].
+fn wait_step(
+    wait: WaitMode,
+    now: Instant,
+    last_request: Instant,
+    last_yield: &mut Instant,
+    waitset: &WaitSet<ipc::Service>,
+    endpoints: &Endpoints,
+) {
+    let sleep = match wait {
+        WaitMode::Spin => false,
+        WaitMode::Block => true,
+        WaitMode::Adaptive => now.duration_since(last_request) > ADAPTIVE_SPIN,
+    };
+    if sleep {
+        block(waitset, endpoints);
+    } else if now.duration_since(*last_yield) >= POLITE_EVERY {
+        // A client scheduled onto this core could not send while the
+        // server spins: give the core away now and then.
+        std::thread::yield_now();
+        *last_yield = Instant::now();
+    } else {
+        std::hint::spin_loop();
     }
 }
 
@@ -503,73 +525,124 @@ fn block(waitset: &WaitSet<ipc::Service>, endpoints: &Endpoints) {
     }
 }
 
-/// Answers every query request waiting; returns how many.
-fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
+/// The one path every service's requests take: receives each request
+/// waiting (`receive`, the service's port) and hands it to `answer`, the
+/// service's part; returns how many. A failed receive is logged and ends
+/// the turn.
+fn serve_waiting<R, E: std::fmt::Debug>(
+    service: &'static str,
+    mut receive: impl FnMut() -> Result<Option<R>, E>,
+    mut answer: impl FnMut(R),
+) -> usize {
     let mut served = 0;
     loop {
-        let request = match query.receive() {
-            Ok(Some(r)) => r,
+        match receive() {
+            Ok(Some(request)) => {
+                served += 1;
+                answer(request);
+            }
             Ok(None) => return served,
             Err(e) => {
-                warn!(error = ?e, "query receive failed");
+                warn!(service, error = ?e, "receive failed");
                 return served;
             }
-        };
-        served += 1;
-        let items = request.payload();
-        let client = request.origin().value();
-        let header = match state.check_batch(items.len()) {
-            Ok(()) => ReplyHeader {
-                error: ErrorCode::Ok as u32,
-                count: items.len() as u32,
-            },
-            Err(code) => {
-                debug!(len = items.len(), ?code, "batch rejected");
-                let reply = request.loan_slice_uninit(0).map(|r| {
-                    let mut r = r.write_from_fn(|_| ItemResult::default());
-                    *r.user_header_mut() = ReplyHeader {
-                        error: code as u32,
-                        count: 0,
-                    };
-                    r
-                });
-                match reply {
-                    Ok(r) => {
-                        if let Err(e) = r.send() {
-                            debug!(error = ?e, "reply not delivered");
-                        }
-                    }
-                    Err(e) => warn!(error = ?e, "cannot loan reply"),
-                }
-                continue;
-            }
-        };
-        let reply = match request.loan_slice_uninit(items.len()) {
-            Ok(r) => r,
-            Err(e) => {
-                warn!(error = ?e, len = items.len(), "cannot loan reply");
-                continue;
-            }
-        };
-        // Filled first, then answered: the fill takes every line of the
-        // reply from the client's cache in one sweep whose misses overlap.
-        // Writing each result straight in after its GJK run measured slower
-        // on batches, each write then missing alone.
-        let mut reply = reply.write_from_fn(|_| ItemResult::default());
-        *reply.user_header_mut() = header;
-        let results = reply.payload_mut();
-        let outcome = catch_unwind(AssertUnwindSafe(|| state.handle(client, items, results)));
-        if outcome.is_err() {
-            // A bug of ours, not the client's: answer, log, keep serving.
-            error!(len = items.len(), "query handler panicked");
-            for r in reply.payload_mut() {
-                *r = ItemResult::error(ErrorCode::Internal);
-            }
-        }
-        if let Err(e) = reply.send() {
-            debug!(error = ?e, "reply not delivered (client gone?)");
         }
     }
+}
+
+/// Runs a service's handler. A panic is a bug of ours, not the client's:
+/// it is logged, the request is answered with `fallback()`, and serving
+/// goes on.
+fn guarded<T>(
+    service: &'static str,
+    handler: impl FnOnce() -> T,
+    fallback: impl FnOnce() -> T,
+) -> T {
+    catch_unwind(AssertUnwindSafe(handler)).unwrap_or_else(|_| {
+        error!(service, "handler panicked");
+        fallback()
+    })
+}
+
+/// Logs a reply that could not be delivered (its client gone, usually).
+fn delivered<E: std::fmt::Debug>(service: &'static str, sent: Result<(), E>) {
+    if let Err(e) = sent {
+        debug!(service, error = ?e, "reply not delivered (client gone?)");
+    }
+}
+
+/// Refuses a request of a service whose replies are rows: no row, and
+/// `header` saying why.
+fn refuse<Req, ReqHeader, Row, Header>(
+    service: &'static str,
+    request: &ActiveRequest<ipc::Service, Req, ReqHeader, [Row], Header>,
+    header: Header,
+) where
+    Req: std::fmt::Debug + IceoryxSend + ?Sized,
+    ReqHeader: std::fmt::Debug + ZeroCopySend,
+    Row: std::fmt::Debug + ZeroCopySend + Default + 'static,
+    Header: std::fmt::Debug + ZeroCopySend + Default,
+{
+    match request.loan_slice_uninit(0) {
+        Ok(reply) => {
+            let mut reply = reply.write_from_fn(|_| Row::default());
+            *reply.user_header_mut() = header;
+            delivered(service, reply.send());
+        }
+        Err(e) => warn!(service, error = ?e, "cannot loan reply"),
+    }
+}
+
+/// Answers every query request waiting; returns how many.
+fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
+    serve_waiting(
+        "query",
+        || query.receive(),
+        |request| {
+            let items = request.payload();
+            let client = request.origin().value();
+            if let Err(code) = state.check_batch(items.len()) {
+                debug!(len = items.len(), ?code, "batch rejected");
+                let header = ReplyHeader {
+                    error: code as u32,
+                    count: 0,
+                };
+                refuse("query", &request, header);
+                return;
+            }
+            let reply = match request.loan_slice_uninit(items.len()) {
+                Ok(r) => r,
+                Err(e) => {
+                    warn!(error = ?e, len = items.len(), "cannot loan reply");
+                    return;
+                }
+            };
+            // Filled first, then answered: the fill takes every line of the
+            // reply from the client's cache in one sweep whose misses overlap.
+            // Writing each result straight in after its GJK run measured slower
+            // on batches, each write then missing alone.
+            let mut reply = reply.write_from_fn(|_| ItemResult::default());
+            *reply.user_header_mut() = ReplyHeader {
+                error: ErrorCode::Ok as u32,
+                count: items.len() as u32,
+            };
+            let results = reply.payload_mut();
+            let answered = guarded(
+                "query",
+                || {
+                    state.handle(client, items, results);
+                    true
+                },
+                || false,
+            );
+            if !answered {
+                for r in reply.payload_mut() {
+                    *r = ItemResult::error(ErrorCode::Internal);
+                }
+            }
+            delivered("query", reply.send());
+        },
+    )
 }
 
 /// Answers every scene request waiting; returns how many.
@@ -580,73 +653,49 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
 /// which cost more than the question for a handful of rows in a buffer
 /// of a thousand.
 fn serve_scenes(scene: &SceneServer, state: &mut State, scratch: &mut Vec<SceneRow>) -> usize {
-    let mut served = 0;
-    loop {
-        let request = match scene.receive() {
-            Ok(Some(r)) => r,
-            Ok(None) => return served,
-            Err(e) => {
-                warn!(error = ?e, "scene receive failed");
-                return served;
+    serve_waiting(
+        "scene",
+        || scene.receive(),
+        |request| {
+            let header = *request.user_header();
+            let items = request.payload();
+            // The client port keys the warm starts and motion bounds, as the
+            // query service's does: two clients never share them.
+            let client = request.origin().value();
+            let max_batch = state.limits().max_batch;
+            if items.len() > max_batch {
+                refuse(
+                    "scene",
+                    &request,
+                    SceneReply::error(ErrorCode::BatchTooLarge),
+                );
+                return;
             }
-        };
-        served += 1;
-        let header = *request.user_header();
-        let items = request.payload();
-        // The client port keys the warm starts and motion bounds, as the
-        // query service's does: two clients never share them.
-        let client = request.origin().value();
-        let max_batch = state.limits().max_batch;
-        let answer = if items.len() > max_batch {
-            SceneReply::error(ErrorCode::BatchTooLarge)
-        } else {
             let rows = (header.max_rows as usize).min(max_batch);
             if scratch.len() < rows {
                 scratch.resize(rows, SceneRow::default());
             }
-            let answer = catch_unwind(AssertUnwindSafe(|| {
-                state.scene(client, &header, items, &mut scratch[..rows])
-            }))
-            .unwrap_or_else(|_| {
-                // A bug of ours, not the client's: answer, log, keep serving.
-                error!(
-                    kind = header.kind,
-                    items = items.len(),
-                    "scene handler panicked"
-                );
-                SceneReply::error(ErrorCode::Internal)
-            });
-            if answer.error_code() == ErrorCode::Ok {
-                let written = usize::try_from(answer.total).map_or(rows, |t| t.min(rows));
-                match request.loan_slice_uninit(written) {
-                    Ok(reply) => {
-                        let mut reply = reply.write_from_slice(&scratch[..written]);
-                        *reply.user_header_mut() = answer;
-                        if let Err(e) = reply.send() {
-                            debug!(error = ?e, "scene reply not delivered (client gone?)");
-                        }
-                    }
-                    Err(e) => warn!(error = ?e, written, "cannot loan scene reply"),
-                }
-                continue;
+            let answer = guarded(
+                "scene",
+                || state.scene(client, &header, items, &mut scratch[..rows]),
+                || SceneReply::error(ErrorCode::Internal),
+            );
+            if answer.error_code() != ErrorCode::Ok {
+                debug!(kind = header.kind, code = ?answer.error_code(), "scene request refused");
+                refuse("scene", &request, answer);
+                return;
             }
-            answer
-        };
-        debug!(kind = header.kind, code = ?answer.error_code(), "scene request refused");
-        let reply = request.loan_slice_uninit(0).map(|r| {
-            let mut r = r.write_from_fn(|_| SceneRow::default());
-            *r.user_header_mut() = answer;
-            r
-        });
-        match reply {
-            Ok(r) => {
-                if let Err(e) = r.send() {
-                    debug!(error = ?e, "scene reply not delivered (client gone?)");
+            let written = usize::try_from(answer.total).map_or(rows, |t| t.min(rows));
+            match request.loan_slice_uninit(written) {
+                Ok(reply) => {
+                    let mut reply = reply.write_from_slice(&scratch[..written]);
+                    *reply.user_header_mut() = answer;
+                    delivered("scene", reply.send());
                 }
+                Err(e) => warn!(error = ?e, written, "cannot loan scene reply"),
             }
-            Err(e) => warn!(error = ?e, "cannot loan scene reply"),
-        }
-    }
+        },
+    )
 }
 
 /// The owner identity of admin client port `port`: the id of the iceoryx2
@@ -669,48 +718,38 @@ fn owner_of(service: &AdminService, port: u128) -> u128 {
 
 /// Answers every admin request waiting; returns how many.
 fn serve_admin(admin: &AdminServer, service: &AdminService, state: &mut State) -> usize {
-    let mut served = 0;
-    loop {
-        let request = match admin.receive() {
-            Ok(Some(r)) => r,
-            Ok(None) => return served,
-            Err(e) => {
-                warn!(error = ?e, "admin receive failed");
-                return served;
-            }
-        };
-        served += 1;
-        let header = request.user_header();
-        let client = owner_of(service, request.origin().value());
-        let vertices = request.payload();
-        let reply = catch_unwind(AssertUnwindSafe(|| {
-            state.handle_admin(client, header, vertices)
-        }))
-        .unwrap_or_else(|_| {
-            error!(op = header.op, "admin handler panicked");
-            AdminReply::error(header.op, ErrorCode::Internal)
-        });
-        match reply.error_code() {
-            ErrorCode::Ok => debug!(op = header.op, id = reply.id, "admin ok"),
-            code => info!(op = header.op, ?code, "admin request refused"),
-        }
-        if header.op == AdminOp::Register as u32
-            && reply.error_code() == ErrorCode::Ok
-            && fault_kill_after_register()
-        {
-            // Fault injection for the tests: a crash between the commit
-            // and the reply, as `kill -9` would make it.
-            error!(
-                id = reply.id,
-                "{KILL_AFTER_REGISTER} is set: killing this server before the reply"
+    serve_waiting(
+        "admin",
+        || admin.receive(),
+        |request| {
+            let header = request.user_header();
+            let client = owner_of(service, request.origin().value());
+            let vertices = request.payload();
+            let reply = guarded(
+                "admin",
+                || state.handle_admin(client, header, vertices),
+                || AdminReply::error(header.op, ErrorCode::Internal),
             );
-            // SAFETY: kill(2) on our own pid; no memory is involved.
-            unsafe { libc::kill(libc::getpid(), libc::SIGKILL) };
-        }
-        if let Err(e) = request.send_copy(reply) {
-            debug!(error = ?e, "admin reply not delivered (client gone?)");
-        }
-    }
+            match reply.error_code() {
+                ErrorCode::Ok => debug!(op = header.op, id = reply.id, "admin ok"),
+                code => info!(op = header.op, ?code, "admin request refused"),
+            }
+            if header.op == AdminOp::Register as u32
+                && reply.error_code() == ErrorCode::Ok
+                && fault_kill_after_register()
+            {
+                // Fault injection for the tests: a crash between the commit
+                // and the reply, as `kill -9` would make it.
+                error!(
+                    id = reply.id,
+                    "{KILL_AFTER_REGISTER} is set: killing this server before the reply"
+                );
+                // SAFETY: kill(2) on our own pid; no memory is involved.
+                unsafe { libc::kill(libc::getpid(), libc::SIGKILL) };
+            }
+            delivered("admin", request.send_copy(reply));
+        },
+    )
 }
 
 /// Fault-injection hook for the tests, not for production: when this

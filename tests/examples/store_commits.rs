@@ -7,8 +7,8 @@
 
 use std::time::{Duration, Instant};
 
-use gjkd_server::database::Database;
-use gjkd_server::stored::{StoredObject, StoredOwner, StoredPose, StoredShape};
+use gjkd_server::engine::records::{StoredObject, StoredOwner, StoredPose, StoredShape};
+use gjkd_server::persist::database::Database;
 use nalgebra::{Isometry3, Vector3};
 
 fn main() {

@@ -283,7 +283,7 @@ fn a_state_file_in_use_is_not_shared() {
     drop(client);
     let mut first = first;
     first.terminate();
-    let (_, opened) = gjkd_server::database::Database::open(&path, 1).expect("intact");
+    let (_, opened) = gjkd_server::persist::database::Database::open(&path, 1).expect("intact");
     assert!(opened.set_aside.is_empty() && !opened.fresh);
     let snap = opened.snapshot;
     assert!(snap.objects.is_empty());

@@ -845,7 +845,7 @@ impl Client {
                 "name longer than MAX_NAME_LEN",
             ));
         }
-        request.id = self.tokens.next();
+        request.token = self.tokens.next();
         let mut vertices = std::mem::take(&mut self.vertex_scratch);
         vertices.clear();
         let built = Self::encode(geometry, &mut request, &mut vertices);
@@ -1016,7 +1016,7 @@ impl Client {
     /// there is room).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
-        request.id = id.raw();
+        request.object = id.raw();
         self.admin(&request, &[]).map(|_| ())
     }
 
@@ -1235,7 +1235,7 @@ mod tests {
     fn push_convex(g: &Geometry<'_>, v: &mut Vec<Vertex>) -> Result<(f64, u32), ClientError> {
         let mut req = AdminRequest::new(AdminOp::Register);
         Client::encode(g, &mut req, v)?;
-        Ok((req.pieces[0].radius, req.pieces[0].reserved))
+        Ok((req.pieces[0].rounding, req.pieces[0].kind))
     }
 
     #[test]
@@ -1316,7 +1316,7 @@ mod tests {
         assert_eq!(req.piece_count, 2);
         assert_eq!(req.pieces[0].vertex_count, 1);
         assert_eq!(req.pieces[1].vertex_count, 2);
-        assert_eq!(req.pieces[1].radius, 0.1);
+        assert_eq!(req.pieces[1].rounding, 0.1);
         assert_eq!(req.pieces[0].offset.translation, [1.0, 0.0, 0.0]);
         assert_eq!(v.len(), 3);
 
@@ -1331,7 +1331,7 @@ mod tests {
     }
 
     #[test]
-    fn cylinders_travel_as_one_dimension_vertex() {
+    fn cylinders_travel_with_named_dimensions() {
         let can = Geometry::Cylinder {
             radius: 0.5,
             half_height: 2.0,
@@ -1342,19 +1342,10 @@ mod tests {
         Client::encode(&can, &mut req, &mut v).expect("valid");
         assert_eq!((req.shape, req.piece_count), (shape_kind::CONVEX, 1));
         let desc = req.pieces[0];
-        assert_eq!(
-            (desc.reserved, desc.vertex_count),
-            (piece_kind::CYLINDER, 1)
-        );
-        assert_eq!(desc.radius, 0.125);
-        assert_eq!(
-            v,
-            [Vertex {
-                x: 0.5,
-                y: 2.0,
-                z: 0.0
-            }]
-        );
+        assert_eq!((desc.kind, desc.vertex_count), (piece_kind::CYLINDER, 0));
+        assert_eq!(desc.rounding, 0.125);
+        assert_eq!((desc.cylinder_radius, desc.half_height), (0.5, 2.0));
+        assert!(v.is_empty(), "a cylinder sends no vertices");
 
         let pieces = [
             Piece {
@@ -1368,9 +1359,9 @@ mod tests {
         ];
         let mut v = Vec::new();
         Client::encode(&Geometry::Compound(&pieces), &mut req, &mut v).expect("valid");
-        assert_eq!(req.pieces[0].reserved, piece_kind::HULL);
-        assert_eq!(req.pieces[1].reserved, piece_kind::CYLINDER);
-        assert_eq!(v.len(), 2);
+        assert_eq!(req.pieces[0].kind, piece_kind::HULL);
+        assert_eq!(req.pieces[1].kind, piece_kind::CYLINDER);
+        assert_eq!(v.len(), 1);
 
         // A gjk cylinder maps back to the same geometry, a polytope to its
         // vertices.

@@ -13,7 +13,7 @@ pub enum AdminOp {
     /// Register a convex object (one piece) or a compound (several), with
     /// the vertices in the request's slice payload.
     Register = 2,
-    /// Remove object [`AdminRequest::id`].
+    /// Remove object [`AdminRequest::object`].
     Remove = 3,
     /// Look an object up by [`AdminRequest::name`].
     Lookup = 4,
@@ -25,8 +25,8 @@ pub enum AdminOp {
     /// children). The slice payload is text packed by [`pack_text`]: the
     /// URDF, optionally followed by a NUL byte and an SRDF whose
     /// `disable_collisions` pairs (with the adjacent links) the server keeps
-    /// as the robot's allowed pairs. [`AdminRequest::id`] is the text's
-    /// length in bytes. The reply's id is the robot's id, for
+    /// as the robot's allowed pairs. [`AdminRequest::text_len`] is the
+    /// text's length in bytes. The reply's id is the robot's id, for
     /// [`ItemKind::SetJoints`]; attaching a name again replaces the robot.
     AttachRobot = 6,
 }
@@ -46,7 +46,7 @@ impl AdminOp {
     }
 }
 
-/// Values of [`AdminRequest::shape`] for [`AdminOp::Lookup`].
+/// Values of [`AdminRequest::lookup`].
 pub mod lookup_kind {
     /// Look up an object (the default, 0).
     pub const OBJECT: u32 = 0;
@@ -56,18 +56,28 @@ pub mod lookup_kind {
 }
 
 /// Request header of the admin service. The slice payload holds the
-/// vertices of a registration (empty for other operations).
+/// vertices of a registration, or the text of a robot
+/// ([`AdminOp::AttachRobot`]), and is empty for other operations.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.AdminRequest")]
+#[type_name("gjkd.v2.AdminRequest")]
 pub struct AdminRequest {
     /// [`AdminOp`] wire value.
     pub op: u32,
-    /// [`shape_kind`] value, for [`AdminOp::Register`].
+    /// [`shape_kind`](crate::shape_kind) value, for [`AdminOp::Register`].
     pub shape: u32,
-    /// Object, for [`AdminOp::Remove`].
-    ///
-    /// For [`AdminOp::Register`], the registration token: 0 for none, or
+    /// [`lookup_kind`] value, for [`AdminOp::Lookup`].
+    pub lookup: u32,
+    /// Number of valid entries of `pieces`, for [`AdminOp::Register`].
+    pub piece_count: u32,
+    /// Bytes of `name` in use.
+    pub name_len: u32,
+    /// Bytes of robot text in the slice payload, for
+    /// [`AdminOp::AttachRobot`].
+    pub text_len: u32,
+    /// The object to remove, for [`AdminOp::Remove`].
+    pub object: u64,
+    /// The registration token, for [`AdminOp::Register`]: 0 for none, or
     /// a value the client draws at random for each registration and sends
     /// again, unchanged with the rest of the request, when it retries that
     /// registration (after a timeout, or a server that died and came back).
@@ -76,15 +86,9 @@ pub struct AdminRequest {
     /// was stored (also after a crash between the commit and the reply),
     /// never a second object. A token is forgotten with its object; the
     /// same token with another shape or name is [`ErrorCode::Malformed`].
-    /// Added within v1 (the layout is unchanged): a server older than this
-    /// ignores the token, so a retry there may store a second object.
-    pub id: u64,
-    /// Number of valid entries of `pieces`.
-    pub piece_count: u32,
-    /// Bytes of `name` in use.
-    pub name_len: u32,
+    pub token: u64,
     /// UTF-8 name: optional for [`AdminOp::Register`], required for
-    /// [`AdminOp::Lookup`].
+    /// [`AdminOp::Lookup`] and [`AdminOp::AttachRobot`].
     pub name: [u8; MAX_NAME_LEN],
     /// Initial pose of a registered object.
     pub pose: Pose,
@@ -109,9 +113,12 @@ impl AdminRequest {
         AdminRequest {
             op: op as u32,
             shape: 0,
-            id: 0,
+            lookup: lookup_kind::OBJECT,
             piece_count: 0,
             name_len: 0,
+            text_len: 0,
+            object: 0,
+            token: 0,
             name: [0; MAX_NAME_LEN],
             pose: Pose::IDENTITY,
             pieces: [PieceDesc::default(); MAX_PIECES],
@@ -172,7 +179,7 @@ impl WaitMode {
 /// crate's `Client::server_info`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.ServerInfo")]
+#[type_name("gjkd.v2.ServerInfo")]
 pub struct ServerInfo {
     /// [`PROTOCOL_VERSION`] of the server.
     pub protocol: u32,
@@ -195,7 +202,7 @@ pub struct ServerInfo {
 /// Server statistics.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.ServerStats")]
+#[type_name("gjkd.v2.ServerStats")]
 pub struct ServerStats {
     /// Objects held.
     pub objects: u64,
@@ -229,7 +236,7 @@ pub struct ServerStats {
 /// The admin service's answer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.AdminReply")]
+#[type_name("gjkd.v2.AdminReply")]
 pub struct AdminReply {
     /// [`ErrorCode`] wire value.
     pub error: u32,

@@ -188,29 +188,37 @@ impl<'a> Geometry<'a> {
     /// appended to `out`.
     fn piece(&self, offset: Pose, out: &mut Vec<Vertex>) -> Result<PieceDesc, ShapeError> {
         let before = out.len();
-        let (radius, kind) = match *self {
+        let hull = |rounding: f64, out: &mut Vec<Vertex>| {
+            Ok(PieceDesc {
+                offset,
+                kind: piece_kind::HULL,
+                vertex_count: u32::try_from(out.len() - before)
+                    .map_err(|_| ShapeError::TooManyVertices)?,
+                rounding,
+                ..PieceDesc::default()
+            })
+        };
+        match *self {
             Geometry::Sphere { radius } => {
                 out.push(Vertex::default());
-                (radius, piece_kind::HULL)
+                hull(radius, out)
             }
             Geometry::Capsule { a, b, radius } => {
                 out.extend([Vertex::from(a), Vertex::from(b)]);
-                (radius, piece_kind::HULL)
+                hull(radius, out)
             }
             Geometry::Cylinder {
                 radius,
                 half_height,
                 rounding,
-            } => {
-                // The wire's cylinder layout: one vertex holding the
-                // dimensions (see `piece_kind::CYLINDER`).
-                out.push(Vertex {
-                    x: radius,
-                    y: half_height,
-                    z: 0.0,
-                });
-                (rounding, piece_kind::CYLINDER)
-            }
+            } => Ok(PieceDesc {
+                offset,
+                kind: piece_kind::CYLINDER,
+                vertex_count: 0,
+                rounding,
+                cylinder_radius: radius,
+                half_height,
+            }),
             Geometry::Cuboid {
                 half_extents: h,
                 radius,
@@ -219,22 +227,14 @@ impl<'a> Geometry<'a> {
                     return Err(ShapeError::HalfExtentIsNegative);
                 }
                 out.extend(cuboid_corners(&h).map(Vertex::from));
-                (radius, piece_kind::HULL)
+                hull(radius, out)
             }
             Geometry::Polytope { vertices, radius } => {
                 out.extend(vertices.iter().map(|&p| Vertex::from(p)));
-                (radius, piece_kind::HULL)
+                hull(radius, out)
             }
-            Geometry::Compound(_) => return Err(ShapeError::CompoundIsNested),
-        };
-        let vertex_count =
-            u32::try_from(out.len() - before).map_err(|_| ShapeError::TooManyVertices)?;
-        Ok(PieceDesc {
-            offset,
-            radius,
-            vertex_count,
-            reserved: kind,
-        })
+            Geometry::Compound(_) => Err(ShapeError::CompoundIsNested),
+        }
     }
 }
 
@@ -269,13 +269,11 @@ pub fn decode_shape(
             }
             let piece = &request.pieces[0];
             if piece.vertex_count as usize != vertices.len() {
-                return Err(
-                    if vertices.is_empty() && piece.reserved == piece_kind::HULL {
-                        ErrorCode::EmptyVertices
-                    } else {
-                        ErrorCode::Malformed
-                    },
-                );
+                return Err(if vertices.is_empty() && piece.kind == piece_kind::HULL {
+                    ErrorCode::EmptyVertices
+                } else {
+                    ErrorCode::Malformed
+                });
             }
             Ok(Shape::Convex(decode_piece(piece, vertices)?))
         }
@@ -307,20 +305,17 @@ pub fn decode_shape(
     }
 }
 
-/// One piece of a registration, `vertices` its own run of the slice: a
-/// hull, or a cylinder whose one vertex holds its dimensions (see
-/// [`piece_kind::CYLINDER`]). A kind this version does not know is
-/// malformed.
+/// One piece of a registration, `vertices` its own run of the slice
+/// (empty for a cylinder). A kind this version does not know is malformed.
 ///
 /// # Errors
 /// The specific [`ErrorCode`] of the first problem found.
 pub fn decode_piece(desc: &PieceDesc, vertices: &[Vertex]) -> Result<Convex, ErrorCode> {
-    match desc.reserved {
-        piece_kind::HULL => hull(vertices, desc.radius),
-        piece_kind::CYLINDER => match vertices {
-            [v] if v.z == 0.0 => cylinder(v.x, v.y, desc.radius),
-            _ => Err(ErrorCode::Malformed),
-        },
+    match desc.kind {
+        piece_kind::HULL => hull(vertices, desc.rounding),
+        piece_kind::CYLINDER if vertices.is_empty() => {
+            cylinder(desc.cylinder_radius, desc.half_height, desc.rounding)
+        }
         _ => Err(ErrorCode::Malformed),
     }
 }
@@ -347,7 +342,12 @@ pub fn cylinder(radius: f64, half_height: f64, rounding: f64) -> Result<Convex, 
     Convex::cylinder(radius, half_height, rounding).map_err(ErrorCode::from)
 }
 
-fn hull(vertices: &[Vertex], radius: f64) -> Result<Convex, ErrorCode> {
+/// The hull of `vertices` rounded by `radius`.
+///
+/// # Errors
+/// [`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`] and the
+/// codes of gjk's own checks.
+pub fn hull(vertices: &[Vertex], radius: f64) -> Result<Convex, ErrorCode> {
     if vertices.is_empty() {
         return Err(ErrorCode::EmptyVertices);
     }
@@ -484,7 +484,7 @@ mod tests {
         // An unknown piece kind, an unknown shape kind, a compound of
         // more pieces than the table holds.
         let mut kind = req;
-        kind.pieces[0].reserved = 99;
+        kind.pieces[0].kind = 99;
         assert_eq!(
             decode_shape(&kind, &v, MAX_PIECES).err(),
             Some(ErrorCode::Malformed)
@@ -502,25 +502,22 @@ mod tests {
             decode_shape(&huge, &v, MAX_PIECES).err(),
             Some(ErrorCode::TooManyPieces)
         );
-        // A cylinder whose dimension vertex has a z.
-        let (mut can, mut dims) = register(&Geometry::Cylinder {
+        // A cylinder sent with vertices, or with a NaN radius.
+        let (mut can, none) = register(&Geometry::Cylinder {
             radius: 1.0,
             half_height: 1.0,
             rounding: 0.0,
         });
-        dims[0].z = 1.0;
+        assert!(none.is_empty(), "a cylinder travels without vertices");
+        can.pieces[0].vertex_count = 1;
         assert_eq!(
-            decode_shape(&can, &dims, MAX_PIECES).err(),
+            decode_shape(&can, &v, MAX_PIECES).err(),
             Some(ErrorCode::Malformed)
         );
-        dims[0] = Vertex {
-            x: f64::NAN,
-            y: 1.0,
-            z: 0.0,
-        };
-        can.pieces[0].radius = 0.0;
+        can.pieces[0].vertex_count = 0;
+        can.pieces[0].cylinder_radius = f64::NAN;
         assert_eq!(
-            decode_shape(&can, &dims, MAX_PIECES).err(),
+            decode_shape(&can, &[], MAX_PIECES).err(),
             Some(ErrorCode::InvalidRadius)
         );
     }

@@ -57,20 +57,17 @@ pub mod item_flags {
     pub const MARGIN: u32 = 1 << 2;
     /// Start from the server's cached simplex of this pair (for this client).
     pub const WARM_START: u32 = 1 << 3;
-    /// Search support points in f32 ([`Precision::Single`](crate::Precision::Single)). Added within
-    /// v1 (the layout is unchanged): a server older than this bit refuses it
-    /// as malformed rather than silently answering in f64.
+    /// Search support points in f32 ([`Precision::Single`](crate::Precision::Single)).
     pub const SINGLE_PRECISION: u32 = 1 << 4;
     /// For [`super::ItemKind::SetJoints`]: clamp positions outside their
-    /// limits instead of refusing the item. Added within v1, like
-    /// `SINGLE_PRECISION`.
+    /// limits instead of refusing the item.
     pub const CLAMP: u32 = 1 << 5;
     /// Scene paths only: a [`super::ItemKind::SetPose`] or
     /// [`super::ItemKind::SetJoints`] item with this bit also ends its path
     /// step, as a [`super::ItemKind::Step`] item after it would. A path's
     /// steps then take one item fewer each, which is what a long path's
     /// round trip is made of. Refused as malformed on any other item and
-    /// outside a path. Added within v1, like `SINGLE_PRECISION`.
+    /// outside a path.
     pub const END_STEP: u32 = 1 << 6;
     /// Every bit this version knows; others are rejected as malformed.
     pub const ALL: u32 =
@@ -142,7 +139,7 @@ impl QueryOptions {
 /// Build items with [`Item::set_pose`] and [`Item::distance`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.Item")]
+#[type_name("gjkd.v2.Item")]
 pub struct Item {
     /// [`ItemKind`] wire value.
     pub kind: u32,

@@ -11,10 +11,10 @@
 //!
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
-//! | [`query_service_name`] `{service}/v1/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
-//! | [`admin_service_name`] `{service}/v1/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
-//! | [`scene_service_name`] `{service}/v1/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
-//! | [`wake_service_name`] `{service}/v1/wake` | event | | |
+//! | [`query_service_name`] `{service}/v2/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
+//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
+//! | [`scene_service_name`] `{service}/v2/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
+//! | [`wake_service_name`] `{service}/v2/wake` | event | | |
 //!
 //! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
 //! are plain `u32` on the wire, never Rust enums: any bit pattern a client
@@ -58,7 +58,7 @@ pub use admin::{
 };
 pub use error::ErrorCode;
 pub use geometry::{
-    Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape,
+    Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape, hull,
 };
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
 pub use pose::{Pose, UNIT_TOLERANCE};
@@ -71,8 +71,11 @@ pub use text::{pack_text, unpack_text};
 
 /// Protocol version, part of every service name: a client and a server of
 /// different versions never see each other's services, instead of misreading
-/// each other's bytes.
-pub const PROTOCOL_VERSION: u32 = 1;
+/// each other's bytes (a client that finds only another version's services
+/// reports a version mismatch). Version 2 names every field for what it
+/// holds: registration tokens, removed objects, lookup kinds and cylinder
+/// dimensions have fields of their own.
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Service name used when none is given: `"gjkd"`.
 pub const DEFAULT_SERVICE: &str = "gjkd";
@@ -94,7 +97,7 @@ pub const JOINTS_PER_ITEM: usize = 9;
 /// Longest object name in bytes (UTF-8).
 pub const MAX_NAME_LEN: usize = 64;
 
-/// Name of the query service of deployment `service`: `{service}/v1/query`.
+/// Name of the query service of deployment `service`: `{service}/v2/query`.
 pub fn query_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/query")
 }
@@ -105,8 +108,7 @@ pub fn admin_service_name(service: &str) -> String {
 }
 
 /// Name of the scene service (whole-scene questions: clearance, pairs
-/// within a margin, nearest objects, paths), added within v1: a server older
-/// than it has no such service, and a client finds none to open.
+/// within a margin, nearest objects, paths).
 pub fn scene_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/scene")
 }

@@ -18,7 +18,7 @@ pub const UNIT_TOLERANCE: f64 = 1e-6;
 /// (nalgebra's coordinate order), in f64.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.Pose")]
+#[type_name("gjkd.v2.Pose")]
 pub struct Pose {
     /// Translation.
     pub translation: [f64; 3],

@@ -63,7 +63,7 @@ pub mod result_flags {
 /// Read it with [`ItemResult::answer`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.ItemResult")]
+#[type_name("gjkd.v2.ItemResult")]
 pub struct ItemResult {
     /// Distance between the (rounded) shapes, `>= 0`.
     pub distance: f64,
@@ -181,7 +181,7 @@ pub struct Answer {
 /// is not [`ErrorCode::Ok`] the result slice is empty.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v1.ReplyHeader")]
+#[type_name("gjkd.v2.ReplyHeader")]
 pub struct ReplyHeader {
     /// [`ErrorCode`] wire value: [`ErrorCode::EmptyBatch`],
     /// [`ErrorCode::BatchTooLarge`], or [`ErrorCode::Ok`].

@@ -5,9 +5,9 @@ use nalgebra::{Isometry3, Vector3};
 
 #[test]
 fn names_carry_the_version() {
-    assert_eq!(query_service_name("gjkd"), "gjkd/v1/query");
-    assert_eq!(admin_service_name("x"), "x/v1/admin");
-    assert_eq!(wake_service_name("x"), "x/v1/wake");
+    assert_eq!(query_service_name("gjkd"), "gjkd/v2/query");
+    assert_eq!(admin_service_name("x"), "x/v2/admin");
+    assert_eq!(wake_service_name("x"), "x/v2/wake");
 }
 
 #[test]

@@ -288,7 +288,7 @@ mod tests {
         reg.shape = shape_kind::CONVEX;
         reg.piece_count = 1;
         reg.pieces[0].vertex_count = 1;
-        reg.pieces[0].radius = 0.5;
+        reg.pieces[0].rounding = 0.5;
         let a = state.handle_admin(1, &reg, &[Vertex::default()]).id;
         let b = state
             .handle_admin(

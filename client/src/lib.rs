@@ -149,14 +149,14 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, PieceDesc, ReplyHeader, Vertex, admin_service_name,
-    piece_kind, query_service_name, shape_kind, wake_service_name,
+    AdminOp, AdminReply, AdminRequest, ReplyHeader, Vertex, admin_service_name, query_service_name,
+    wake_service_name,
 };
 pub use gjkd_proto::{
-    Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Item, ItemKind,
-    ItemResult, MAX_NAME_LEN, MAX_PIECES, ObjectId, PROTOCOL_VERSION, Pose, Precision,
-    QueryOptions, SceneReply, SceneRequest, SceneRow, ServerInfo, ServerStats, Status, WaitMode,
-    item_flags, result_flags, scene_flags, scene_reply_flags,
+    Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Geometry, Item,
+    ItemKind, ItemResult, MAX_NAME_LEN, MAX_PIECES, ObjectId, PROTOCOL_VERSION, Piece, Pose,
+    Precision, QueryOptions, SceneReply, SceneRequest, SceneRow, ServerInfo, ServerStats,
+    ShapeError, Status, WaitMode, item_flags, result_flags, scene_flags, scene_reply_flags,
 };
 
 /// Timeout of every call unless set with [`ClientBuilder::timeout`]: one
@@ -265,151 +265,6 @@ fn reply_accepted(raw: u32) -> Result<(), ClientError> {
 
 fn ipc_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ClientError {
     move |e| ClientError::Ipc(format!("{what}: {e:?}"))
-}
-
-/// A convex shape, or a union of convex pieces, to register.
-///
-/// Vertices are in the object's body frame. The radius grows the convex hull
-/// of the vertices by a ball ("rounding"); 0 gives the plain polytope.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Geometry<'a> {
-    /// A ball of `radius` about the body origin.
-    Sphere {
-        /// Radius, `>= 0`.
-        radius: f64,
-    },
-    /// The segment from `a` to `b` grown by `radius`.
-    Capsule {
-        /// One end.
-        a: Point3<f64>,
-        /// The other end.
-        b: Point3<f64>,
-        /// Radius, `>= 0`.
-        radius: f64,
-    },
-    /// A box centred on the body origin, its edges rounded by `radius`.
-    Cuboid {
-        /// Half extents, each `>= 0`.
-        half_extents: Vector3<f64>,
-        /// Rounding radius, `>= 0`.
-        radius: f64,
-    },
-    /// The convex hull of `vertices` grown by `radius`. Vertices need not be
-    /// hull vertices.
-    Polytope {
-        /// At least one vertex.
-        vertices: &'a [Point3<f64>],
-        /// Rounding radius, `>= 0`.
-        radius: f64,
-    },
-    /// An exact cylinder about the body z axis, centred on the body origin:
-    /// the disk of `radius` swept from `z = -half_height` to
-    /// `z = +half_height`, its edges rounded by `rounding` (0 for sharp
-    /// rims). Never a polytope: the server answers with the cylinder's own
-    /// support function. Needs a server that knows cylinders (an older one
-    /// refuses it with [`ErrorCode::Malformed`]).
-    Cylinder {
-        /// Radius of the disk, `>= 0`.
-        radius: f64,
-        /// Half the length along z, `>= 0`.
-        half_height: f64,
-        /// Rounding radius, `>= 0`.
-        rounding: f64,
-    },
-    /// A union of convex pieces (at most [`MAX_PIECES`], none of them itself
-    /// a compound). Answers name the pieces that realise the distance, by
-    /// position in this slice.
-    Compound(&'a [Piece<'a>]),
-}
-
-/// A convex piece of a [`Geometry::Compound`], placed in the compound's body
-/// frame by `offset`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Piece<'a> {
-    /// Pose of the piece in the compound's body frame.
-    pub offset: Isometry3<f64>,
-    /// The piece's shape; not a compound.
-    pub geometry: Geometry<'a>,
-}
-
-impl<'a> Geometry<'a> {
-    /// The geometry that registers `convex` as it is: a cylinder as a
-    /// [`Geometry::Cylinder`], anything else as the
-    /// [`Geometry::Polytope`] of its vertices and radius (vertex order
-    /// kept, so the server builds the very same shape).
-    pub fn of_convex(convex: &'a gjk::Convex) -> Self {
-        match convex.cylinder_dimensions() {
-            Some((radius, half_height)) => Geometry::Cylinder {
-                radius,
-                half_height,
-                rounding: convex.radius(),
-            },
-            None => Geometry::Polytope {
-                vertices: convex.vertices(),
-                radius: convex.radius(),
-            },
-        }
-    }
-
-    /// Vertices, radius and piece kind ([`piece_kind`]) of a convex
-    /// geometry, the vertices appended to `out`; the order is the one the
-    /// `gjk` crate's constructors use, so that the server's answers equal
-    /// in-process ones bit for bit.
-    fn push_convex(&self, out: &mut Vec<Vertex>) -> Result<(f64, u32), ClientError> {
-        let radius = match *self {
-            Geometry::Sphere { radius } => {
-                out.push(Vertex::default());
-                radius
-            }
-            Geometry::Capsule { a, b, radius } => {
-                out.push(a.into());
-                out.push(b.into());
-                radius
-            }
-            Geometry::Cylinder {
-                radius,
-                half_height,
-                rounding,
-            } => {
-                // The wire's cylinder layout: one vertex holding the
-                // dimensions (see `piece_kind::CYLINDER`).
-                out.push(Vertex {
-                    x: radius,
-                    y: half_height,
-                    z: 0.0,
-                });
-                return Ok((rounding, piece_kind::CYLINDER));
-            }
-            Geometry::Cuboid {
-                half_extents: h,
-                radius,
-            } => {
-                // A negative extent would give the same eight corners as its
-                // absolute value, so the server could not tell: refuse it here.
-                if h.iter().any(|&c| c < 0.0) {
-                    return Err(ClientError::InvalidArgument("a half extent is negative"));
-                }
-                for i in 0..8 {
-                    out.push(Vertex {
-                        x: if i & 1 == 0 { -h.x } else { h.x },
-                        y: if i & 2 == 0 { -h.y } else { h.y },
-                        z: if i & 4 == 0 { -h.z } else { h.z },
-                    });
-                }
-                radius
-            }
-            Geometry::Polytope { vertices, radius } => {
-                out.extend(vertices.iter().map(|&p| Vertex::from(p)));
-                radius
-            }
-            Geometry::Compound(_) => {
-                return Err(ClientError::InvalidArgument(
-                    "a compound cannot be a piece of a compound",
-                ));
-            }
-        };
-        Ok((radius, piece_kind::HULL))
-    }
 }
 
 /// Configures and opens a [`Client`].
@@ -991,7 +846,7 @@ impl Client {
                 "name longer than MAX_NAME_LEN",
             ));
         }
-        request.id = self.tokens.next();
+        request.token = self.tokens.next();
         let mut vertices = std::mem::take(&mut self.vertex_scratch);
         vertices.clear();
         let built = Self::encode(geometry, &mut request, &mut vertices);
@@ -1020,45 +875,15 @@ impl Client {
         }
     }
 
+    /// The wire form of `geometry` into `request` and `vertices`.
     fn encode(
         geometry: &Geometry<'_>,
         request: &mut AdminRequest,
         vertices: &mut Vec<Vertex>,
     ) -> Result<(), ClientError> {
-        match geometry {
-            Geometry::Compound(pieces) => {
-                if pieces.len() > MAX_PIECES {
-                    return Err(ClientError::InvalidArgument("more than MAX_PIECES pieces"));
-                }
-                request.shape = shape_kind::COMPOUND;
-                request.piece_count = pieces.len() as u32;
-                for (desc, piece) in request.pieces.iter_mut().zip(pieces.iter()) {
-                    let before = vertices.len();
-                    let (radius, kind) = piece.geometry.push_convex(vertices)?;
-                    *desc = PieceDesc {
-                        offset: Pose::from_isometry(&piece.offset),
-                        radius,
-                        vertex_count: u32::try_from(vertices.len() - before).map_err(|_| {
-                            ClientError::InvalidArgument("too many vertices in a piece")
-                        })?,
-                        reserved: kind,
-                    };
-                }
-            }
-            convex => {
-                request.shape = shape_kind::CONVEX;
-                request.piece_count = 1;
-                let (radius, kind) = convex.push_convex(vertices)?;
-                request.pieces[0] = PieceDesc {
-                    offset: Pose::IDENTITY,
-                    radius,
-                    vertex_count: u32::try_from(vertices.len())
-                        .map_err(|_| ClientError::InvalidArgument("too many vertices"))?,
-                    reserved: kind,
-                };
-            }
-        }
-        Ok(())
+        geometry
+            .encode(request, vertices)
+            .map_err(|e| ClientError::InvalidArgument(e.describe()))
     }
 
     /// Registers a ball of `radius` about the body origin.
@@ -1192,7 +1017,7 @@ impl Client {
     /// there is room).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
-        request.id = id.raw();
+        request.object = id.raw();
         self.admin(&request, &[]).map(|_| ())
     }
 
@@ -1405,6 +1230,14 @@ enum Waited {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use gjkd_proto::{piece_kind, shape_kind};
+
+    /// Vertices, radius and piece kind of a convex geometry's wire form.
+    fn push_convex(g: &Geometry<'_>, v: &mut Vec<Vertex>) -> Result<(f64, u32), ClientError> {
+        let mut req = AdminRequest::new(AdminOp::Register);
+        Client::encode(g, &mut req, v)?;
+        Ok((req.pieces[0].rounding, req.pieces[0].kind))
+    }
 
     #[test]
     fn a_negative_half_extent_is_refused_before_sending() {
@@ -1419,7 +1252,7 @@ mod tests {
                 radius: 0.0,
             };
             assert_eq!(
-                g.push_convex(&mut v),
+                push_convex(&g, &mut v),
                 Err(ClientError::InvalidArgument("a half extent is negative")),
                 "{h:?}"
             );
@@ -1431,7 +1264,7 @@ mod tests {
             half_extents: Vector3::new(1.0, 0.0, -0.0),
             radius: 0.0,
         };
-        assert_eq!(flat.push_convex(&mut v), Ok((0.0, piece_kind::HULL)));
+        assert_eq!(push_convex(&flat, &mut v), Ok((0.0, piece_kind::HULL)));
     }
 
     #[test]
@@ -1441,7 +1274,7 @@ mod tests {
             half_extents: Vector3::new(1.0, 2.0, 3.0),
             radius: 0.0,
         };
-        assert_eq!(g.push_convex(&mut v), Ok((0.0, piece_kind::HULL)));
+        assert_eq!(push_convex(&g, &mut v), Ok((0.0, piece_kind::HULL)));
         assert_eq!(v.len(), 8);
         assert_eq!(
             v[0],
@@ -1484,7 +1317,7 @@ mod tests {
         assert_eq!(req.piece_count, 2);
         assert_eq!(req.pieces[0].vertex_count, 1);
         assert_eq!(req.pieces[1].vertex_count, 2);
-        assert_eq!(req.pieces[1].radius, 0.1);
+        assert_eq!(req.pieces[1].rounding, 0.1);
         assert_eq!(req.pieces[0].offset.translation, [1.0, 0.0, 0.0]);
         assert_eq!(v.len(), 3);
 
@@ -1499,7 +1332,7 @@ mod tests {
     }
 
     #[test]
-    fn cylinders_travel_as_one_dimension_vertex() {
+    fn cylinders_travel_with_named_dimensions() {
         let can = Geometry::Cylinder {
             radius: 0.5,
             half_height: 2.0,
@@ -1510,19 +1343,10 @@ mod tests {
         Client::encode(&can, &mut req, &mut v).expect("valid");
         assert_eq!((req.shape, req.piece_count), (shape_kind::CONVEX, 1));
         let desc = req.pieces[0];
-        assert_eq!(
-            (desc.reserved, desc.vertex_count),
-            (piece_kind::CYLINDER, 1)
-        );
-        assert_eq!(desc.radius, 0.125);
-        assert_eq!(
-            v,
-            [Vertex {
-                x: 0.5,
-                y: 2.0,
-                z: 0.0
-            }]
-        );
+        assert_eq!((desc.kind, desc.vertex_count), (piece_kind::CYLINDER, 0));
+        assert_eq!(desc.rounding, 0.125);
+        assert_eq!((desc.cylinder_radius, desc.half_height), (0.5, 2.0));
+        assert!(v.is_empty(), "a cylinder sends no vertices");
 
         let pieces = [
             Piece {
@@ -1536,9 +1360,9 @@ mod tests {
         ];
         let mut v = Vec::new();
         Client::encode(&Geometry::Compound(&pieces), &mut req, &mut v).expect("valid");
-        assert_eq!(req.pieces[0].reserved, piece_kind::HULL);
-        assert_eq!(req.pieces[1].reserved, piece_kind::CYLINDER);
-        assert_eq!(v.len(), 2);
+        assert_eq!(req.pieces[0].kind, piece_kind::HULL);
+        assert_eq!(req.pieces[1].kind, piece_kind::CYLINDER);
+        assert_eq!(v.len(), 1);
 
         // A gjk cylinder maps back to the same geometry, a polytope to its
         // vertices.

@@ -318,7 +318,8 @@ impl Client {
                 "name longer than MAX_NAME_LEN",
             ));
         }
-        request.id = text.len() as u64;
+        request.text_len = u32::try_from(text.len())
+            .map_err(|_| ClientError::InvalidArgument("robot text longer than 4 GiB"))?;
         request.pose = Pose::from_isometry(base);
         let reply = self.admin(&request, &pack_text(&text))?;
         self.handle(ObjectId::from_raw(reply.id), name, kinematics)
@@ -339,7 +340,7 @@ impl Client {
                 "name longer than MAX_NAME_LEN",
             ));
         }
-        request.shape = lookup_kind::ROBOT;
+        request.lookup = lookup_kind::ROBOT;
         let reply = self.admin(&request, &[])?;
         self.handle(ObjectId::from_raw(reply.id), name, kinematics)
     }

@@ -120,3 +120,82 @@ fn every_function_is_documented() {
     }
     assert!(functions >= 23, "only {functions} functions found");
 }
+
+/// The C compiler lays out the header's mirrors of wire structs exactly as
+/// Rust lays out the wire structs: a C file of `_Static_assert`s on
+/// `sizeof` and `offsetof`, with the Rust figures written in, must compile.
+/// (The crate's own const assertions check the Rust mirrors; this checks
+/// what a C program sees.)
+#[test]
+fn c_sees_the_wire_layouts_rust_sends() {
+    use gjkd_proto::{Item, ItemResult, Pose};
+    use std::mem::{offset_of, size_of};
+    let mut c = String::from("#include <stddef.h>\n#include \"gjkd.h\"\n");
+    let mut check = |ty: &str, what: &str, rust: usize| {
+        let expr = if what == "size" {
+            format!("sizeof({ty})")
+        } else {
+            format!("offsetof({ty}, {what})")
+        };
+        c.push_str(&format!(
+            "_Static_assert({expr} == {rust}, \"{ty} {what} differs from Rust's\");\n"
+        ));
+    };
+    check("gjkd_pose", "size", size_of::<Pose>());
+    check("gjkd_pose", "translation", offset_of!(Pose, translation));
+    check("gjkd_pose", "rotation", offset_of!(Pose, rotation));
+    check("gjkd_pair_query", "size", size_of::<Item>());
+    check("gjkd_pair_query", "kind", offset_of!(Item, kind));
+    check("gjkd_pair_query", "flags", offset_of!(Item, flags));
+    check("gjkd_pair_query", "a", offset_of!(Item, a));
+    check("gjkd_pair_query", "b", offset_of!(Item, b));
+    check("gjkd_pair_query", "pose_a", offset_of!(Item, pose_a));
+    check("gjkd_pair_query", "pose_b", offset_of!(Item, pose_b));
+    check("gjkd_pair_query", "tolerance", offset_of!(Item, tolerance));
+    check("gjkd_pair_query", "margin", offset_of!(Item, margin));
+    check(
+        "gjkd_pair_query",
+        "max_iterations",
+        offset_of!(Item, max_iterations),
+    );
+    check("gjkd_pair_query", "reserved", offset_of!(Item, reserved));
+    check("gjkd_result", "size", size_of::<ItemResult>());
+    check("gjkd_result", "distance", offset_of!(ItemResult, distance));
+    check("gjkd_result", "lower", offset_of!(ItemResult, lower));
+    check("gjkd_result", "upper", offset_of!(ItemResult, upper));
+    check(
+        "gjkd_result",
+        "penetration",
+        offset_of!(ItemResult, penetration),
+    );
+    check("gjkd_result", "point_a", offset_of!(ItemResult, point_a));
+    check("gjkd_result", "point_b", offset_of!(ItemResult, point_b));
+    check("gjkd_result", "normal", offset_of!(ItemResult, normal));
+    check("gjkd_result", "error", offset_of!(ItemResult, error));
+    check("gjkd_result", "status", offset_of!(ItemResult, status));
+    check(
+        "gjkd_result",
+        "iterations",
+        offset_of!(ItemResult, iterations),
+    );
+    check("gjkd_result", "flags", offset_of!(ItemResult, flags));
+    check("gjkd_result", "pieces", offset_of!(ItemResult, pieces));
+
+    let dir = std::env::temp_dir().join(format!("gjkd-layout-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let file = dir.join("layout.c");
+    std::fs::write(&file, &c).expect("write layout.c");
+    let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let out = std::process::Command::new(&compiler)
+        .args(["-std=c11", "-fsyntax-only", "-I"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("include"))
+        .arg(&file)
+        .output()
+        .unwrap_or_else(|e| panic!("run {compiler}: {e}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        out.status.success(),
+        "the header's layouts differ from the wire's:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -5,49 +5,17 @@
 use pyo3::prelude::*;
 
 use gjkd_client::{ClientError, ErrorCode, Item, ItemResult, ObjectId};
-use gjkd_proto::Pose;
 
 use nalgebra::Isometry3;
 
 use crate::arrays::{Ids, Poses, id_array, pose, pose_array};
 use crate::batch::{Answer, Distances, RequestArrays, options, set_pose_a, set_pose_b};
 use crate::errors::{self, invalid};
-use crate::runner::{Answerer, Buffers, run_items, run_pairs};
+use crate::runner::{run_items, run_pairs};
 use crate::server_lib::check_pose;
 use crate::shape::{Pieces, Registration, Shape};
 
-/// Who holds the objects: a server (through the Rust client) or the
-/// Python process.
-pub trait Backend {
-    /// The answerer of query items and the buffers kept for it.
-    fn parts(&mut self, py: Python<'_>) -> PyResult<(&mut dyn Answerer, &mut Buffers)>;
-    /// Registers `what`, returning its id.
-    fn register(
-        &mut self,
-        py: Python<'_>,
-        what: &Registration<'_>,
-        name: Option<&str>,
-        pose: Option<Pose>,
-    ) -> PyResult<u64>;
-    /// Removes object `id`.
-    fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()>;
-    /// The id of the object named `name`.
-    fn lookup(&mut self, py: Python<'_>, name: &str) -> PyResult<u64>;
-}
-
-/// A pose argument, checked as the server will check it, so that a bad one
-/// raises before anything is registered or changed.
-pub fn checked_pose(
-    py: Python<'_>,
-    obj: Option<&Bound<'_, PyAny>>,
-    field: &str,
-) -> PyResult<Option<Pose>> {
-    let Some(p) = pose(obj, field)? else {
-        return Ok(None);
-    };
-    check_pose(&p).map_err(|code| errors::refused(py, code, Some(field), None))?;
-    Ok(Some(p))
-}
+pub use crate::backend::{Backend, checked_pose};
 
 /// Registers one convex shape.
 pub fn register_shape(

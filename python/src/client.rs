@@ -6,6 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use gjkd_client::{ClientError, Item, ItemResult};
+
+use crate::call::RustCall;
 use gjkd_proto::Pose;
 
 use crate::api::{Backend, backend_methods};
@@ -108,13 +110,8 @@ fn seconds(py: Python<'_>, field: &str, s: f64) -> PyResult<Duration> {
         })
 }
 
-impl Client {
-    fn inner_client(&mut self, py: Python<'_>) -> PyResult<&mut gjkd_client::Client> {
-        self.conn.inner.as_mut().ok_or_else(|| closed(py))
-    }
-
-    /// Runs `call` on the Rust client with the GIL released.
-    pub(crate) fn call<R>(
+impl RustCall for Client {
+    fn call<R>(
         &mut self,
         py: Python<'_>,
         call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,
@@ -127,6 +124,12 @@ impl Client {
                 OnThisThread::new(call(client))
             })
             .into_inner())
+    }
+}
+
+impl Client {
+    fn inner_client(&mut self, py: Python<'_>) -> PyResult<&mut gjkd_client::Client> {
+        self.conn.inner.as_mut().ok_or_else(|| closed(py))
     }
 
     /// Ends the connection; later calls raise.

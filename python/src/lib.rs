@@ -5,7 +5,9 @@
 
 mod api;
 mod arrays;
+mod backend;
 mod batch;
+mod call;
 mod client;
 mod errors;
 mod local;

@@ -86,7 +86,7 @@ impl Backend for Local {
 
     fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()> {
         let mut request = AdminRequest::new(AdminOp::Remove);
-        request.id = id;
+        request.object = id;
         self.admin(py, &request, &[], Some("id")).map(|_| ())
     }
 

@@ -11,8 +11,8 @@ use gjkd_client::{MAX_PIECES, Mesh};
 use gjkd_proto::Pose;
 use nalgebra::Point3;
 
-use crate::api::{Backend, checked_pose};
 use crate::arrays::{points, slice};
+use crate::backend::{Backend, checked_pose};
 use crate::errors::invalid;
 use crate::shape::{Pieces, Registration, Shape, ShapeKind};
 

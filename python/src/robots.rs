@@ -11,8 +11,9 @@ use pyo3::types::PyDict;
 use gjkd_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle, Steps};
 use nalgebra::Isometry3;
 
-use crate::api::checked_pose;
 use crate::arrays::{f64_array, slice};
+use crate::backend::checked_pose;
+use crate::call::RustCall;
 use crate::errors::{self, Kind, Raise, invalid};
 use crate::shape::isometry;
 
@@ -362,7 +363,7 @@ impl Text {
 /// Registers a robot on `client` (GIL released while its meshes load and
 /// its links register).
 pub fn register_robot(
-    client: &mut crate::client::Client,
+    client: &mut impl RustCall,
     py: Python<'_>,
     name: &str,
     source: &RobotSource,
@@ -397,7 +398,7 @@ pub fn register_robot(
 
 /// Finds a robot on the server by name, given its URDF text.
 pub fn open_robot(
-    client: &mut crate::client::Client,
+    client: &mut impl RustCall,
     py: Python<'_>,
     name: &str,
     urdf: &str,
@@ -416,7 +417,7 @@ pub fn open_robot(
 
 /// Sets `robot`'s joints (and base) in one round trip.
 pub fn set_joints(
-    client: &mut crate::client::Client,
+    client: &mut impl RustCall,
     py: Python<'_>,
     robot: &mut Robot,
     positions: &Bound<'_, PyAny>,

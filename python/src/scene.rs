@@ -11,6 +11,7 @@ use gjkd_proto::{PathMode, SceneKind, SceneRequest, scene_flags};
 
 use crate::arrays::{IdArray, Ids, PoseArray, Poses, f64_array, id_array, pose_array, slice};
 use crate::batch::Distances;
+use crate::call::RustCall;
 use crate::client::Client;
 use crate::errors::{self, invalid};
 use crate::robots::{Robot, path_steps};

@@ -1,6 +1,6 @@
-//! `gjkd.Shape`: a convex shape described in Python, and its two encodings,
-//! for the Rust client (`Geometry`) and for the wire registration that
-//! `gjkd.Local` hands to the server's own decoder.
+//! `gjkd.Shape`: a convex shape described in Python, as the protocol's
+//! shape table (`Geometry`) for the Rust client, and in its wire form
+//! (written by that same table) for `gjkd.Local`.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use numpy::PyArray2;
@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAnyMethods, PyList};
 
 use gjkd_client::{Geometry, MAX_NAME_LEN, MAX_PIECES, Piece};
-use gjkd_proto::{AdminOp, AdminRequest, PieceDesc, Pose, Vertex, piece_kind, shape_kind};
+use gjkd_proto::{AdminOp, AdminRequest, Pose, Vertex, cuboid_corners};
 
 use crate::arrays::{point, points, pose};
 use crate::errors::invalid;
@@ -222,55 +222,15 @@ impl Shape {
         }
     }
 
-    /// Appends the vertices in the order the Rust client sends them (the
-    /// `gjk` constructors' order), so that `gjkd.Local` builds the very
-    /// shape the server builds.
+    /// Appends the vertices the shape is the hull of, in the order the
+    /// wire carries them (the `gjk` constructors' order).
     fn push_vertices(&self, out: &mut Vec<Point3<f64>>) {
         match &self.kind {
             ShapeKind::Sphere { .. } => out.push(Point3::origin()),
             ShapeKind::Capsule { a, b, .. } => out.extend([*a, *b]),
-            ShapeKind::Box { half: h, .. } => out.extend((0..8).map(|i| {
-                Point3::new(
-                    if i & 1 == 0 { -h.x } else { h.x },
-                    if i & 2 == 0 { -h.y } else { h.y },
-                    if i & 4 == 0 { -h.z } else { h.z },
-                )
-            })),
+            ShapeKind::Box { half, .. } => out.extend(cuboid_corners(half)),
             ShapeKind::Cylinder { .. } => {}
             ShapeKind::Polytope { vertices, .. } => out.extend_from_slice(vertices),
-        }
-    }
-
-    /// This shape's piece of a wire registration, its vertices appended to
-    /// `vertices`.
-    fn piece_desc(&self, offset: Pose, vertices: &mut Vec<Vertex>) -> PieceDesc {
-        if let ShapeKind::Cylinder {
-            disk,
-            half_height,
-            radius,
-        } = self.kind
-        {
-            // The wire's cylinder: one vertex holding its dimensions.
-            vertices.push(Vertex {
-                x: disk,
-                y: half_height,
-                z: 0.0,
-            });
-            return PieceDesc {
-                offset,
-                radius,
-                vertex_count: 1,
-                reserved: piece_kind::CYLINDER,
-            };
-        }
-        let mut points = Vec::new();
-        self.push_vertices(&mut points);
-        vertices.extend(points.iter().map(|&p| Vertex::from(p)));
-        PieceDesc {
-            offset,
-            radius: self.radius(),
-            vertex_count: u32::try_from(points.len()).unwrap_or(u32::MAX),
-            reserved: 0,
         }
     }
 }
@@ -369,25 +329,17 @@ pub fn wire_registration(
         ));
     }
     let mut vertices = Vec::new();
-    match what {
-        Registration::Convex(shape) => {
-            request.shape = shape_kind::CONVEX;
-            request.piece_count = 1;
-            request.pieces[0] = shape.piece_desc(Pose::IDENTITY, &mut vertices);
+    let pieces;
+    let geometry = match what {
+        Registration::Convex(shape) => shape.geometry(),
+        Registration::Compound(list) => {
+            pieces = list.client_pieces();
+            Geometry::Compound(&pieces)
         }
-        Registration::Compound(pieces) => {
-            request.shape = shape_kind::COMPOUND;
-            request.piece_count = pieces.shapes.len() as u32;
-            for ((desc, shape), offset) in request
-                .pieces
-                .iter_mut()
-                .zip(&pieces.shapes)
-                .zip(&pieces.offsets)
-            {
-                *desc = shape.piece_desc(*offset, &mut vertices);
-            }
-        }
-    }
+    };
+    geometry
+        .encode(&mut request, &mut vertices)
+        .map_err(|e| invalid(py, "shape", None, e.to_string()))?;
     Ok((request, vertices))
 }
 

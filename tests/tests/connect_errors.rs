@@ -59,6 +59,34 @@ fn a_server_of_another_protocol_version_is_named() {
 }
 
 #[test]
+fn a_server_of_an_older_protocol_version_is_named() {
+    // What a client of this version meets on a host still running the
+    // release before it (the first typed protocol replaced version 1).
+    let service = unique_service("older-version");
+    let theirs = PROTOCOL_VERSION - 1;
+    let node = node();
+    let old_admin = admin_service_name(&service)
+        .replace(&format!("/v{PROTOCOL_VERSION}/"), &format!("/v{theirs}/"));
+    let _old = node
+        .service_builder(&ServiceName::new(&old_admin).unwrap())
+        .request_response::<u64, u64>()
+        .create()
+        .expect("older version's admin service");
+
+    let (result, waited) = connect(&service);
+    match result {
+        Err(ClientError::VersionMismatch { server, client, .. }) => {
+            assert_eq!((server, client), (theirs, PROTOCOL_VERSION));
+        }
+        other => panic!("expected VersionMismatch, got {:?}", other.map(|_| ())),
+    }
+    assert!(
+        waited < CONNECT_TIMEOUT,
+        "a version mismatch is final ({waited:?})"
+    );
+}
+
+#[test]
 fn a_service_with_other_message_types_is_incompatible() {
     let service = unique_service("other-types");
     let node = node();

@@ -323,7 +323,7 @@ mod tests {
     fn attach_text(s: &mut State, text: &str, who: u128) -> Result<u64, ErrorCode> {
         let mut req = AdminRequest::new(AdminOp::AttachRobot);
         req.set_name("two");
-        req.id = text.len() as u64;
+        req.text_len = text.len() as u32;
         let reply = s.handle_admin(who, &req, &pack_text(text));
         match reply.error_code() {
             ErrorCode::Ok => Ok(reply.id),
@@ -498,7 +498,7 @@ mod tests {
         // Text that does not unpack.
         let mut req = AdminRequest::new(AdminOp::AttachRobot);
         req.set_name("two");
-        req.id = 5;
+        req.text_len = 5;
         assert_eq!(
             s.handle_admin(CLIENT, &req, &pack_text(URDF)).error_code(),
             ErrorCode::Malformed

@@ -345,7 +345,7 @@ pub(crate) mod test_support {
         req.shape = shape_kind::CONVEX;
         req.piece_count = 1;
         req.pieces[0].vertex_count = 1;
-        req.pieces[0].radius = 0.5;
+        req.pieces[0].rounding = 0.5;
         assert!(req.set_name(name));
         let reply = s.handle_admin(owner, &req, &[Vertex::default()]);
         assert_eq!(reply.error_code(), ErrorCode::Ok);

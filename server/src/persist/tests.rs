@@ -215,8 +215,8 @@ fn a_retried_registration_gets_the_stored_object_across_a_restart() {
     req.shape = shape_kind::CONVEX;
     req.piece_count = 1;
     req.pieces[0].vertex_count = 1;
-    req.pieces[0].radius = 0.5;
-    req.id = 0xfeed;
+    req.pieces[0].rounding = 0.5;
+    req.token = 0xfeed;
     let v = [Vertex::default()];
     let first = s.handle_admin(1, &req, &v);
     assert_eq!(first.error_code(), ErrorCode::Ok);
@@ -235,14 +235,14 @@ fn a_retried_registration_gets_the_stored_object_across_a_restart() {
     assert_ne!(other.id, first.id);
     // The same token for another shape is a client bug.
     let mut changed = req;
-    changed.pieces[0].radius = 0.75;
+    changed.pieces[0].rounding = 0.75;
     assert_eq!(
         r.handle_admin(1, &changed, &v).error_code(),
         ErrorCode::Malformed
     );
     // Token 0 is no token: two objects.
     let mut plain = req;
-    plain.id = 0;
+    plain.token = 0;
     let (p1, p2) = (r.handle_admin(1, &plain, &v), r.handle_admin(1, &plain, &v));
     assert_ne!(p1.id, p2.id);
     // Removed: the token is forgotten with the object, on disk too.

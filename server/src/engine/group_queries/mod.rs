@@ -17,7 +17,7 @@
 //! reg.shape = shape_kind::CONVEX;
 //! reg.piece_count = 1;
 //! reg.pieces[0].vertex_count = 1;
-//! reg.pieces[0].radius = 0.5;
+//! reg.pieces[0].rounding = 0.5;
 //! let ball = state.handle_admin(1, &reg, &[Vertex::default()]).id;
 //! for x in [3.0, 5.0] {
 //!     state.handle_admin(1, &reg, &[Vertex { x, y: 0.0, z: 0.0 }]);

@@ -49,10 +49,12 @@ impl State {
                 .and_then(|new| {
                     let max = self.limits.max_objects;
                     self.store
-                        .register(new, Owner::Client(requester), max, request.id)
+                        .register(new, Owner::Client(requester), max, request.token)
                 }),
-            Some(AdminOp::Remove) => self.remove(request.id, requester).map(|()| request.id),
-            Some(AdminOp::Lookup) => match (request.name(), request.shape) {
+            Some(AdminOp::Remove) => self
+                .remove(request.object, requester)
+                .map(|()| request.object),
+            Some(AdminOp::Lookup) => match (request.name(), request.lookup) {
                 (Some(name), gjkd_proto::lookup_kind::OBJECT) => {
                     self.lookup(name).ok_or(ErrorCode::UnknownName)
                 }
@@ -88,7 +90,8 @@ impl State {
             .filter(|n| !n.is_empty())
             .ok_or(ErrorCode::Malformed)?
             .to_owned();
-        let text = gjkd_proto::unpack_text(text, request.id).ok_or(ErrorCode::Malformed)?;
+        let text = gjkd_proto::unpack_text(text, u64::from(request.text_len))
+            .ok_or(ErrorCode::Malformed)?;
         let (urdf, srdf) = match text.split_once('\0') {
             Some((urdf, srdf)) => (urdf, Some(srdf)),
             None => (text.as_str(), None),

@@ -133,19 +133,20 @@ mod tests {
     use nalgebra::Vector3;
     use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
-    /// A cylinder registration: one piece of kind `CYLINDER` whose one
-    /// vertex holds `(r, h, z)`.
-    fn cylinder_request(r: f64, h: f64, z: f64, rounding: f64) -> (AdminRequest, [Vertex; 1]) {
+    /// A cylinder registration: one piece of kind `CYLINDER` of radius
+    /// `r` and half-height `h`, with no vertices.
+    fn cylinder_request(r: f64, h: f64, rounding: f64) -> (AdminRequest, [Vertex; 0]) {
         let mut req = AdminRequest::new(AdminOp::Register);
         req.shape = shape_kind::CONVEX;
         req.piece_count = 1;
         req.pieces[0] = PieceDesc {
-            offset: Pose::IDENTITY,
-            radius: rounding,
-            vertex_count: 1,
-            reserved: piece_kind::CYLINDER,
+            kind: piece_kind::CYLINDER,
+            rounding,
+            cylinder_radius: r,
+            half_height: h,
+            ..PieceDesc::default()
         };
-        (req, [Vertex { x: r, y: h, z }])
+        (req, [])
     }
 
     /// Beside the curved face the distance to a ball is
@@ -154,12 +155,13 @@ mod tests {
     #[test]
     fn cylinders_register_and_answer_exactly() {
         let mut s = state();
-        let (req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
+        let (req, v) = cylinder_request(0.5, 1.0, 0.0);
         let reply = s.handle_admin(1, &req, &v);
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         let can = ObjectId::from_raw(reply.id);
-        let mut ball = cylinder_request(0.0, 0.0, 0.0, 0.25).0;
-        ball.pieces[0].reserved = piece_kind::HULL;
+        let mut ball = cylinder_request(0.0, 0.0, 0.25).0;
+        ball.pieces[0].kind = piece_kind::HULL;
+        ball.pieces[0].vertex_count = 1;
         let ball = s.handle_admin(1, &ball, &[Vertex::default()]);
         assert_eq!(ball.error_code(), ErrorCode::Ok);
         let ball = ObjectId::from_raw(ball.id);
@@ -185,7 +187,7 @@ mod tests {
         pair.pieces[0] = req.pieces[0];
         pair.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(5.0, 0.0, 0.0));
         pair.pieces[1].vertex_count = 1;
-        let verts = [v[0], Vertex::default()];
+        let verts = [Vertex::default()];
         let reply = s.handle_admin(1, &pair, &verts);
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         let Shape::Compound(c) = &s.object(reply.id).expect("stored").shape else {
@@ -206,41 +208,44 @@ mod tests {
         let before = s.stats().objects;
         let huge = 4e300;
         let cases = [
-            ((-0.5, 1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((0.5, -1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((f64::NAN, 1.0, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((0.5, f64::NAN, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((0.5, f64::INFINITY, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((0.5, 1.0, 0.0, -0.1), ErrorCode::InvalidRadius),
-            ((0.5, 1.0, 0.0, f64::NAN), ErrorCode::InvalidRadius),
-            ((huge, huge, 0.0, 0.0), ErrorCode::InvalidRadius),
-            ((0.5, 1.0, 1.0, 0.0), ErrorCode::Malformed),
-            ((0.5, 1.0, f64::NAN, 0.0), ErrorCode::Malformed),
+            ((-0.5, 1.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, -1.0, 0.0), ErrorCode::InvalidRadius),
+            ((f64::NAN, 1.0, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, f64::NAN, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, f64::INFINITY, 0.0), ErrorCode::InvalidRadius),
+            ((0.5, 1.0, -0.1), ErrorCode::InvalidRadius),
+            ((0.5, 1.0, f64::NAN), ErrorCode::InvalidRadius),
+            ((huge, huge, 0.0), ErrorCode::InvalidRadius),
         ];
-        for ((r, h, z, rounding), want) in cases {
-            let (req, v) = cylinder_request(r, h, z, rounding);
+        for ((r, h, rounding), want) in cases {
+            let (req, v) = cylinder_request(r, h, rounding);
             assert_eq!(
                 s.handle_admin(1, &req, &v).error_code(),
                 want,
-                "{r} {h} {z}"
+                "{r} {h} {rounding}"
             );
         }
-        // One vertex, no more, no less.
-        let (mut req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
-        let two = [v[0], v[0]];
-        req.pieces[0].vertex_count = 2;
-        assert_eq!(
-            s.handle_admin(1, &req, &two).error_code(),
-            ErrorCode::Malformed
-        );
-        req.pieces[0].vertex_count = 0;
-        assert_eq!(
-            s.handle_admin(1, &req, &[]).error_code(),
-            ErrorCode::Malformed
-        );
+        // A cylinder has no vertices: one or two sent with it, counted or
+        // not, are malformed.
+        let (mut req, _) = cylinder_request(0.5, 1.0, 0.0);
+        let one_vertex = [Vertex {
+            x: 0.5,
+            y: 1.0,
+            z: 0.0,
+        }];
+        let two = [one_vertex[0], one_vertex[0]];
+        for (count, sent) in [(1, &one_vertex[..]), (2, &two[..]), (0, &one_vertex[..])] {
+            req.pieces[0].vertex_count = count;
+            assert_eq!(
+                s.handle_admin(1, &req, sent).error_code(),
+                ErrorCode::Malformed,
+                "{count} counted, {} sent",
+                sent.len()
+            );
+        }
         // A piece kind from the future is malformed, in a compound too.
-        let (mut req, v) = cylinder_request(0.5, 1.0, 0.0, 0.0);
-        req.pieces[0].reserved = 2;
+        let (mut req, v) = cylinder_request(0.5, 1.0, 0.0);
+        req.pieces[0].kind = 3;
         assert_eq!(
             s.handle_admin(1, &req, &v).error_code(),
             ErrorCode::Malformed
@@ -251,16 +256,13 @@ mod tests {
             ErrorCode::Malformed
         );
         // A compound whose cylinder piece is bad, or sits too far away.
-        req.pieces[0].reserved = piece_kind::CYLINDER;
-        let bad = [Vertex {
-            x: -1.0,
-            y: 1.0,
-            z: 0.0,
-        }];
+        req.pieces[0].kind = piece_kind::CYLINDER;
+        req.pieces[0].cylinder_radius = -1.0;
         assert_eq!(
-            s.handle_admin(1, &req, &bad).error_code(),
+            s.handle_admin(1, &req, &v).error_code(),
             ErrorCode::InvalidRadius
         );
+        req.pieces[0].cylinder_radius = 0.5;
         req.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(6e300, 0.0, 0.0));
         assert_eq!(
             s.handle_admin(1, &req, &v).error_code(),
@@ -406,9 +408,9 @@ mod tests {
         };
         assert_eq!(code(&mut s, &req, &[]), ErrorCode::EmptyVertices);
         req.pieces[0].vertex_count = 1;
-        req.pieces[0].radius = -1.0;
+        req.pieces[0].rounding = -1.0;
         assert_eq!(code(&mut s, &req, &[v]), ErrorCode::InvalidRadius);
-        req.pieces[0].radius = 0.5;
+        req.pieces[0].rounding = 0.5;
         let nan = Vertex { x: f64::NAN, ..v };
         assert_eq!(code(&mut s, &req, &[nan]), ErrorCode::NonFiniteVertex);
         assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::Malformed);
@@ -438,7 +440,7 @@ mod tests {
         assert!(lookup.set_name("dumbbell"));
         assert_eq!(s.handle_admin(5, &lookup, &[]).id, reply.id);
         let mut remove = AdminRequest::new(AdminOp::Remove);
-        remove.id = reply.id;
+        remove.object = reply.id;
         assert_eq!(code(&mut s, &remove, &[]), ErrorCode::Ok);
         assert_eq!(
             s.handle_admin(5, &lookup, &[]).error_code(),
@@ -479,7 +481,7 @@ mod tests {
             let item = Item::distance(a, ghost, &QueryOptions::default());
             assert_eq!(one(&mut s, 1, item).error_code(), ErrorCode::UnknownObject);
             let mut rm = AdminRequest::new(AdminOp::Remove);
-            rm.id = raw;
+            rm.object = raw;
             assert_eq!(
                 s.handle_admin(1, &rm, &[]).error_code(),
                 ErrorCode::UnknownObject
@@ -493,7 +495,7 @@ mod tests {
             AdminOp::Lookup,
         ] {
             let mut req = AdminRequest::new(op);
-            req.id = a.raw();
+            req.object = a.raw();
             assert_eq!(
                 s.handle_admin(1, &req, &v).error_code(),
                 ErrorCode::Malformed,
@@ -508,7 +510,7 @@ mod tests {
         reg.shape = shape_kind::CONVEX;
         reg.piece_count = 1;
         reg.pieces[0].vertex_count = 1;
-        reg.pieces[0].reserved = 3; // a piece kind from the future
+        reg.pieces[0].kind = 3; // a piece kind from the future
         assert_eq!(
             s.handle_admin(1, &reg, &v).error_code(),
             ErrorCode::Malformed
@@ -518,7 +520,7 @@ mod tests {
             s.handle_admin(1, &reg, &v).error_code(),
             ErrorCode::Malformed
         );
-        reg.pieces[0].reserved = 0;
+        reg.pieces[0].kind = piece_kind::HULL;
         assert_eq!(s.handle_admin(1, &reg, &v).error_code(), ErrorCode::Ok);
         // Quaternions: zero and NaN; registration poses as well as items.
         reg.pose.rotation = [0.0; 4];
@@ -577,7 +579,7 @@ mod tests {
         req.shape = shape_kind::CONVEX;
         req.piece_count = 1;
         req.pieces[0].vertex_count = 4;
-        req.pieces[0].radius = 6.4000000000000006e100;
+        req.pieces[0].rounding = 6.4000000000000006e100;
         let v = |x: f64, y: f64, z: f64| Vertex { x, y, z };
         let a = s.handle_admin(
             1,
@@ -589,7 +591,7 @@ mod tests {
                 v(6.1875, 9.9e100, 9.9e100),
             ],
         );
-        req.pieces[0].radius = 0.0;
+        req.pieces[0].rounding = 0.0;
         let b = s.handle_admin(
             1,
             &req,

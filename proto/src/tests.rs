@@ -1,0 +1,114 @@
+//! Unit tests of the wire types.
+
+use crate::*;
+use nalgebra::{Isometry3, Vector3};
+
+#[test]
+fn names_carry_the_version() {
+    assert_eq!(query_service_name("gjkd"), "gjkd/v2/query");
+    assert_eq!(admin_service_name("x"), "x/v2/admin");
+    assert_eq!(wake_service_name("x"), "x/v2/wake");
+}
+
+#[test]
+fn error_codes_round_trip() {
+    for (i, c) in ErrorCode::ALL.iter().enumerate() {
+        assert_eq!(c.raw() as usize, i);
+        assert_eq!(ErrorCode::from_raw(c.raw()), Some(*c));
+    }
+    assert_eq!(ErrorCode::from_raw(ErrorCode::ALL.len() as u32), None);
+}
+
+#[test]
+fn pose_round_trips_bit_for_bit() {
+    let iso = Isometry3::new(
+        Vector3::new(1.25, -3.5, 1e-300),
+        Vector3::new(0.3, -1.2, 2.0),
+    );
+    let back = Pose::from_isometry(&iso).to_isometry_unchecked();
+    assert_eq!(back, iso);
+}
+
+#[test]
+fn item_encodes_options() {
+    let o = QueryOptions {
+        tolerance: 1e-9,
+        max_iterations: 7,
+        margin: Some(0.5),
+        warm_start: false,
+        precision: Precision::Single,
+    };
+    let it = Item::distance(ObjectId::from_raw(3), ObjectId::from_raw(4), &o);
+    assert_eq!(it.options(), o);
+    assert_eq!(it.item_kind(), Some(ItemKind::Distance));
+    assert_eq!(it.flags & item_flags::WARM_START, 0);
+    assert_eq!(
+        it.flags & item_flags::SINGLE_PRECISION,
+        item_flags::SINGLE_PRECISION
+    );
+    let d = Item::distance(
+        ObjectId::from_raw(3),
+        ObjectId::from_raw(4),
+        &QueryOptions::default(),
+    );
+    assert_eq!(d.flags & item_flags::SINGLE_PRECISION, 0);
+    assert_eq!(d.options().precision, Precision::Double);
+}
+
+#[test]
+fn names_are_bounded_and_checked() {
+    let mut r = AdminRequest::new(AdminOp::Lookup);
+    assert!(r.set_name("ball"));
+    assert_eq!(r.name(), Some("ball"));
+    assert!(!r.set_name(&"x".repeat(MAX_NAME_LEN + 1)));
+    r.name_len = 1000;
+    assert_eq!(r.name(), None);
+    r.name_len = 2;
+    r.name[0] = 0xff;
+    assert_eq!(r.name(), None);
+}
+
+#[test]
+fn joint_items_carry_their_positions() {
+    let q = [0.5, -1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
+    let robot = ObjectId::from_raw(9);
+    let base = Isometry3::translation(1.0, 2.0, 3.0);
+    let it = Item::set_joints(robot, 2, &q, Some(&base), true);
+    assert_eq!(it.item_kind(), Some(ItemKind::SetJoints));
+    assert_eq!(it.joint_positions(), Some((q, 9)));
+    assert_eq!((it.a, it.b), (9, 2));
+    assert_eq!(it.flags, item_flags::POSE_A | item_flags::CLAMP);
+    assert_eq!(it.pose_a, Pose::from_isometry(&base));
+    let short = Item::set_joints(robot, 0, &[1.5], None, false);
+    assert_eq!(
+        short.joint_positions().map(|(v, n)| (v[0], n)),
+        Some((1.5, 1))
+    );
+    assert_eq!(short.flags, 0);
+    let mut bad = short;
+    bad.max_iterations = 10;
+    assert_eq!(bad.joint_positions(), None);
+}
+
+#[test]
+fn text_round_trips_through_vertices() {
+    for text in ["", "a", &"<robot name=\"é\"/>".repeat(5), &"x".repeat(48)] {
+        let packed = pack_text(text);
+        assert_eq!(packed.len(), text.len().div_ceil(24));
+        assert_eq!(
+            unpack_text(&packed, text.len() as u64).as_deref(),
+            Some(text)
+        );
+    }
+    let packed = pack_text("hello");
+    assert_eq!(unpack_text(&packed, 4), None, "non-zero padding");
+    assert_eq!(unpack_text(&packed, 30), None, "too few vertices");
+}
+
+#[test]
+fn wire_sizes_are_stable() {
+    assert_eq!(std::mem::size_of::<Pose>(), 56);
+    assert_eq!(std::mem::size_of::<Item>(), 160);
+    assert_eq!(std::mem::size_of::<ItemResult>(), 128);
+    assert_eq!(std::mem::size_of::<Vertex>(), 24);
+}

@@ -42,20 +42,17 @@ fn ipc<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> BenchError {
     move |e| BenchError::Other(format!("iceoryx2 {what}: {e:?}"))
 }
 
+/// The floor's request-response service.
+type RawService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [Item],
+    (),
+    [ItemResult],
+    (),
+>;
+
 /// The request-response service of the floor, opened or created.
-fn service(
-    node: &Node<ipc::Service>,
-    name: &str,
-) -> Result<
-    iceoryx2::service::port_factory::request_response::PortFactory<
-        ipc::Service,
-        [Item],
-        (),
-        [ItemResult],
-        (),
-    >,
-    BenchError,
-> {
+fn service(node: &Node<ipc::Service>, name: &str) -> Result<RawService, BenchError> {
     let name = ServiceName::new(name).map_err(ipc("service name"))?;
     node.service_builder(&name)
         .request_response::<[Item], [ItemResult]>()

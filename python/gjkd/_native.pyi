@@ -24,7 +24,9 @@ __all__ = [
     "SceneSummary",
     "Shape",
     "error_codes",
+    "pin_thread",
     "serve",
+    "set_realtime_priority",
 ]
 
 DEFAULT_TOLERANCE: float

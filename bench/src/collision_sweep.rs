@@ -5,7 +5,7 @@
 //! - **cold per-pair**: the demo's sweep, every step's five queries cold, in
 //!   as few batches as the server's batch limit allows (also with the
 //!   margin's early exit, which is all the question needs);
-//! - **path request**: one scene request ([`SceneKind::Within`], margin 0,
+//! - **path request**: one scene request ([`SceneKind::Within`](gjkd_proto::SceneKind::Within), margin 0,
 //!   [`PathMode::EveryStep`]) carrying every step's pose, the server
 //!   carrying warm starts and motion bounds from step to step; and the same
 //!   with [`PathMode::FirstHit`], which stops at the first step that hits.

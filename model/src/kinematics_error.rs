@@ -59,7 +59,7 @@ pub enum KinematicsError {
     },
     /// A mimic joint follows a fixed joint or (through a chain) itself; or
     /// its multiplier or offset is not finite. (One naming a joint that does
-    /// not exist moves on its own, see [`Kinematics::warnings`].)
+    /// not exist moves on its own, see [`Kinematics::warnings`](crate::Kinematics::warnings).)
     #[error("joint `{joint}` cannot mimic `{leader}`: {reason}")]
     BadMimic {
         /// The mimic joint.

@@ -22,12 +22,12 @@ pub enum AdminOp {
     /// Attach a robot's kinematics, named [`AdminRequest::name`], to the
     /// objects already registered as its links (named `<robot>/<link>`; a
     /// link with no such object has no shape and only carries its
-    /// children). The slice payload is text packed by [`pack_text`]: the
+    /// children). The slice payload is text packed by [`pack_text`](crate::pack_text): the
     /// URDF, optionally followed by a NUL byte and an SRDF whose
     /// `disable_collisions` pairs (with the adjacent links) the server keeps
     /// as the robot's allowed pairs. [`AdminRequest::text_len`] is the
     /// text's length in bytes. The reply's id is the robot's id, for
-    /// [`ItemKind::SetJoints`]; attaching a name again replaces the robot.
+    /// [`ItemKind::SetJoints`](crate::ItemKind::SetJoints); attaching a name again replaces the robot.
     AttachRobot = 6,
 }
 
@@ -181,7 +181,7 @@ impl WaitMode {
 #[repr(C)]
 #[type_name("gjkd.v2.ServerInfo")]
 pub struct ServerInfo {
-    /// [`PROTOCOL_VERSION`] of the server.
+    /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION) of the server.
     pub protocol: u32,
     /// [`WaitMode`] wire value.
     pub wait: u32,

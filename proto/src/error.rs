@@ -4,7 +4,7 @@ use std::fmt;
 
 /// What went wrong with one item or one request.
 ///
-/// `Ok` is 0, so an all-zero [`ItemResult`] (its `Default`) reads as a
+/// `Ok` is 0, so an all-zero [`ItemResult`](crate::ItemResult) (its `Default`) reads as a
 /// successful pose update: trust only results the server wrote. The client's
 /// `query_batch` overwrites one result per item it sends and leaves the rest
 /// of the buffer alone.
@@ -47,7 +47,7 @@ pub enum ErrorCode {
     /// The object was loaded from the server's scene file: anyone may move
     /// it (set its pose), nobody may remove it.
     ReadOnly = 12,
-    /// A compound has more pieces than [`MAX_PIECES`].
+    /// A compound has more pieces than [`MAX_PIECES`](crate::MAX_PIECES).
     TooManyPieces = 13,
     /// A compound has no pieces.
     EmptyCompound = 14,
@@ -69,7 +69,7 @@ pub enum ErrorCode {
     /// server restart.
     StorageFull = 20,
     /// A joint position is outside its joint's limits (and the item did not
-    /// ask for clamping, [`item_flags::CLAMP`]).
+    /// ask for clamping, [`item_flags::CLAMP`](crate::item_flags::CLAMP)).
     OutOfLimits = 21,
     /// A robot's URDF is malformed, or its links do not form one tree of
     /// fixed, revolute, continuous and prismatic joints.

@@ -20,7 +20,7 @@ pub enum ItemKind {
     /// them. See [`Item::set_joints`] for the layout.
     SetJoints = 3,
     /// Scene requests only: object `a` is a member of the request's group
-    /// (when [`SceneRequest::group`] is 0).
+    /// (when [`SceneRequest::group`](crate::SceneRequest::group) is 0).
     Member = 4,
     /// Scene requests only: the pair `a`, `b` is never reported (an allowed
     /// pair, on top of a robot's own).
@@ -84,7 +84,7 @@ pub struct QueryOptions {
     /// Iteration cap, at least 1 (default [`DEFAULT_MAX_ITERATIONS`]).
     pub max_iterations: u32,
     /// Early exit: stop as soon as the distance is proved greater than this
-    /// margin ([`Status::Farther`]) or at most it ([`Status::Closer`]).
+    /// margin ([`Status::Farther`](crate::Status::Farther)) or at most it ([`Status::Closer`](crate::Status::Closer)).
     pub margin: Option<f64>,
     /// Start from the simplex the server kept for this pair after this
     /// client's previous query of it (default on). Changes only the time,
@@ -132,7 +132,7 @@ impl QueryOptions {
 }
 
 /// One item of a query request: a pose update or a pair query. A request is a
-/// slice of items, answered by a slice of [`ItemResult`]s of the same length,
+/// slice of items, answered by a slice of [`ItemResult`](crate::ItemResult)s of the same length,
 /// in the same order; items are applied in order, so a pose update affects
 /// the queries after it in the same batch.
 ///

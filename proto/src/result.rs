@@ -25,7 +25,7 @@ pub enum Status {
     /// last certified interval widened by how far either object can have
     /// moved since; the interval holds, the distance and points are the last
     /// answer's carried with the objects (see
-    /// [`scene_flags::MOTION_BOUNDS`]).
+    /// [`scene_flags::MOTION_BOUNDS`](crate::scene_flags::MOTION_BOUNDS)).
     Bounded = 6,
 }
 
@@ -58,7 +58,7 @@ pub mod result_flags {
     pub const BACKUP_USED: u32 = 1 << 1;
 }
 
-/// The answer to one [`Item`]. For a pose update only `error` is meaningful.
+/// The answer to one [`Item`](crate::Item). For a pose update only `error` is meaningful.
 ///
 /// Read it with [`ItemResult::answer`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]

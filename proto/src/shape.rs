@@ -34,7 +34,7 @@ impl From<Vertex> for Point3<f64> {
     }
 }
 
-/// Values of [`AdminRequest::shape`].
+/// Values of [`AdminRequest::shape`](crate::AdminRequest::shape).
 pub mod shape_kind {
     /// One convex piece: `pieces[0]` describes it (its offset is ignored).
     pub const CONVEX: u32 = 1;

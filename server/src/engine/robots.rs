@@ -80,7 +80,7 @@ impl Robots {
 
     /// Drops the robots attached by clients for which `alive` is false, and
     /// returns how many: their link objects go with their client (see
-    /// [`State::remove_departed`]), so their kinematics would only move
+    /// [`State::remove_departed`](crate::engine::State::remove_departed)), so their kinematics would only move
     /// nothing while holding their names.
     pub fn drop_departed(&mut self, alive: impl Fn(u128) -> bool) -> usize {
         let before = self.by_id.len();

@@ -1,7 +1,7 @@
 //! Registration tokens: what makes a registration safe to retry.
 //!
 //! A client puts a token of its choosing (random, not 0) into a
-//! registration ([`gjkd_proto::AdminRequest::id`]). The server remembers,
+//! registration ([`gjkd_proto::AdminRequest::token`]). The server remembers,
 //! for each owner, the tokens of its last [`TOKENS_PER_OWNER`]
 //! registrations with the ids they got, in the same database transaction
 //! as the object ([`crate::persist::database`]), so a retry of a registration whose

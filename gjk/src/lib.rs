@@ -29,11 +29,8 @@
 
 #![warn(missing_docs)]
 
-mod blocks;
-mod cones;
-mod cylinder;
-mod dd;
 mod johnson;
+mod numeric;
 mod overlap;
 mod query;
 mod separation;

@@ -16,7 +16,7 @@
 use nalgebra::Vector3;
 
 use super::pair::{ConvexPair, rotate, rotate_back};
-use crate::cylinder;
+use crate::shape::cylinder;
 
 /// How near the rim (as a share of the radius) a projection may come and
 /// still be seeded from the cap: nearer, the answer is on the rim, and the
@@ -106,7 +106,7 @@ mod tests {
     use super::super::numerical_algorithm::RunOutcome;
     use super::super::pair::{ConvexPair, PiecePlacement};
     use crate::johnson::Simplex;
-    use crate::shape::tests::Rng;
+    use crate::shape::test_rng::Rng;
     use crate::{Convex, Options, Precision};
 
     /// The pair of `a` at the identity and `b` at `pose`.

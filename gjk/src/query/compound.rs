@@ -8,7 +8,8 @@ use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::warm_start::PieceSimplex;
 use super::{Answer, Query, Status, WarmStart};
 use crate::johnson::Simplex;
-use crate::shape::{Convex, robust_norm};
+use crate::numeric::robust_norm;
+use crate::shape::Convex;
 
 /// A certified lower bound on the distance between piece `convex_a` placed
 /// by `offset_a` and piece `convex_b` placed by `placed_b`, both in A's body
@@ -347,7 +348,7 @@ fn order_by_sphere_gap(query: &Query<'_>, rel: &Isometry3<f64>, order: &mut [Can
         for piece_a in 0..a.piece_count() {
             let convex_a = a.convex_piece(piece_a).expect("index below piece_count");
             let centre_a = a.piece_centre(piece_a).expect("index below piece_count");
-            let gap = crate::shape::robust_norm(&(centre_b - centre_a))
+            let gap = crate::numeric::robust_norm(&(centre_b - centre_a))
                 - (convex_a.size() + convex_a.radius())
                 - (convex_b.size() + convex_b.radius());
             if let Some(entry) = slot.next() {

@@ -29,7 +29,7 @@ use nalgebra::Vector3;
 
 use super::newton_seed::{Kinks, Solve};
 use super::pair::ConvexPair;
-use crate::cylinder;
+use crate::shape::cylinder;
 
 /// What a warm start names as one shape's part of the answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -37,9 +37,9 @@ use nalgebra::Vector3;
 
 use super::feature_seed::Feature;
 use super::pair::{ConvexPair, rotate, rotate_back};
-use crate::cylinder;
 use crate::johnson::{Vertex, triangle_weights};
 use crate::shape::Convex;
+use crate::shape::cylinder;
 
 /// A seed: the simplex the run starts from (up to three points of `K`,
 /// and how many), and a lower bound on the core distance (scaled; 0 when
@@ -1221,7 +1221,7 @@ mod tests {
     use super::super::pair::{ConvexPair, PiecePlacement};
     use super::{Seeding, turn_triangle};
     use crate::johnson::{Simplex, Vertex};
-    use crate::shape::tests::Rng;
+    use crate::shape::test_rng::Rng;
     use crate::{Convex, Options, Precision};
 
     /// The run of `a` at the identity against `b` at `pose`, seeded or

@@ -61,7 +61,7 @@ pub(super) fn exact_centroid_gap(
     centroid_a: &Point3<f64>,
     centroid_b: &Point3<f64>,
 ) -> Vector3<f64> {
-    let gap = crate::dd::centroid_gap(
+    let gap = crate::numeric::dd::centroid_gap(
         (place_a.pose, place_a.offset),
         centroid_a,
         (place_b.pose, place_b.offset),
@@ -139,7 +139,7 @@ impl<'s> ConvexPair<'s> {
         let (scale, inv_scale) = if largest > 5.4e-20 && largest < 1.8e19 {
             (1.0, 1.0)
         } else {
-            crate::shape::pow2_scale(largest)
+            crate::numeric::pow2_scale(largest)
         };
         let centroid_gap = centroid_gap * scale;
         let size_bound = (a.size() + b.size()) * scale + centroid_gap.norm();
@@ -149,7 +149,7 @@ impl<'s> ConvexPair<'s> {
         // support value of K = A - B may be missed by this times |v|.
         let single_slack = if single_precision {
             let f32_size = |c: &Convex| if c.has_single() { c.size() } else { 0.0 };
-            crate::shape::SINGLE_SLACK * (f32_size(a) + f32_size(b)) * scale
+            crate::shape::polytope::single::SINGLE_SLACK * (f32_size(a) + f32_size(b)) * scale
         } else {
             0.0
         };
@@ -164,7 +164,7 @@ impl<'s> ConvexPair<'s> {
             size_bound
                 + norm_a * scale
                 + norm_b * scale
-                + crate::shape::robust_norm(&rel.translation.vector) * scale
+                + crate::numeric::robust_norm(&rel.translation.vector) * scale
         };
         let slack = 64.0 * f64::EPSILON * magnitude;
         ConvexPair {

@@ -79,30 +79,16 @@ pub(super) fn search_compound<const AVX2: bool>(
     search_compound_base(simplex, query, rel, warm)
 }
 
-/// [`search_compound_body`] for any CPU.
-#[inline(never)]
-pub(super) fn search_compound_base(
-    simplex: &mut Simplex,
-    query: &Query<'_>,
-    rel: &Isometry3<f64>,
-    warm: Option<&WarmStart>,
-) -> (Answer, f64) {
-    search_compound_body::<false>(simplex, query, rel, warm)
-}
-
-/// [`search_compound_body`] compiled for AVX2 and FMA (see
-/// [`distance_avx2`](super::distance_avx2)); out of line, so that the convex
-/// pair's path around its call stays as it was.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-#[inline(never)]
-pub(super) fn search_compound_avx2(
-    simplex: &mut Simplex,
-    query: &Query<'_>,
-    rel: &Isometry3<f64>,
-    warm: Option<&WarmStart>,
-) -> (Answer, f64) {
-    search_compound_body::<true>(simplex, query, rel, warm)
+cpu_forms! { entry
+    /// [`search_compound_body`] for any CPU; the AVX2 form out of line too,
+    /// so that the convex pair's path around its call stays as it was.
+    #[inline(never)]
+    pub(super) fn search_compound_base / search_compound_avx2 (
+        simplex: &mut Simplex,
+        query: &Query<'_>,
+        rel: &Isometry3<f64>,
+        warm: Option<&WarmStart>
+    ) -> (Answer, f64) => search_compound_body
 }
 
 /// A piece pair to visit: its sphere gap (a rough lower bound on its

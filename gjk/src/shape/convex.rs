@@ -20,6 +20,7 @@ use super::polytope::{SupportKind, SupportSearch};
 use super::reach::MAX_REACH;
 use crate::Error;
 use crate::numeric::robust_norm;
+use crate::support_map::{SeedForm, SupportMap};
 
 /// A convex object: the convex hull of a vertex set, grown by a radius `r >= 0`
 /// (the paper's r-spherical extension, Section 2).
@@ -386,6 +387,47 @@ impl Convex {
 }
 
 /// The documented bound on a shape's reach holds with its radius counted.
+impl SupportMap for Convex {
+    #[inline(always)]
+    fn local_support(&self, dir: &Vector3<f64>) -> (usize, Vector3<f64>) {
+        self.support_point(dir)
+    }
+
+    #[inline(always)]
+    fn local_point(&self, index: usize) -> Vector3<f64> {
+        self.point(index)
+    }
+
+    #[inline(always)]
+    fn centre(&self) -> Point3<f64> {
+        self.centroid
+    }
+
+    #[inline(always)]
+    fn rounding(&self) -> f64 {
+        self.radius
+    }
+
+    #[inline(always)]
+    fn local_support_single(&self, dir: &Vector3<f64>) -> (usize, Vector3<f64>) {
+        self.support_point_single(dir)
+    }
+
+    #[inline(always)]
+    fn seed_form(&self) -> Option<SeedForm> {
+        match self.kind {
+            SupportKind::Cylinder {
+                radius,
+                half_height,
+            } => Some(SeedForm::Cylinder {
+                radius,
+                half_height,
+            }),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use nalgebra::Isometry3;

@@ -70,8 +70,6 @@ pub mod stats;
 #[cfg(feature = "measure")]
 pub mod tradeoff;
 #[cfg(feature = "measure")]
-mod tradeoff_by_size;
-#[cfg(feature = "measure")]
 pub mod uds;
 
 #[cfg(feature = "measure")]

@@ -29,15 +29,15 @@
 
 #![warn(missing_docs)]
 
-mod blocks;
-mod cones;
-mod cylinder;
-mod dd;
+#[macro_use]
+mod cpu;
 mod johnson;
+mod numeric;
 mod overlap;
 mod query;
 mod separation;
 mod shape;
+mod support_map;
 
 pub use overlap::penetration_bound;
 #[doc(hidden)]
@@ -45,30 +45,10 @@ pub use query::distance_in_baseline;
 pub use query::{Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_in};
 pub use separation::separation_bound;
 pub use shape::{Compound, Convex, Shape};
+pub use support_map::{DifferencePoint, SeedForm, SupportMap, SupportPoint, support_of_difference};
 
-/// Whether this CPU has AVX2 and FMA, what every vector path of the crate
-/// needs: detected once, then one load. The standard macro's own cache costs
-/// two checks and a frame around its first-call path at every call.
 #[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) fn has_avx2_fma() -> bool {
-    use std::sync::atomic::{AtomicU8, Ordering};
-    /// 0: not yet known, 1: no, 2: yes.
-    static KNOWN: AtomicU8 = AtomicU8::new(0);
-    #[cold]
-    #[inline(never)]
-    fn detect() -> bool {
-        let yes = std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma");
-        KNOWN.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
-        yes
-    }
-    match KNOWN.load(Ordering::Relaxed) {
-        2 => true,
-        1 => false,
-        _ => detect(),
-    }
-}
+pub(crate) use cpu::has_avx2_fma;
 
 /// What can be wrong with the input. Every query and constructor reports bad
 /// input with one of these; none panics and none returns NaN.

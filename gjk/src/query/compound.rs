@@ -8,7 +8,8 @@ use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::warm_start::PieceSimplex;
 use super::{Answer, Query, Status, WarmStart};
 use crate::johnson::Simplex;
-use crate::shape::{Convex, robust_norm};
+use crate::numeric::robust_norm;
+use crate::shape::Convex;
 
 /// A certified lower bound on the distance between piece `convex_a` placed
 /// by `offset_a` and piece `convex_b` placed by `placed_b`, both in A's body
@@ -78,30 +79,16 @@ pub(super) fn search_compound<const AVX2: bool>(
     search_compound_base(simplex, query, rel, warm)
 }
 
-/// [`search_compound_body`] for any CPU.
-#[inline(never)]
-pub(super) fn search_compound_base(
-    simplex: &mut Simplex,
-    query: &Query<'_>,
-    rel: &Isometry3<f64>,
-    warm: Option<&WarmStart>,
-) -> (Answer, f64) {
-    search_compound_body::<false>(simplex, query, rel, warm)
-}
-
-/// [`search_compound_body`] compiled for AVX2 and FMA (see
-/// [`distance_avx2`](super::distance_avx2)); out of line, so that the convex
-/// pair's path around its call stays as it was.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-#[inline(never)]
-pub(super) fn search_compound_avx2(
-    simplex: &mut Simplex,
-    query: &Query<'_>,
-    rel: &Isometry3<f64>,
-    warm: Option<&WarmStart>,
-) -> (Answer, f64) {
-    search_compound_body::<true>(simplex, query, rel, warm)
+cpu_forms! { entry
+    /// [`search_compound_body`] for any CPU; the AVX2 form out of line too,
+    /// so that the convex pair's path around its call stays as it was.
+    #[inline(never)]
+    pub(super) fn search_compound_base / search_compound_avx2 (
+        simplex: &mut Simplex,
+        query: &Query<'_>,
+        rel: &Isometry3<f64>,
+        warm: Option<&WarmStart>
+    ) -> (Answer, f64) => search_compound_body
 }
 
 /// A piece pair to visit: its sphere gap (a rough lower bound on its
@@ -347,7 +334,7 @@ fn order_by_sphere_gap(query: &Query<'_>, rel: &Isometry3<f64>, order: &mut [Can
         for piece_a in 0..a.piece_count() {
             let convex_a = a.convex_piece(piece_a).expect("index below piece_count");
             let centre_a = a.piece_centre(piece_a).expect("index below piece_count");
-            let gap = crate::shape::robust_norm(&(centre_b - centre_a))
+            let gap = crate::numeric::robust_norm(&(centre_b - centre_a))
                 - (convex_a.size() + convex_a.radius())
                 - (convex_b.size() + convex_b.radius());
             if let Some(entry) = slot.next() {

@@ -2,16 +2,14 @@
 //! pair's relative frame, with certified bounds, margins and warm start.
 
 mod answer;
-mod cap_seed;
 mod compound;
-mod feature_seed;
 mod full_step;
-mod newton_seed;
 mod numerical_algorithm;
 mod options;
 mod pair;
 mod penetration;
 mod recovery;
+mod seed;
 mod warm_start;
 
 use std::cell::Cell;
@@ -195,22 +193,15 @@ impl<'q> Query<'q> {
     }
 }
 
-/// [`distance_body`] for any CPU, out of line, so that [`distance_in`] stays
-/// a few instructions of dispatch with no frame of its own.
-#[inline(never)]
-fn distance_base(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
-    distance_body::<false>(workspace, query)
-}
-
-/// [`distance_body`] compiled for AVX2 and FMA: the same operations, each
-/// rounded the same way (Rust never fuses a multiply and an add on its own,
-/// and `mul_add` is exact either way), so the same answer bit for bit, in
-/// fewer instructions (three-operand forms, wider moves), hence in less
-/// time.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn distance_avx2(workspace: &mut Workspace, query: &Query<'_>) -> Result<Answer, Error> {
-    distance_body::<true>(workspace, query)
+cpu_forms! { entry
+    /// [`distance_body`] for any CPU, out of line, so that [`distance_in`]
+    /// stays a few instructions of dispatch with no frame of its own; its
+    /// AVX2 form is `distance_avx2` (see [`crate::cpu`]).
+    #[inline(never)]
+    fn distance_base / distance_avx2 (
+        workspace: &mut Workspace,
+        query: &Query<'_>
+    ) -> Result<Answer, Error> => distance_body
 }
 
 /// The body of [`distance_in`], inlined into each of its compiled forms;

@@ -1,8 +1,8 @@
 //! The paper's Numerical Algorithm (Section 6), steps (1) to (6), on one
 //! convex pair.
 
-use super::newton_seed::{Certificate, Seeding};
 use super::pair::ConvexPair;
+use super::seed::{Certificate, Seeding};
 use super::{Options, Status};
 use crate::johnson::{Simplex, Solution, Vertex};
 

@@ -6,6 +6,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use super::Precision;
 use crate::johnson::Vertex;
 use crate::shape::Convex;
+use crate::support_map::SupportMap;
 
 /// Two convex pieces in the frame of A's piece, origin at A's centroid: the
 /// quantities that do not change during one query.
@@ -34,7 +35,7 @@ pub(super) struct ConvexPair<'s> {
     /// distance times `scale`: 0 in f64.
     pub(super) single_slack: f64,
     /// The iteration after which the run is seeded by Newton's method on
-    /// the nearest points' direction (see `newton_seed`): never (`u32::MAX`)
+    /// the nearest points' direction (see `seed`): never (`u32::MAX`)
     /// unless a piece is a cylinder.
     pub(super) seed_after: u32,
 }
@@ -61,7 +62,7 @@ pub(super) fn exact_centroid_gap(
     centroid_a: &Point3<f64>,
     centroid_b: &Point3<f64>,
 ) -> Vector3<f64> {
-    let gap = crate::dd::centroid_gap(
+    let gap = crate::numeric::dd::centroid_gap(
         (place_a.pose, place_a.offset),
         centroid_a,
         (place_b.pose, place_b.offset),
@@ -139,7 +140,7 @@ impl<'s> ConvexPair<'s> {
         let (scale, inv_scale) = if largest > 5.4e-20 && largest < 1.8e19 {
             (1.0, 1.0)
         } else {
-            crate::shape::pow2_scale(largest)
+            crate::numeric::pow2_scale(largest)
         };
         let centroid_gap = centroid_gap * scale;
         let size_bound = (a.size() + b.size()) * scale + centroid_gap.norm();
@@ -149,7 +150,7 @@ impl<'s> ConvexPair<'s> {
         // support value of K = A - B may be missed by this times |v|.
         let single_slack = if single_precision {
             let f32_size = |c: &Convex| if c.has_single() { c.size() } else { 0.0 };
-            crate::shape::SINGLE_SLACK * (f32_size(a) + f32_size(b)) * scale
+            crate::shape::polytope::single::SINGLE_SLACK * (f32_size(a) + f32_size(b)) * scale
         } else {
             0.0
         };
@@ -164,7 +165,7 @@ impl<'s> ConvexPair<'s> {
             size_bound
                 + norm_a * scale
                 + norm_b * scale
-                + crate::shape::robust_norm(&rel.translation.vector) * scale
+                + crate::numeric::robust_norm(&rel.translation.vector) * scale
         };
         let slack = 64.0 * f64::EPSILON * magnitude;
         ConvexPair {
@@ -180,7 +181,7 @@ impl<'s> ConvexPair<'s> {
             inv_scale,
             single_precision,
             single_slack,
-            seed_after: match (a.cylinder_dimensions(), b.cylinder_dimensions()) {
+            seed_after: match (a.seed_form(), b.seed_form()) {
                 (Some(_), Some(_)) => 1,
                 (Some(_), None) | (None, Some(_)) => COLD_SEED_AFTER,
                 (None, None) => u32::MAX,
@@ -194,7 +195,7 @@ impl<'s> ConvexPair<'s> {
     /// terms are small vectors relative to their centroids.
     #[inline(always)]
     pub(super) fn difference_vertex(&self, ia: usize, ib: usize) -> Vertex {
-        self.difference_of((ia, self.a.point(ia)), (ib, self.b.point(ib)))
+        self.difference_of((ia, self.a.local_point(ia)), (ib, self.b.local_point(ib)))
     }
 
     /// `y = z1 - z2` for A's point `za` (index `ia`) and B's point `zb`
@@ -227,11 +228,11 @@ impl<'s> ConvexPair<'s> {
         let eta_b = -rotate_back(&self.rotation, eta);
         let (a, b) = if self.single_precision {
             (
-                self.a.support_point_single(eta),
-                self.b.support_point_single(&eta_b),
+                self.a.local_support_single(eta),
+                self.b.local_support_single(&eta_b),
             )
         } else {
-            (self.a.support_point(eta), self.b.support_point(&eta_b))
+            (self.a.local_support(eta), self.b.local_support(&eta_b))
         };
         self.difference_of(a, b)
     }

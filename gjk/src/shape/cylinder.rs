@@ -121,7 +121,7 @@ pub(crate) fn point(code: u32, r: f64, h: f64) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::tests::Rng;
+    use crate::shape::test_rng::Rng;
 
     /// The support value of a code's point reaches the exact one,
     /// `h·|d_z| + r·|d_xy|`, to a few ε, for random, axis, tiny and huge

@@ -217,7 +217,7 @@ pub(crate) fn first_max<const FUSED: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::tests::Rng;
+    use crate::shape::test_rng::Rng;
 
     /// The full scan's choice: the first index of the largest dot product.
     fn full(xs: &[f64], ys: &[f64], zs: &[f64], d: &Vector3<f64>, fused: bool) -> usize {

@@ -2,7 +2,7 @@
 //!
 //! Where the nearest point of a cylinder lies inside one of its caps, the
 //! answer's direction is the cap's axis, where the rim's curvature
-//! `r / |u_xy|` is unbounded: Newton's steps (see `newton_seed`) cannot
+//! `r / |u_xy|` is unbounded: Newton's steps (see `seed`) cannot
 //! converge there, and the plain run closes in on the disk one rim point an
 //! iteration. The cap needs no iteration: along the axis the other shape's
 //! support point `q` is known, and when `q` lies beyond the cap's plane and
@@ -15,8 +15,8 @@
 
 use nalgebra::Vector3;
 
-use super::pair::{ConvexPair, rotate, rotate_back};
-use crate::cylinder;
+use crate::query::pair::{ConvexPair, rotate, rotate_back};
+use crate::shape::cylinder;
 
 /// How near the rim (as a share of the radius) a projection may come and
 /// still be seeded from the cap: nearer, the answer is on the rim, and the
@@ -103,10 +103,10 @@ fn cap_triangle(q: &Vector3<f64>, side: f64, r: f64, h: f64) -> Option<[u32; 3]>
 mod tests {
     use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
-    use super::super::numerical_algorithm::RunOutcome;
-    use super::super::pair::{ConvexPair, PiecePlacement};
     use crate::johnson::Simplex;
-    use crate::shape::tests::Rng;
+    use crate::query::numerical_algorithm::RunOutcome;
+    use crate::query::pair::{ConvexPair, PiecePlacement};
+    use crate::shape::test_rng::Rng;
     use crate::{Convex, Options, Precision};
 
     /// The pair of `a` at the identity and `b` at `pose`.

@@ -15,7 +15,8 @@
 
 use nalgebra::Vector3;
 
-use crate::shape::{robust_norm, scan_top};
+use super::scan::scan_top;
+use crate::numeric::robust_norm;
 
 /// Vertices per block: a multiple of the AVX2 scan's eight lanes, near the
 /// square root of the set's size, so that bounding every block costs about
@@ -259,7 +260,7 @@ impl Blocks {
             // SAFETY: the caller's CPU has AVX2 and FMA (this function's
             // own requirement).
             let (top, i) = unsafe {
-                crate::shape::scan_avx2_top(
+                crate::shape::polytope::scan_avx2::scan_avx2_top(
                     &self.xs[r.clone()],
                     &self.ys[r.clone()],
                     &self.zs[r],
@@ -328,7 +329,7 @@ fn split(pts: &mut [([f64; 3], u32)], block: usize) {
 mod tests {
     use super::*;
     use crate::Convex;
-    use crate::shape::tests::Rng;
+    use crate::shape::test_rng::Rng;
     use nalgebra::Point3;
 
     /// The shape's vertices in the plain scan's layout, unpadded.
@@ -342,7 +343,7 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         if avx2 {
             // SAFETY: callers pass avx2 only when the CPU has AVX2 and FMA.
-            return unsafe { crate::shape::scan_avx2_top(xs, ys, zs, d).1 };
+            return unsafe { crate::shape::polytope::scan_avx2::scan_avx2_top(xs, ys, zs, d).1 };
         }
         let _ = avx2;
         scan_top(xs, ys, zs, d).1

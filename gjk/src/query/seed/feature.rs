@@ -3,7 +3,7 @@
 //!
 //! Where the features of a pair's answer are known (a cylinder's rim on
 //! one cap or its side, a polytope's vertex or edge), the separation on a
-//! unit direction `u` (see `newton_seed`) is a closed form. A rim of radius
+//! unit direction `u` (see `seed`) is a closed form. A rim of radius
 //! `r` about the unit axis `a` (pair frame) contributes `-r·√(1 - (a·u)²)`
 //! and its cap `∓h·(a·u)`; a polytope's vertex `p`, `±u·p`; a held side
 //! its radius, a constant, on the circle of directions across its axis;
@@ -27,9 +27,9 @@
 
 use nalgebra::Vector3;
 
-use super::newton_seed::{Kinks, Solve};
-use super::pair::ConvexPair;
-use crate::cylinder;
+use super::kinks::{Kinks, Solve};
+use crate::query::pair::ConvexPair;
+use crate::shape::cylinder;
 
 /// What a warm start names as one shape's part of the answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,7 +54,7 @@ pub(super) enum Feature {
 /// the sphere of directions is not tried: nearer, the rim's curvature
 /// `r / sin` outgrows the steps' model (two rims are then solved on their
 /// angles, see `rim_pair_newton`, and a cap may hold the answer, see
-/// `cap_seed`).
+/// `seed::cap`).
 const RIM_FLOOR: f64 = 0.05;
 
 /// Newton steps before the closed form is given up: from a warm start a

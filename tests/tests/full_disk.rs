@@ -69,22 +69,37 @@ fn free_bytes(dir: &Path) -> u64 {
     st.f_bavail as u64 * st.f_frsize as u64
 }
 
+/// A tmpfs of `size` with a block-mode server keeping its store there, or
+/// `None` (said on stderr) where no tmpfs can be mounted. The server is
+/// second in the pair so that, bound in this order, it stops before the
+/// tmpfs is unmounted.
+fn serve_on_tmpfs(size: &str, name: &str) -> Option<(Tmpfs, Server)> {
+    let Some(tmpfs) = Tmpfs::mount(size) else {
+        eprintln!("cannot mount a tmpfs (not root?): nothing checked");
+        return None;
+    };
+    let store = tmpfs.0.join("objects");
+    let server = Server::start(
+        name,
+        &[
+            "--wait",
+            "block",
+            "--state-file",
+            store.to_str().expect("utf-8"),
+        ],
+    );
+    Some((tmpfs, server))
+}
+
 fn storage_full<T>(r: &Result<T, ClientError>) -> bool {
     matches!(r, Err(ClientError::Rejected(ErrorCode::StorageFull)))
 }
 
 #[test]
 fn a_full_disk_refuses_changes_serves_the_rest_and_recovers_without_restart() {
-    let Some(tmpfs) = Tmpfs::mount("2m") else {
-        eprintln!("cannot mount a tmpfs (not root?): nothing checked");
+    let Some((tmpfs, mut server)) = serve_on_tmpfs("2m", "full-disk") else {
         return;
     };
-    let store = tmpfs.0.join("objects");
-    let store_arg = store.to_str().expect("utf-8").to_owned();
-    let mut server = Server::start(
-        "full-disk",
-        &["--wait", "block", "--state-file", &store_arg],
-    );
     let mut client = server.client(Duration::from_secs(5));
     let a = client.register_sphere(0.5).expect("a");
     let b = client
@@ -153,16 +168,9 @@ fn a_full_disk_refuses_changes_serves_the_rest_and_recovers_without_restart() {
 /// journal.)
 #[test]
 fn a_server_starts_on_a_disk_too_small_for_a_new_store() {
-    let Some(tmpfs) = Tmpfs::mount("64k") else {
-        eprintln!("cannot mount a tmpfs (not root?): nothing checked");
+    let Some((tmpfs, mut server)) = serve_on_tmpfs("64k", "small-disk") else {
         return;
     };
-    let store = tmpfs.0.join("objects");
-    let store_arg = store.to_str().expect("utf-8").to_owned();
-    let mut server = Server::start(
-        "small-disk",
-        &["--wait", "block", "--state-file", &store_arg],
-    );
     let mut client = server.client(Duration::from_secs(5));
     assert_eq!(client.stats().expect("served").objects, 0);
     let mut refused = false;

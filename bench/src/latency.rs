@@ -798,7 +798,17 @@ fn measure_condition(
     let label = condition.label();
     for round in 0..rounds {
         probe(probes);
-        for &t in &plan.transports {
+        // Each round starts with the next transport: a server started right
+        // after another one stopped (its shared memory cleaned up, the
+        // competitors' scheduling history reset) is not always the same one.
+        let n = plan.transports.len();
+        for &t in plan
+            .transports
+            .iter()
+            .cycle()
+            .skip(round % n.max(1))
+            .take(n)
+        {
             progress.step(format!(
                 "{label}, round {}/{rounds}, {}: starting",
                 round + 1,

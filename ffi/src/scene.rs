@@ -61,6 +61,10 @@ pub struct gjkd_scene_options {
     pub motion_bounds: bool,
     /// Within: every pair of the scene, not only group against the rest.
     pub all_pairs: bool,
+    /// Within (and within paths): the group's members against each other
+    /// too, but the allowed pairs (a robot's self-collisions). Refused with
+    /// other questions.
+    pub self_pairs: bool,
     /// Clamp joint positions outside their limits instead of refusing.
     pub clamp: bool,
 }
@@ -78,6 +82,7 @@ impl Default for gjkd_scene_options {
             warm_start: true,
             motion_bounds: true,
             all_pairs: false,
+            self_pairs: false,
             clamp: false,
         }
     }
@@ -206,6 +211,7 @@ impl<'a> Call<'a> {
             (options.warm_start, scene_flags::WARM_START),
             (options.motion_bounds, scene_flags::MOTION_BOUNDS),
             (options.all_pairs, scene_flags::ALL_PAIRS),
+            (options.self_pairs, scene_flags::SELF_PAIRS),
             (options.precision == 1, scene_flags::SINGLE_PRECISION),
             (options.use_cutoff, scene_flags::CUTOFF),
             (options.clamp, scene_flags::CLAMP),

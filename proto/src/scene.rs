@@ -111,8 +111,14 @@ pub mod scene_flags {
     /// Clamp joint positions outside their limits instead of refusing the
     /// request, as [`item_flags::CLAMP`](crate::item_flags::CLAMP).
     pub const CLAMP: u32 = 1 << 5;
+    /// [`SceneKind::Within`](super::SceneKind::Within) only: the group
+    /// against the rest and its members against each other, but the
+    /// allowed pairs (for a robot: its self-collisions, without the SRDF's
+    /// disabled pairs and adjacent links). Refused with other kinds.
+    pub const SELF_PAIRS: u32 = 1 << 6;
     /// Every bit this version knows; others are refused as malformed.
-    pub const ALL: u32 = WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP;
+    pub const ALL: u32 =
+        WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP | SELF_PAIRS;
 }
 
 /// Bits of [`SceneReply::flags`].

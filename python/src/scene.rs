@@ -534,8 +534,10 @@ impl Client {
 
     /// Every pair, `group` against the rest (or all against all with
     /// `all_pairs=True`), whose distance is at most `margin`, into `out`.
-    /// Other arguments as `clearance`.
-    #[pyo3(signature = (group, margin, *, out, all_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    /// With `self_pairs=True`, also the group's members against each other
+    /// but the allowed pairs (a robot's self-collisions: not its adjacent
+    /// links nor the SRDF's disabled pairs). Other arguments as `clearance`.
+    #[pyo3(signature = (group, margin, *, out, all_pairs=false, self_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn within<'py>(
         &mut self,
@@ -544,6 +546,7 @@ impl Client {
         margin: f64,
         out: &Bound<'py, SceneRows>,
         all_pairs: bool,
+        self_pairs: bool,
         allow: Option<&Bound<'py, PyAny>>,
         tolerance: f64,
         max_iterations: u32,
@@ -566,6 +569,9 @@ impl Client {
             r.margin = margin;
             if all_pairs {
                 r.flags |= scene_flags::ALL_PAIRS;
+            }
+            if self_pairs {
+                r.flags |= scene_flags::SELF_PAIRS;
             }
         };
         ask(
@@ -634,8 +640,9 @@ impl Client {
     /// clearance at every step), `"within"` (the pairs within `margin` at
     /// every step) or `"first_hit"` (only the first step with a pair within
     /// `margin`, its index in the summary's `first_hit`). Rows carry their
-    /// step in `out.step`. Other arguments as `clearance`.
-    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    /// step in `out.step`. `self_pairs` (`"within"` and `"first_hit"` only)
+    /// as `within`. Other arguments as `clearance`.
+    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn path<'py>(
         &mut self,
@@ -646,6 +653,7 @@ impl Client {
         out: &Bound<'py, SceneRows>,
         question: &str,
         margin: f64,
+        self_pairs: bool,
         allow: Option<&Bound<'py, PyAny>>,
         cutoff: Option<f64>,
         tolerance: f64,
@@ -680,6 +688,9 @@ impl Client {
             if kind == SceneKind::Within {
                 r.margin = margin;
             }
+            if self_pairs {
+                r.flags |= scene_flags::SELF_PAIRS;
+            }
         };
         let path = PathArg::Poses(mode, moving, poses);
         ask(py, self, kind, group, allow, path, &options, edit, out)
@@ -695,7 +706,7 @@ impl Client {
     /// to the nearest limit; a NaN raises (`NON_FINITE_POSE`). `group` is
     /// usually the robot (`robot.id`, or the `Robot` itself, so that its
     /// allowed pairs apply). Other arguments as `path`.
-    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn path_joints<'py>(
         &mut self,
@@ -706,6 +717,7 @@ impl Client {
         out: &Bound<'py, SceneRows>,
         question: &str,
         margin: f64,
+        self_pairs: bool,
         clamp: bool,
         allow: Option<&Bound<'py, PyAny>>,
         cutoff: Option<f64>,
@@ -746,6 +758,9 @@ impl Client {
         let edit = |r: &mut SceneRequest| {
             if kind == SceneKind::Within {
                 r.margin = margin;
+            }
+            if self_pairs {
+                r.flags |= scene_flags::SELF_PAIRS;
             }
         };
         let path = PathArg::Joints(mode, steps);

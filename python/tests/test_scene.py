@@ -196,3 +196,54 @@ def test_path_along_joint_positions_refuses_bad_positions(client: gjkd.Client, p
     assert e.value.field == "question"
     with pytest.raises(TypeError):
         client.path_joints(robot, robot.id, [[0.0]], out=rows)  # type: ignore[arg-type]
+
+
+# Two balls of radius 0.1 joined by a bar: l0 at the origin, l2 at the end
+# of a second 1 m segment that folds back over the first about j2.
+FOLD = """<robot name="fold">
+  <link name="l0"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+  <link name="l1"><collision><origin xyz="0.5 0 0"/>
+    <geometry><box size="0.8 0.05 0.05"/></geometry></collision></link>
+  <link name="l2"><collision><origin xyz="1 0 0"/>
+    <geometry><sphere radius="0.1"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/>
+    <axis xyz="0 0 1"/><limit lower="-3.1" upper="3.1" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3.1" upper="3.1" effort="1" velocity="1"/></joint>
+</robot>"""
+
+
+def folded(theta: float) -> float:
+    """Closed form: l2's centre is at (1 + cos θ, sin θ), 2|cos(θ/2)| from
+    l0's; both balls have radius 0.1."""
+    return 2.0 * abs(np.cos(theta / 2.0)) - 0.2
+
+
+def test_self_pairs_report_a_robots_own_collisions(client: gjkd.Client) -> None:
+    robot = client.register_robot(unique_service("fold"), urdf_text=FOLD)
+    l0, l2 = robot.link("l0"), robot.link("l2")
+    rows = gjkd.SceneRows(8)
+    margin = 0.1
+    for theta in [0.0, 2.5, 2.9, -3.0]:
+        client.set_joints(robot, [0.0, theta])
+        own = client.within(robot, margin, out=rows, self_pairs=True)
+        pairs = {tuple(sorted((int(rows.a[k]), int(rows.b[k])))) for k in range(own.written)}
+        d = max(folded(theta), 0.0)  # overlapping balls are at distance 0
+        # l1 touches both balls but is adjacent to them: never reported.
+        assert pairs == ({tuple(sorted((l0, l2)))} if d <= margin else set()), theta
+        if pairs:
+            assert rows.lower[0] <= d <= rows.upper[0]
+        assert client.within(robot, margin, out=rows).written == 0
+    steps = np.array([[0.0, t] for t in [0.0, 1.0, 2.0, 2.9, 3.0]])
+    assert folded(2.0) > margin >= folded(2.9)
+    hit = client.path_joints(
+        robot, robot, steps, out=rows, question="first_hit", margin=margin, self_pairs=True
+    )
+    assert hit.first_hit == 3
+    assert {int(rows.a[0]), int(rows.b[0])} == {l0, l2}
+    assert rows.lower[0] <= folded(2.9) <= rows.upper[0]
+    # Only within questions have self pairs.
+    with pytest.raises(gjkd.Error) as e:
+        client.path_joints(robot, robot, steps, out=rows, self_pairs=True)
+    assert e.value.code == gjkd.ErrorCode.MALFORMED

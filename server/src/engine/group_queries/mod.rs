@@ -61,6 +61,7 @@ use groups::Group;
 use pair::Ctx;
 use path::{RobotOverlay, item_poses};
 use rows::Rows;
+use within::Partners;
 
 use crate::engine::state::State;
 
@@ -74,6 +75,8 @@ pub(crate) struct Question {
     /// [`scene_flags::CUTOFF`].
     pub cutoff: bool,
     all_pairs: bool,
+    /// [`scene_flags::SELF_PAIRS`].
+    self_pairs: bool,
     /// [`scene_flags::MOTION_BOUNDS`].
     pub motion: bool,
     /// [`scene_flags::WARM_START`].
@@ -143,13 +146,16 @@ impl GroupQueries {
 ///
 /// # Errors
 /// [`ErrorCode::Malformed`] for an unknown kind, path mode or flag, a
-/// first-hit path of another kind than within; [`ErrorCode::InvalidOptions`]
+/// first-hit path or the group's own pairs asked of another kind than
+/// within; [`ErrorCode::InvalidOptions`]
 /// for a margin, tolerance or accuracy that is not a finite number `>= 0`,
 /// no iterations, or `k = 0` for nearest.
 fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
     let kind = r.scene_kind().ok_or(ErrorCode::Malformed)?;
     let mode = r.path_mode().ok_or(ErrorCode::Malformed)?;
-    if r.flags & !scene_flags::ALL != 0 || (mode == PathMode::FirstHit && kind != SceneKind::Within)
+    if r.flags & !scene_flags::ALL != 0
+        || (mode == PathMode::FirstHit && kind != SceneKind::Within)
+        || (r.flags & scene_flags::SELF_PAIRS != 0 && kind != SceneKind::Within)
     {
         return Err(ErrorCode::Malformed);
     }
@@ -169,6 +175,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         margin: r.margin,
         cutoff: has(scene_flags::CUTOFF),
         all_pairs: has(scene_flags::ALL_PAIRS),
+        self_pairs: has(scene_flags::SELF_PAIRS),
         motion: has(scene_flags::MOTION_BOUNDS),
         warm: has(scene_flags::WARM_START),
         clamp: has(scene_flags::CLAMP),
@@ -422,7 +429,9 @@ impl State {
         let mut first_hit = u32::MAX;
         let (mut start, mut step) = (0, 0);
         for &end in &ends {
-            self.move_step(&plan[start..end], !members_only);
+            // Members meet each other only when asked for their own pairs;
+            // then the tree must follow them too.
+            self.move_step(&plan[start..end], !members_only || q.self_pairs);
             start = end;
             let (written, total) = (rows.written, rows.total);
             let moves = u32::try_from(end).unwrap_or(u32::MAX);
@@ -489,6 +498,13 @@ impl State {
         for (&m, look) in engine.group.members.iter().zip(&mut engine.lookahead) {
             hits += advance::within_along(&mut ctx, look, m, step, moves, rows);
         }
+        // The lookaheads hold against objects that stay put; the members'
+        // own pairs, both moving, are asked at every step.
+        if q.self_pairs {
+            for &m in &engine.group.members {
+                hits += within::within_of(&mut ctx, m, Partners::Members, step, rows);
+            }
+        }
         hits
     }
 
@@ -550,13 +566,18 @@ impl State {
             SceneKind::Within if q.all_pairs => {
                 for slot in 0..bp.slot_count() as u32 {
                     if bp.entry(slot).live {
-                        hits += within::within_of(&mut ctx, slot, true, step, rows);
+                        hits += within::within_of(&mut ctx, slot, Partners::All, step, rows);
                     }
                 }
             }
             SceneKind::Within => {
                 for &m in &group.members {
-                    hits += within::within_of(&mut ctx, m, false, step, rows);
+                    hits += within::within_of(&mut ctx, m, Partners::Rest, step, rows);
+                }
+                if q.self_pairs {
+                    for &m in &group.members {
+                        hits += within::within_of(&mut ctx, m, Partners::Members, step, rows);
+                    }
                 }
             }
             SceneKind::Nearest => {

@@ -203,6 +203,11 @@ fn bad_requests_get_their_codes_and_change_nothing() {
             ErrorCode::Malformed,
         ),
         (
+            with(&|r| r.flags |= scene_flags::SELF_PAIRS),
+            vec![good_move],
+            ErrorCode::Malformed,
+        ),
+        (
             with(&|_| {}),
             vec![good_move, Item::step()],
             ErrorCode::Malformed,
@@ -409,4 +414,107 @@ fn departed_clients_nearest_objects_are_forgotten() {
     let (_, again) = ask(&mut s, 2, &req, &[]);
     assert_eq!(again[0].b, second[0].b);
     assert_eq!(again[0].result.upper, second[0].result.upper);
+}
+
+/// The arm's pairs that are not allowed: l0 and l2 (l1 touches both), and
+/// each link with the obstacle.
+fn arm_pairs(links: &[u64], obstacle: u64) -> Vec<(u64, u64)> {
+    let mut pairs = vec![(links[0], links[2])];
+    pairs.extend(links.iter().map(|&l| (l, obstacle)));
+    pairs
+}
+
+#[test]
+fn self_pairs_add_the_groups_own_pairs_but_the_allowed_ones() {
+    let (mut s, robot, links, obstacle) = arm_state();
+    let margin = 0.05;
+    let mut own = SceneRequest::new(SceneKind::Within, robot);
+    own.margin = margin;
+    own.flags |= scene_flags::SELF_PAIRS;
+    let mut rest = own;
+    rest.flags &= !scene_flags::SELF_PAIRS;
+    let key = |a: u64, b: u64| (a.min(b), a.max(b));
+    let mut folded = 0;
+    // Straight, folded back over l0 both ways, and bent towards the
+    // obstacle: the reported pairs are those brute force finds within the
+    // margin, the arm's own ones only when asked for.
+    for q in [[0.0, 0.0], [0.0, 3.0], [0.0, -3.0], [0.6, 2.95], [0.8, 0.6]] {
+        let set = Item::set_joints(ObjectId::from_raw(robot), 0, &q, None, false);
+        let (_, with_own) = ask(&mut s, 1, &own, &[set]);
+        let (_, without) = ask(&mut s, 1, &rest, &[]);
+        check_within(&s, &with_own, &arm_pairs(&links, obstacle), margin);
+        let own_rows: Vec<_> = with_own.iter().map(|r| key(r.a, r.b)).collect();
+        let rest_rows: Vec<_> = without.iter().map(|r| key(r.a, r.b)).collect();
+        let self_row = key(links[0], links[2]);
+        assert!(!rest_rows.contains(&self_row), "{q:?}: {rest_rows:?}");
+        let expected: Vec<_> = own_rows
+            .iter()
+            .copied()
+            .filter(|&p| p != self_row)
+            .collect();
+        assert_eq!(rest_rows, expected, "{q:?}");
+        let e = exact(&s, links[0], links[2]);
+        if e.upper <= margin {
+            folded += 1;
+            assert!(own_rows.contains(&self_row), "{q:?}: {own_rows:?}");
+        }
+    }
+    assert!(
+        folded >= 2,
+        "the folded configurations must bring l2 onto l0"
+    );
+    // Along a path that folds the arm (the obstacle moved out of its way),
+    // the first hit is the first step at which l2 comes within the margin
+    // of l0 (brute force at each step).
+    let away = Item::set_pose(
+        ObjectId::from_raw(obstacle),
+        &Isometry3::translation(10.0, 0.0, 0.0),
+    );
+    ask(&mut s, 1, &rest, &[away]);
+    let mut path = Vec::new();
+    let mut first = None;
+    let kin = s.robots.get(robot).unwrap().kinematics.clone();
+    for i in 0..=30 {
+        let q = [0.0, 0.1 * f64::from(i)];
+        path.push(Item::set_joints(
+            ObjectId::from_raw(robot),
+            0,
+            &q,
+            None,
+            false,
+        ));
+        path.push(Item::step());
+        let fk = kin
+            .link_poses(&Isometry3::identity(), &q, gjkd_model::LimitMode::Reject)
+            .unwrap();
+        let (o0, o2) = (s.object(links[0]).unwrap(), s.object(links[2]).unwrap());
+        let d = gjk::distance(
+            &o0.shape,
+            &fk[0],
+            &o2.shape,
+            &fk[2],
+            &Default::default(),
+            None,
+        )
+        .unwrap();
+        if first.is_none() && d.upper <= margin {
+            first = Some(i);
+        }
+    }
+    let first = first.expect("the fold reaches l0");
+    let mut hit = own;
+    hit.path = PathMode::FirstHit as u32;
+    let (reply, rows) = ask(&mut s, 1, &hit, &path);
+    assert_eq!(reply.first_hit, first);
+    assert!(
+        rows.iter()
+            .any(|r| key(r.a, r.b) == key(links[0], links[2]))
+    );
+    hit.flags &= !scene_flags::SELF_PAIRS;
+    let (reply, _) = ask(&mut s, 1, &hit, &path);
+    assert_eq!(
+        reply.first_hit,
+        u32::MAX,
+        "without self pairs the fold is no hit"
+    );
 }

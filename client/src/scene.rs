@@ -366,10 +366,10 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
         self.flag(scene_flags::ALL_PAIRS, true)
     }
 
-    /// [`Client::within`] and within paths: the group's members against
-    /// each other too, but the allowed pairs (a robot's self-collisions,
-    /// without its adjacent links and the SRDF's disabled pairs). Other
-    /// questions are refused with it.
+    /// [`Client::within`] and [`Client::clearance`] (and their paths): the
+    /// group's members meet each other too, but the allowed pairs (a
+    /// robot's self-collisions, without its adjacent links and the SRDF's
+    /// disabled pairs). [`Client::nearest`] is refused with it.
     pub fn self_pairs(self) -> Self {
         self.flag(scene_flags::SELF_PAIRS, true)
     }

@@ -61,9 +61,9 @@ pub struct gjkd_scene_options {
     pub motion_bounds: bool,
     /// Within: every pair of the scene, not only group against the rest.
     pub all_pairs: bool,
-    /// Within (and within paths): the group's members against each other
-    /// too, but the allowed pairs (a robot's self-collisions). Refused with
-    /// other questions.
+    /// Within and clearance (and their paths): the group's members meet
+    /// each other too, but the allowed pairs (a robot's self-collisions).
+    /// Refused with nearest.
     pub self_pairs: bool,
     /// Clamp joint positions outside their limits instead of refusing.
     pub clamp: bool,

@@ -111,10 +111,12 @@ pub mod scene_flags {
     /// Clamp joint positions outside their limits instead of refusing the
     /// request, as [`item_flags::CLAMP`](crate::item_flags::CLAMP).
     pub const CLAMP: u32 = 1 << 5;
-    /// [`SceneKind::Within`](super::SceneKind::Within) only: the group
-    /// against the rest and its members against each other, but the
-    /// allowed pairs (for a robot: its self-collisions, without the SRDF's
-    /// disabled pairs and adjacent links). Refused with other kinds.
+    /// [`SceneKind::Within`](super::SceneKind::Within) and
+    /// [`SceneKind::Clearance`](super::SceneKind::Clearance): the group's
+    /// members meet each other too, but the allowed pairs (for a robot: its
+    /// self-collisions, without the SRDF's disabled pairs and adjacent
+    /// links); a clearance row's nearest object may then be another member.
+    /// Refused with nearest.
     pub const SELF_PAIRS: u32 = 1 << 6;
     /// Every bit this version knows; others are refused as malformed.
     pub const ALL: u32 =

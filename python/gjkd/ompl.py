@@ -72,9 +72,9 @@ __all__ = [
 _PathLike = Union[str, "os.PathLike[str]"]
 _F64 = npt.NDArray[np.float64]
 
-# Where the shadow copy of the robot waits between requests: far from any
-# scene a robot plans in, so that no other client's question meets it.
-_PARKED = [1.0e6, 1.0e6, 1.0e6, 0.0, 0.0, 0.0, 1.0]
+# Joint positions one item of a request carries (the protocol's
+# JOINTS_PER_ITEM): a step of a robot with more moving joints takes more.
+_JOINTS_PER_ITEM = 9
 
 
 def _read(path: Optional[_PathLike], text: Optional[str]) -> Optional[str]:
@@ -115,15 +115,14 @@ class RobotChecker:
     """A robot's state, motion and clearance checks against everything a
     gjkd server holds, one scene request per call.
 
-    Registers the robot (``name``) from its URDF, and a shadow copy
-    (``name + "~self"``) parked far away: a scene question pairs a group's
-    members with every object outside the group but never with each other,
-    so each request moves the shadow's links to the robot's poses too, and
-    the robot's links meet the shadow's wherever a self-collision pair is
-    not allowed (each such pair once; a link and its own shadow, and the
-    allowed pairs, are passed as allowed). :meth:`close` removes both
-    robots' links. The checker moves nothing on the server: other clients'
-    questions see the robot where its joints were last set.
+    Registers the robot (``name``) from its URDF. Each question is one
+    path request of joint positions (``Client.path_joints``): the server
+    places the links by forward kinematics and checks them against every
+    other object it holds and against each other (``self_pairs=True``: the
+    self-collisions, but the SRDF's disabled pairs and adjacent links).
+    :meth:`close` removes the robot's links. The checker moves nothing on
+    the server: other clients' questions see the robot where its joints
+    were last set.
 
     Args:
         client: a connected :class:`gjkd.Client`.
@@ -182,28 +181,18 @@ class RobotChecker:
         allowed = allowed_link_pairs(text, srdf_str)
         paths = list(package_path)
 
-        def register(robot_name: str, pose: Optional[npt.ArrayLike]) -> Robot:
-            # From the file when there is one: relative mesh paths are read
-            # next to it.
-            if urdf is not None:
-                return client.register_robot(
-                    robot_name, urdf, srdf_text=srdf_str, package_path=paths, base=pose
-                )
-            return client.register_robot(
-                robot_name, urdf_text=text, srdf_text=srdf_str, package_path=paths, base=pose
+        # From the file when there is one: relative mesh paths are read
+        # next to it.
+        if urdf is not None:
+            robot = client.register_robot(
+                name, urdf, srdf_text=srdf_str, package_path=paths, base=base
             )
-
-        robot = register(name, base)
-        try:
-            shadow = register(name + "~self", _PARKED)
-        except Error:
-            for i in robot.link_ids:
-                if i != 0:
-                    client.remove(int(i))
-            raise
+        else:
+            robot = client.register_robot(
+                name, urdf_text=text, srdf_text=srdf_str, package_path=paths, base=base
+            )
         self.client = client
         self.robot: Robot = robot
-        self.shadow: Robot = shadow
         self.margin = float(margin)
         self.resolution = float(resolution)
         self.error: Optional[BaseException] = None
@@ -218,10 +207,10 @@ class RobotChecker:
         self._plan_pairs(allowed)
         self._rows = SceneRows(256)
         info = client.server_info() or {}
-        # A request holds at most max_batch items: the allowed pairs, then
-        # per step a pose per moved link (and room for the step's end).
-        room = int(info.get("max_batch", 1024)) - len(self._allow)
-        self.steps_per_request = max(1, room // (len(self._objects) + 1))
+        # A request holds at most max_batch items: per step, the joint
+        # positions' items and the step's end.
+        per_step = -(-len(self._full) // _JOINTS_PER_ITEM) + 1
+        self.steps_per_request = max(1, int(info.get("max_batch", 1024)) // per_step)
 
     def _choose_joints(
         self, joints: Optional[Sequence[str]], fixed: Optional[Mapping[str, float]]
@@ -244,31 +233,16 @@ class RobotChecker:
         self.extent = float(np.linalg.norm(self.upper - self.lower))
 
     def _plan_pairs(self, allowed: set[frozenset[str]]) -> None:
-        names = self.robot.link_names
-        ids, shadow_ids = self.robot.link_ids, self.shadow.link_ids
+        # The server skips the same pairs (the robot's allowed pairs): this
+        # only counts the self-collision pairs each question checks.
+        names, ids = self.robot.link_names, self.robot.link_ids
         links = [i for i in range(len(names)) if ids[i] != 0]
-        # Link i meets shadow link j only for i < j and a pair not allowed.
-        meets = {
-            (i, j)
+        self.self_pairs = sum(
+            1
             for i in links
             for j in links
             if i < j and frozenset((names[i], names[j])) not in allowed
-        }
-        partners = sorted({j for _, j in meets})
-        allow = [
-            (int(ids[i]), int(shadow_ids[j]))
-            for j in partners
-            for i in links
-            if (i, j) not in meets
-        ]
-        # The shadow's links that never take part stay parked.
-        self._links = np.array(links, dtype=np.intp)
-        self._partners = np.array(partners, dtype=np.intp)
-        self._objects = np.concatenate([ids[links], shadow_ids[partners]]).astype(np.uint64)
-        # The shadow's links take the poses of the robot's of the same index.
-        self._select = np.concatenate([self._links, self._partners])
-        self._allow = np.array(allow, dtype=np.uint64).reshape(-1, 2)
-        self.self_pairs = len(meets)
+        )
 
     # -- positions ---------------------------------------------------------
 
@@ -284,16 +258,12 @@ class RobotChecker:
         full[self._index] = np.asarray(q, dtype=np.float64)
         return full
 
-    def _poses(self, qs: _F64) -> _F64:
-        """``(S * objects, 7)`` poses of the robot's and the shadow's moved
-        links at each row of ``qs``."""
+    def _positions(self, qs: _F64) -> _F64:
+        """``(S, dof_robot)`` positions of every moving joint at each row of
+        ``qs``, the joints not planned at their fixed positions."""
         full = np.repeat(self._full[None, :], len(qs), axis=0)
         full[:, self._index] = qs
-        out = np.empty((len(qs), len(self._objects), 7))
-        link_poses, select = self.robot.link_poses, self._select
-        for s in range(len(qs)):
-            out[s] = link_poses(full[s])[select]
-        return out.reshape(-1, 7)
+        return full
 
     def _steps(self, qs: npt.ArrayLike) -> _F64:
         a = np.asarray(qs, dtype=np.float64)
@@ -311,14 +281,14 @@ class RobotChecker:
     def _ask(self, qs: _F64, question: str) -> Any:
         """One request: ``question`` at each row of ``qs`` (at most
         :attr:`steps_per_request` rows)."""
-        return self.client.path(
-            self.robot.id,
-            self._objects,
-            self._poses(qs),
+        return self.client.path_joints(
+            self.robot,
+            self.robot,
+            self._positions(qs),
             out=self._rows,
             question=question,
             margin=self.margin,
-            allow=self._allow,
+            self_pairs=True,
         )
 
     # -- the questions ------------------------------------------------------
@@ -389,18 +359,17 @@ class RobotChecker:
     # -- lifetime -------------------------------------------------------------
 
     def close(self) -> None:
-        """Removes the robot's and the shadow's link objects from the server
-        (a robot's name stays taken there: the server removes objects, not
-        robots)."""
-        for r in (getattr(self, "robot", None), getattr(self, "shadow", None)):
-            if r is None:
-                continue
-            for i in r.link_ids:
-                if i != 0:
-                    try:
-                        self.client.remove(int(i))
-                    except Error:
-                        pass
+        """Removes the robot's link objects from the server (a robot's name
+        stays taken there: the server removes objects, not robots)."""
+        r = getattr(self, "robot", None)
+        if r is None:
+            return
+        for i in r.link_ids:
+            if i != 0:
+                try:
+                    self.client.remove(int(i))
+                except Error:
+                    pass
 
     def __enter__(self) -> RobotChecker:
         return self

@@ -640,8 +640,9 @@ impl Client {
     /// clearance at every step), `"within"` (the pairs within `margin` at
     /// every step) or `"first_hit"` (only the first step with a pair within
     /// `margin`, its index in the summary's `first_hit`). Rows carry their
-    /// step in `out.step`. `self_pairs` (`"within"` and `"first_hit"` only)
-    /// as `within`. Other arguments as `clearance`.
+    /// step in `out.step`. `self_pairs` as `within` (a clearance row's
+    /// nearest object may then be another member). Other arguments as
+    /// `clearance`.
     #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn path<'py>(

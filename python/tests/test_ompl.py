@@ -136,7 +136,7 @@ def test_motion_checks_the_sampled_segment(checker: gjkd.ompl.RobotChecker) -> N
 
 def test_long_edges_take_several_requests(client: gjkd.Client) -> None:
     with gjkd.ompl.RobotChecker(
-        client, unique_service("fine"), urdf_text=ARM, margin=0.05, resolution=1e-4
+        client, unique_service("fine"), urdf_text=ARM, margin=0.05, resolution=2e-5
     ) as fine:
         a, b = np.array([-0.5, 0.0, 0.0]), np.array([-0.5, 0.0, 1.0])
         steps = fine.segment(a, b)
@@ -156,9 +156,8 @@ def test_bad_input_raises_and_registers_nothing(client: gjkd.Client) -> None:
     assert e.value.field == "joints"
     with pytest.raises(gjkd.InvalidInput):
         gjkd.ompl.RobotChecker(client, name, urdf_text="<robot")
-    for robot in (name, name + "~self"):
-        with pytest.raises(gjkd.NotFound):
-            client.lookup(f"{robot}/l1")
+    with pytest.raises(gjkd.NotFound):
+        client.lookup(f"{name}/l1")
     with gjkd.ompl.RobotChecker(client, name, urdf_text=ARM, joints=["j3", "j1"]) as c:
         assert c.joint_names == ["j3", "j1"] and list(c.lower) == [-2.5, -3.0]
         with pytest.raises(gjkd.InvalidInput):

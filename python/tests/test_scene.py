@@ -223,7 +223,7 @@ def folded(theta: float) -> float:
 def test_self_pairs_report_a_robots_own_collisions(client: gjkd.Client) -> None:
     robot = client.register_robot(unique_service("fold"), urdf_text=FOLD)
     l0, l2 = robot.link("l0"), robot.link("l2")
-    rows = gjkd.SceneRows(8)
+    rows = gjkd.SceneRows(16)
     margin = 0.1
     for theta in [0.0, 2.5, 2.9, -3.0]:
         client.set_joints(robot, [0.0, theta])
@@ -243,7 +243,16 @@ def test_self_pairs_report_a_robots_own_collisions(client: gjkd.Client) -> None:
     assert hit.first_hit == 3
     assert {int(rows.a[0]), int(rows.b[0])} == {l0, l2}
     assert rows.lower[0] <= folded(2.9) <= rows.upper[0]
-    # Only within questions have self pairs.
-    with pytest.raises(gjkd.Error) as e:
-        client.path_joints(robot, robot, steps, out=rows, self_pairs=True)
-    assert e.value.code == gjkd.ErrorCode.MALFORMED
+    # Clearance too: each ball's nearest is the other ball (the bar is
+    # adjacent to both), at the closed-form distance.
+    c = client.path_joints(robot, robot, steps, out=rows, self_pairs=True)
+    l1 = robot.link("l1")
+    for k in range(c.written):
+        theta = steps[rows.step[k], 1]
+        partner = {l0: l2, l2: l0}.get(int(rows.a[k]))
+        if partner is None:
+            assert int(rows.a[k]) == l1 and rows.b[k] == 0
+            continue
+        assert rows.b[k] == partner
+        assert rows.distance[k] == pytest.approx(max(folded(theta), 0.0), abs=1e-9)
+    assert c.written == 3 * len(steps)

@@ -1,4 +1,6 @@
-//! Clearance: for each member of the group, the nearest object outside it.
+//! Clearance: for each member of the group, the nearest object outside it
+//! (or, with the group's own pairs asked for, the nearest object but the
+//! member itself and its allowed partners).
 //!
 //! Branch and bound over the tree (parry's `find_best`: nearer child
 //! first), each candidate's lower bound (box, then bounding sphere, then
@@ -112,7 +114,10 @@ pub(crate) fn clearance_of(
     };
     let seed = seed.and_then(|id| bp.slot(id)).filter(|&s| {
         let group = search.ctx.group;
-        s != a && bp.entry(s).live && !group.contains(s) && !group.allowed(ea.id, bp.entry(s).id)
+        s != a
+            && bp.entry(s).live
+            && (q.self_pairs || !group.contains(s))
+            && !group.allowed(ea.id, bp.entry(s).id)
     });
     let mut bound = cutoff;
     if let Some(s) = seed {
@@ -134,7 +139,7 @@ pub(crate) fn clearance_of(
             if leaf == a
                 || Some(leaf) == seed
                 || !eb.live
-                || group.contains(leaf)
+                || (group.contains(leaf) && !q.self_pairs)
                 || group.allowed(ea.id, eb.id)
                 || sphere_gap(&ea, eb) >= best_cost
             {

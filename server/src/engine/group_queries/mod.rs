@@ -146,8 +146,8 @@ impl GroupQueries {
 ///
 /// # Errors
 /// [`ErrorCode::Malformed`] for an unknown kind, path mode or flag, a
-/// first-hit path or the group's own pairs asked of another kind than
-/// within; [`ErrorCode::InvalidOptions`]
+/// first-hit path of another kind than within, the group's own pairs
+/// asked of nearest; [`ErrorCode::InvalidOptions`]
 /// for a margin, tolerance or accuracy that is not a finite number `>= 0`,
 /// no iterations, or `k = 0` for nearest.
 fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
@@ -155,7 +155,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
     let mode = r.path_mode().ok_or(ErrorCode::Malformed)?;
     if r.flags & !scene_flags::ALL != 0
         || (mode == PathMode::FirstHit && kind != SceneKind::Within)
-        || (r.flags & scene_flags::SELF_PAIRS != 0 && kind != SceneKind::Within)
+        || (r.flags & scene_flags::SELF_PAIRS != 0 && kind == SceneKind::Nearest)
     {
         return Err(ErrorCode::Malformed);
     }

@@ -203,7 +203,12 @@ fn bad_requests_get_their_codes_and_change_nothing() {
             ErrorCode::Malformed,
         ),
         (
-            with(&|r| r.flags |= scene_flags::SELF_PAIRS),
+            with(&|r| {
+                r.kind = SceneKind::Nearest as u32;
+                r.k = 1;
+                r.group = obstacle;
+                r.flags |= scene_flags::SELF_PAIRS;
+            }),
             vec![good_move],
             ErrorCode::Malformed,
         ),
@@ -502,6 +507,18 @@ fn self_pairs_add_the_groups_own_pairs_but_the_allowed_ones() {
         }
     }
     let first = first.expect("the fold reaches l0");
+    // Clearance with the group's own pairs, folded: l0's and l2's nearest
+    // is each other (l1 is adjacent to both), l1's the obstacle far away.
+    let mut clear = SceneRequest::new(SceneKind::Clearance, robot);
+    clear.flags |= scene_flags::SELF_PAIRS;
+    let fold = Item::set_joints(ObjectId::from_raw(robot), 0, &[0.0, 2.5], None, false);
+    let (_, rows) = ask(&mut s, 1, &clear, &[fold]);
+    let nearest: Vec<u64> = rows.iter().map(|r| r.b).collect();
+    assert_eq!(nearest, vec![links[2], obstacle, links[0]], "{rows:?}");
+    check_clearance_rows(&s, &rows);
+    clear.flags &= !scene_flags::SELF_PAIRS;
+    let (_, rows) = ask(&mut s, 1, &clear, &[]);
+    assert!(rows.iter().all(|r| r.b == obstacle), "{rows:?}");
     let mut hit = own;
     hit.path = PathMode::FirstHit as u32;
     let (reply, rows) = ask(&mut s, 1, &hit, &path);
@@ -517,4 +534,15 @@ fn self_pairs_add_the_groups_own_pairs_but_the_allowed_ones() {
         u32::MAX,
         "without self pairs the fold is no hit"
     );
+}
+
+/// Each clearance row's interval holds the exact distance of its pair.
+fn check_clearance_rows(s: &State, rows: &[SceneRow]) {
+    for row in rows {
+        let e = exact(s, row.a, row.b);
+        assert!(
+            overlaps(row.result.lower, row.result.upper, &e),
+            "{row:?} {e:?}"
+        );
+    }
 }

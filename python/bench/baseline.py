@@ -69,3 +69,12 @@ class PinCoal:
                 g = self.geom.geometryObjects
                 return f"{g[p.first].name}-{g[p.second].name}"
         return ""
+
+    def clearance(self, q: Sequence[float]) -> float:
+        """The least distance over every checked pair at ``q`` (coal's
+        distance: negative where shapes overlap), as a clearance objective
+        asks for it."""
+        self.checks += 1
+        self.q[:7] = q
+        k = pin.computeDistances(self.model, self.data, self.geom, self.gdata, self.q)
+        return float(self.gdata.distanceResults[k].min_distance)

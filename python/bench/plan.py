@@ -4,6 +4,8 @@ process (``baseline.py``), the same planner and settings for both.
 
     python python/bench/plan.py            # 100 problems a scene
     python python/bench/plan.py --quick    # 4 problems a scene
+    python python/bench/plan.py --planner RRTstar --objective clearance \
+        --problems 20 --time 2             # an optimising planner, fixed time
 
 Per checker: RRTConnect's planning time (OMPL's own measure; median and
 90th percentile), success rate, state checks and edge checks per second of
@@ -37,6 +39,37 @@ import gjkd
 import gjkd.ompl
 
 SCENES = ["box", "cage", "table_pick", "table_under_pick", "bookshelf_small"]
+# Planners that use their whole time improving the path under an objective.
+OPTIMISING = {"RRTstar", "BITstar", "PRMstar", "LBTRRT", "InformedRRTstar", "ABITstar", "AITstar"}
+
+
+def clearance_cost(si: Any, clearance: Any) -> Any:
+    """OMPL's clearance objective (its demos' form: 1 / clearance
+    integrated along the path) over ``clearance(q)``, for the baseline;
+    ``gjkd.ompl.clearance_objective`` is the same over gjkd's clearance."""
+
+    class Clearance(ob.StateCostIntegralObjective):  # type: ignore[misc]
+        def __init__(self) -> None:
+            super().__init__(si, True)
+
+        def stateCost(self, state: Any) -> Any:  # noqa: N802 (OMPL's name)
+            return ob.Cost(1.0 / (max(clearance(state[0:7]), 0.0) + 1e-9))
+
+    return Clearance()
+
+
+def path_length(path: Optional[np.ndarray]) -> float:
+    """The path's length in joint space (radians), ``nan`` for none."""
+    if path is None:
+        return math.nan
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+
+
+def least_clearance(truth: PinCoal, path: Optional[np.ndarray], step: float) -> float:
+    """The least distance along ``path`` checked densely by ``truth``."""
+    if path is None:
+        return math.nan
+    return min(truth.clearance(q) for q in dense(path, step))
 
 
 def register(client: gjkd.Client, problem: Problem) -> list[int]:
@@ -86,7 +119,7 @@ def run_gjkd(
 
 
 def run_baseline(
-    p: Problem, margin: float, fingers: float, limit: float
+    p: Problem, margin: float, fingers: float, limit: float, planner: str, objective: str
 ) -> tuple[Optional[np.ndarray], dict[str, Any], PinCoal]:
     checker = PinCoal(read_scene(p.scene_file), margin, fingers)
     space = ob.RealVectorStateSpace(7)
@@ -98,7 +131,9 @@ def run_baseline(
     ss = og.SimpleSetup(space)
     ss.setStateValidityChecker(lambda s: checker.is_valid(s[0:7]))
     si = ss.getSpaceInformation()
-    ss.setPlanner(og.RRTConnect(si))
+    ss.setPlanner(getattr(og, planner)(si))
+    if planner in OPTIMISING and objective == "clearance":
+        ss.setOptimizationObjective(clearance_cost(si, checker.clearance))
     start, goal = ss.getStateSpace().allocState(), ss.getStateSpace().allocState()
     for i in range(7):
         start[i], goal[i] = float(p.start[i]), float(p.goal[i])
@@ -145,6 +180,13 @@ def main() -> None:
         help="the gjkd server's wait mode (block: on a loaded 2-core machine, "
         "a spinning server takes the planner's core)",
     )
+    parser.add_argument("--planner", default="RRTConnect", help="OMPL's og.<planner>")
+    parser.add_argument(
+        "--objective",
+        choices=["length", "clearance"],
+        default="length",
+        help="an optimising planner's objective (OMPL's default: path length)",
+    )
     parser.add_argument("--json", help="write every problem's figures here")
     args = parser.parse_args()
     if args.quick:
@@ -171,7 +213,9 @@ def main() -> None:
             joints=robot["joints"],
             fixed=robot["fixed"],
         )
-        ss = gjkd.ompl.simple_setup(checker)
+        ss = gjkd.ompl.simple_setup(checker, planner=args.planner)
+        if args.planner in OPTIMISING and args.objective == "clearance":
+            ss.setOptimizationObjective(gjkd.ompl.clearance_objective(ss, checker))
         for k, p in enumerate(problems):
             ends = np.array([p.start, p.goal])
             if np.any(ends < checker.lower) or np.any(ends > checker.upper):
@@ -186,7 +230,9 @@ def main() -> None:
             path, stats = run_gjkd(ss, checker, p, args.time)
             for i in ids:
                 client.remove(i)
-            bpath, bstats, truth = run_baseline(p, args.margin, fingers, args.time)
+            bpath, bstats, truth = run_baseline(
+                p, args.margin, fingers, args.time, args.planner, args.objective
+            )
             for q, what in ((p.start, "start"), (p.goal, "goal")):
                 if not truth.is_valid(q):
                     why = truth.first_collision(q)
@@ -201,6 +247,10 @@ def main() -> None:
                         "index": p.index,
                         "solved": pth is not None,
                         "touch": touches(truth, pth, step),
+                        "length": path_length(pth),
+                        "clearance": least_clearance(truth, pth, step)
+                        if args.planner in OPTIMISING
+                        else math.nan,
                         **st,
                     }
                 )
@@ -212,9 +262,10 @@ def main() -> None:
                 file=sys.stderr,
             )
         checker.close()
+    objective = f", objective {args.objective}" if args.planner in OPTIMISING else ""
     print(
-        f"RRTConnect, {args.time:g} s limit, margin {args.margin:g}, seed {args.seed}; "
-        "times over every problem, an unsolved one counting as the limit"
+        f"{args.planner}{objective}, {args.time:g} s limit, margin {args.margin:g}, "
+        f"seed {args.seed}; times over every problem, an unsolved one counting as the limit"
     )
     head = "| scene | checker | solved | median ms | p90 ms | states/s | edges/s | paths touching |"
     print(head)
@@ -230,6 +281,24 @@ def main() -> None:
             )
     g, b = summary(results["gjkd"]), summary(results["pinocchio+coal"])
     print(f"median planning time, gjkd / pinocchio+coal: {g['median_ms'] / b['median_ms']:.2f}")
+    if args.planner in OPTIMISING:
+        # A fixed time: what the time bought, the path's length and its least
+        # clearance (checked densely by pinocchio + coal), median over the
+        # problems both solved.
+        print("| checker | median length, rad | median least clearance, m | states/s |")
+        print("|---|---|---|---|")
+        pairs = [
+            (x, y)
+            for x, y in zip(results["gjkd"], results["pinocchio+coal"])
+            if x["solved"] and y["solved"]
+        ]
+        for i, name in enumerate(results):
+            sel = [pair[i] for pair in pairs]
+            if sel:
+                s = summary(sel)
+                length = statistics.median(r["length"] for r in sel)
+                clear = statistics.median(r["clearance"] for r in sel)
+                print(f"| {name} | {length:.3f} | {clear:.4f} | {s['states_per_s']:.0f} |")
     both = [
         (x["time"], y["time"])
         for x, y in zip(results["gjkd"], results["pinocchio+coal"])

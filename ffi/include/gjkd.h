@@ -553,9 +553,9 @@ typedef struct gjkd_scene_options {
   bool motion_bounds;
   // Within: every pair of the scene, not only group against the rest.
   bool all_pairs;
-  // Within (and within paths): the group's members against each other
-  // too, but the allowed pairs (a robot's self-collisions). Refused with
-  // other questions.
+  // Within and clearance (and their paths): the group's members meet
+  // each other too, but the allowed pairs (a robot's self-collisions).
+  // Refused with nearest.
   bool self_pairs;
   // Clamp joint positions outside their limits instead of refusing.
   bool clamp;

@@ -117,7 +117,7 @@ pub mod scene_flags {
     /// self-collisions, without the SRDF's disabled pairs and adjacent
     /// links); a clearance row's nearest object may then be another member.
     /// Refused with nearest.
-    pub const SELF_PAIRS: u32 = 1 << 6;
+    pub const SELF_PAIRS: u32 = 1 << 10;
     /// Every bit this version knows; others are refused as malformed.
     pub const ALL: u32 =
         WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP | SELF_PAIRS;

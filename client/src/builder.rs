@@ -76,6 +76,7 @@ impl ClientBuilder {
             conn: None,
             vertex_scratch: Vec::new(),
             tokens: TokenSource::new(),
+            split_scratch: Default::default(),
         };
         let deadline = Instant::now() + self.connect_timeout.unwrap_or(client.timeout);
         let mut first = true;

@@ -11,6 +11,7 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
 
 use crate::open_failure::{NameTakenBy, OpenFailure, name_taken_by};
+use crate::path_split::{RequestLimits, SplitScratch};
 use crate::{ClientError, ipc_err, scene};
 use gjkd_proto::{
     AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, ServerInfo,
@@ -91,6 +92,7 @@ pub struct Client {
     pub(crate) timeout: Duration,
     pub(crate) vertex_scratch: Vec<Vertex>,
     pub(crate) tokens: TokenSource,
+    pub(crate) split_scratch: SplitScratch,
 }
 
 /// Draws registration tokens: random (from the standard library's
@@ -160,6 +162,14 @@ impl Client {
     /// limits, wait strategy, pid. `None` while disconnected.
     pub fn server_info(&self) -> Option<ServerInfo> {
         self.conn.as_ref().map(|c| c.info)
+    }
+
+    /// The item and row limits of one request, from the server's hello.
+    pub(crate) fn request_limits(&self) -> Option<RequestLimits> {
+        self.conn.as_ref().map(|c| RequestLimits {
+            items: c.info.max_batch as usize,
+            rows: usize::try_from(c.info.max_rows).unwrap_or(usize::MAX),
+        })
     }
 
     /// Whether the client currently holds a connection (it may still find

@@ -230,7 +230,7 @@ pub struct SceneSummary {
 }
 
 impl SceneSummary {
-    fn new(reply: &SceneReply, written: usize) -> Self {
+    pub(crate) fn new(reply: &SceneReply, written: usize) -> Self {
         SceneSummary {
             written,
             total: reply.total,
@@ -416,6 +416,14 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
 
     /// Answer at every step of `steps`, the stored poses unchanged
     /// ([`Client::clearance`] or [`Client::within`]).
+    ///
+    /// A path of any length comes back whole when the buffer holds its
+    /// rows: one longer than a request takes (more items than the
+    /// server's [`ServerInfo::max_batch`](crate::ServerInfo::max_batch), or
+    /// more rows than its [`ServerInfo::max_rows`](crate::ServerInfo::max_rows))
+    /// is sent as several requests of consecutive steps, each repeating the
+    /// first step's poses for the objects later steps leave alone, and the
+    /// rows are numbered from the path's start as in one answer.
     pub fn along(mut self, steps: Steps<'a>) -> Self {
         self.request.path = PathMode::EveryStep as u32;
         self.steps = Some(steps);
@@ -574,9 +582,32 @@ impl Client {
     /// layouts of their own. `request.max_rows` is the room for rows; the
     /// items follow the layout of [`SceneRequest`]'s documentation.
     ///
+    /// A path longer than one request takes (more items than the server's
+    /// [`ServerInfo::max_batch`](crate::ServerInfo::max_batch), or room for
+    /// more rows than its [`ServerInfo::max_rows`](crate::ServerInfo::max_rows))
+    /// is sent as several requests, and `read` gets all the rows at once:
+    /// see [`SceneQuery::along`].
+    ///
     /// # Errors
     /// As [`SceneQuery::into_rows`].
     pub fn scene_with(
+        &mut self,
+        request: &SceneRequest,
+        count: usize,
+        item: impl FnMut(usize) -> Item,
+        read: impl FnOnce(&[SceneRow]),
+    ) -> Result<SceneSummary, ClientError> {
+        self.ensure_connected(Instant::now() + self.timeout)?;
+        if let Some(limits) = self.request_limits()
+            && limits.must_split(request, count)
+        {
+            return self.scene_split(request, count, item, read, limits);
+        }
+        self.scene_once(request, count, item, read)
+    }
+
+    /// One scene request: [`Client::scene_with`] for what one request takes.
+    pub(crate) fn scene_once(
         &mut self,
         request: &SceneRequest,
         count: usize,

@@ -153,7 +153,7 @@ pub struct SceneRequest {
     /// [`SceneKind::Nearest`]: how many objects.
     pub k: u32,
     /// Most rows the reply may carry (at most the server's
-    /// [`ServerInfo::max_batch`](crate::ServerInfo::max_batch)).
+    /// [`ServerInfo::max_rows`](crate::ServerInfo::max_rows)).
     pub max_rows: u32,
     /// [`scene_flags`] bits.
     pub flags: u32,

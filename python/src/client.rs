@@ -352,7 +352,7 @@ backend_methods!(Client, {
     }
 
     /// What the server said about itself at the last (re)connection, as a
-    /// dict (`protocol`, `wait`, `max_batch`, `max_vertices`,
+    /// dict (`protocol`, `wait`, `max_batch`, `max_rows`, `max_vertices`,
     /// `max_pieces`, `max_clients`, `max_objects`, `pid`); `None` while
     /// disconnected.
     fn server_info<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
@@ -363,6 +363,7 @@ backend_methods!(Client, {
         d.set_item("protocol", info.protocol)?;
         d.set_item("wait", info.wait)?;
         d.set_item("max_batch", info.max_batch)?;
+        d.set_item("max_rows", info.max_rows)?;
         d.set_item("max_vertices", info.max_vertices)?;
         d.set_item("max_pieces", info.max_pieces)?;
         d.set_item("max_clients", info.max_clients)?;

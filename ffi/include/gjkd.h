@@ -1125,7 +1125,8 @@ enum gjkd_status gjkd_robot_joint(const struct gjkd_robot *robot,
 // see `gjkd_robot_joint()`) and, if `base` is not NULL, its base pose, in
 // one round trip: the server places every link by forward kinematics. A
 // position outside its limits is refused, or moved to the nearest limit
-// when `clamp` is true.
+// when `clamp` is true. A robot without moving joints takes `count` 0
+// (`positions` may then be NULL): only its base moves.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
 // `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the

@@ -445,7 +445,8 @@ class Client(_Objects):
         base: Optional[_Pose] = None,
         clamp: bool = False,
     ) -> None:
-        """Sets every joint (and the base) in one round trip."""
+        """Sets every joint (and the base) in one round trip; a robot without
+        moving joints takes ``[]`` and moves by ``base`` alone."""
     def clearance(
         self,
         group: _ArrayLike,

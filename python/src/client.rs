@@ -315,7 +315,8 @@ backend_methods!(Client, {
     /// when `base` is given: the server places every link by forward
     /// kinematics. `positions` is a `(dof,)` float64 array in
     /// `robot.joint_names` order, or a `{joint name: position}` dict
-    /// (joints not named keep their last positions). A position outside
+    /// (joints not named keep their last positions); a robot without
+    /// moving joints takes `[]` and moves by `base` alone. A position outside
     /// its limits raises `InvalidInput` (`OUT_OF_LIMITS`, `index` the
     /// joint) unless `clamp=True` moves it to the nearest limit; NaN
     /// raises `InvalidInput` (`NON_FINITE_POSE`); an unknown joint name

@@ -424,15 +424,8 @@ pub fn set_joints(
     base: Option<&Bound<'_, PyAny>>,
     clamp: bool,
 ) -> PyResult<()> {
+    // No positions for a robot without moving joints: only its base moves.
     let q = robot.positions_of(py, positions)?;
-    if q.is_empty() {
-        return Err(invalid(
-            py,
-            "positions",
-            None,
-            "the robot has no moving joint".into(),
-        ));
-    }
     let base = checked_pose(py, base, "base")?.map(|p| isometry(&p));
     let mode = if clamp {
         LimitMode::Clamp

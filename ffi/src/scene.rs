@@ -63,6 +63,10 @@ pub struct gjkd_scene_options {
     pub all_pairs: bool,
     /// Clamp joint positions outside their limits instead of refusing.
     pub clamp: bool,
+    /// Exact distances on every reported row: none with status
+    /// `GJKD_QUERY_BOUNDED` or `GJKD_QUERY_CLOSER` (motion bounds and early
+    /// exits still rule out pairs not reported).
+    pub exact: bool,
 }
 
 impl Default for gjkd_scene_options {
@@ -79,6 +83,7 @@ impl Default for gjkd_scene_options {
             motion_bounds: true,
             all_pairs: false,
             clamp: false,
+            exact: false,
         }
     }
 }
@@ -102,7 +107,14 @@ pub struct gjkd_scene_row {
     pub step: u32,
     /// The pair's `gjkd_error_code`, 0 when answered.
     pub error: u32,
-    /// The pair's answer, `point_a` on `a`.
+    /// The pair's answer, `point_a` on `a`. `lower` and `upper` always
+    /// bound the true distance. With status `GJKD_QUERY_CONVERGED` (and
+    /// `ITERATION_CAP`, `TOLERANCE_NOT_MET` within their bounds) `distance`
+    /// and the points are the answer; with `GJKD_QUERY_CLOSER` (a within
+    /// pair proved inside the margin by an early exit) or
+    /// `GJKD_QUERY_BOUNDED` (from motion bounds, without GJK) they are an
+    /// estimate inside `[lower, upper]`, which may be wide. Set
+    /// `gjkd_scene_options.exact` for exact distances on every row.
     pub answer: gjkd_answer,
 }
 
@@ -205,6 +217,7 @@ impl<'a> Call<'a> {
         let bits = [
             (options.warm_start, scene_flags::WARM_START),
             (options.motion_bounds, scene_flags::MOTION_BOUNDS),
+            (options.exact, scene_flags::EXACT),
             (options.all_pairs, scene_flags::ALL_PAIRS),
             (options.precision == 1, scene_flags::SINGLE_PRECISION),
             (options.use_cutoff, scene_flags::CUTOFF),

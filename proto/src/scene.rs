@@ -111,8 +111,15 @@ pub mod scene_flags {
     /// Clamp joint positions outside their limits instead of refusing the
     /// request, as [`item_flags::CLAMP`](crate::item_flags::CLAMP).
     pub const CLAMP: u32 = 1 << 5;
+    /// Exact distances on every reported row: no row is answered from
+    /// motion bounds ([`Status::Bounded`](crate::Status::Bounded)) or
+    /// left at a margin's early exit ([`Status::Closer`](crate::Status::Closer));
+    /// each runs GJK to the tolerance. Motion bounds and early exits still
+    /// rule out pairs that are not reported.
+    pub const EXACT: u32 = 1 << 6;
     /// Every bit this version knows; others are refused as malformed.
-    pub const ALL: u32 = WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP;
+    pub const ALL: u32 =
+        WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP | EXACT;
 }
 
 /// Bits of [`SceneReply::flags`].
@@ -216,6 +223,12 @@ pub struct SceneRow {
     /// Zero.
     pub reserved: u32,
     /// The pair's answer, as a pair query's, with `point_a` on `a`.
+    /// `lower` and `upper` always bound the true distance; `distance` and
+    /// the points are exact (to the tolerance) for
+    /// [`Status::Converged`](crate::Status::Converged), and an estimate
+    /// inside the interval for [`Status::Closer`](crate::Status::Closer)
+    /// (a margin's early exit) and [`Status::Bounded`](crate::Status::Bounded)
+    /// (motion bounds); [`scene_flags::EXACT`] asks for exact rows only.
     pub result: ItemResult,
 }
 

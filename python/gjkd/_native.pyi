@@ -212,7 +212,17 @@ class Distances:
 
 @final
 class SceneRows:
-    """Room for the rows of scene answers, reused from call to call."""
+    """Room for the rows of scene answers, reused from call to call.
+
+    Which fields are exact depends on a row's ``status``: ``lower`` and
+    ``upper`` always bound the true distance. ``CONVERGED`` (and
+    ``ITERATION_CAP``, ``TOLERANCE_NOT_MET`` within their bounds):
+    ``distance`` and the points are the answer. ``CLOSER`` (a ``within``
+    pair proved inside the margin by an early exit) and ``BOUNDED``
+    (answered from motion bounds, without GJK): ``distance`` and the points
+    are an estimate inside ``[lower, upper]``, which may be wide. Pass
+    ``exact=True`` to a scene call for exact distances on every reported
+    row."""
 
     def __new__(cls, n: int) -> Self:
         """Zeroed room for ``n`` rows."""
@@ -460,6 +470,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """Each member's nearest object outside ``group``."""
     def within(
@@ -476,6 +487,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """Every pair within ``margin``."""
     def nearest(
@@ -492,6 +504,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """The ``k`` objects nearest to ``object``."""
     def path(
@@ -511,6 +524,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """A question at every step of a candidate motion."""
     def path_joints(
@@ -531,6 +545,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """A question at every step of a robot's motion given as ``(S, dof)`` joint positions."""
     def __enter__(self) -> Client: ...

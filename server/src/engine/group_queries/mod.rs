@@ -76,6 +76,9 @@ pub(crate) struct Question {
     all_pairs: bool,
     /// [`scene_flags::MOTION_BOUNDS`].
     pub motion: bool,
+    /// [`scene_flags::EXACT`]: every reported row converged (no early exit,
+    /// no row from motion bounds; bounds still rule pairs out).
+    pub exact: bool,
     /// [`scene_flags::WARM_START`].
     pub warm: bool,
     clamp: bool,
@@ -170,6 +173,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         cutoff: has(scene_flags::CUTOFF),
         all_pairs: has(scene_flags::ALL_PAIRS),
         motion: has(scene_flags::MOTION_BOUNDS),
+        exact: has(scene_flags::EXACT),
         warm: has(scene_flags::WARM_START),
         clamp: has(scene_flags::CLAMP),
         options: gjk::Options {

@@ -444,7 +444,12 @@ class Client(_Objects):
         package_path: Sequence[_Path] = ...,
         base: Optional[_Pose] = None,
     ) -> Robot:
-        """Registers a robot from URDF (a file or text)."""
+        """Registers a robot from URDF (a file or text).
+
+        ``package://NAME/...`` mesh URLs are searched in ``package_path``,
+        then ``$GJKD_PACKAGE_PATH``, ``$ROS_PACKAGE_PATH`` and the ``share``
+        folder of each ``$AMENT_PREFIX_PATH`` prefix, as ROS searches them
+        (see the README's robot section)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
         """The robot ``name`` already on the server."""
     def set_joints(

@@ -244,8 +244,12 @@ backend_methods!(Client, {
     /// limits). `urdf` is a file path, `srdf` an optional SRDF file (its
     /// `disable_collisions` pairs); `urdf_text` / `srdf_text` give the
     /// text instead (then relative mesh paths are relative to the working
-    /// folder). `package://` mesh URLs are searched in `package_path`,
-    /// then `$GJKD_PACKAGE_PATH` and `$ROS_PACKAGE_PATH`. Returns a
+    /// folder). `package://NAME/...` mesh URLs are searched in
+    /// `package_path`, then `$GJKD_PACKAGE_PATH`, `$ROS_PACKAGE_PATH` and
+    /// the `share` folder of each `$AMENT_PREFIX_PATH` prefix, as ROS
+    /// searches them (`DIR/NAME/...` or a `DIR` named `NAME` first, then
+    /// the shallowest folder below a `DIR` whose `package.xml` names
+    /// `NAME`, up to six levels down). Returns a
     /// `gjkd.Robot`. Raises `InvalidInput` (`field="urdf"`) for a URDF,
     /// SRDF or mesh that cannot be read (the message names the file, link
     /// or joint), `Refused` (`NAME_TAKEN`) when a link object of that name

@@ -17,9 +17,7 @@ def test_exact_rows_carry_converged_distances(client: gjkd.Client) -> None:
         np.array([1.5 * np.cos(0.52 * i) + 0.3, 1.5 * np.sin(0.52 * i), 0.2 * (i % 3)])
         for i in range(12)
     ]
-    boxes = [
-        client.register_box(half, pose=[*c, 0.0, 0.0, 0.0, 1.0]) for c in centres
-    ]
+    boxes = [client.register_box(half, pose=[*c, 0.0, 0.0, 0.0, 1.0]) for c in centres]
     rows = gjkd.SceneRows(64)
     estimates = {int(gjkd.Status.CLOSER), int(gjkd.Status.BOUNDED)}
     seen = 0

@@ -250,9 +250,9 @@ backend_methods!(Client, {
     /// searches them (`DIR/NAME/...` or a `DIR` named `NAME` first, then
     /// the shallowest folder below a `DIR` whose `package.xml` names
     /// `NAME`, up to six levels down). Returns a
-    /// `gjkd.Robot`. Raises `InvalidInput` (`field="urdf"`) for a URDF,
-    /// SRDF or mesh that cannot be read (the message names the file, link
-    /// or joint), `Refused` (`NAME_TAKEN`) when a link object of that name
+    /// `gjkd.Robot`. Raises `InvalidInput` (`INVALID_ROBOT`,
+    /// `field="urdf"`) for a URDF, SRDF or mesh that cannot be read (the
+    /// message names the file, link or joint), `Refused` (`NAME_TAKEN`) when a link object of that name
     /// exists; links registered before a failure are removed again.
     #[pyo3(signature = (name, urdf = None, *, srdf = None, urdf_text = None,
         srdf_text = None, package_path = Vec::new(), base = None))]
@@ -324,7 +324,7 @@ backend_methods!(Client, {
     /// its limits raises `InvalidInput` (`OUT_OF_LIMITS`, `index` the
     /// joint) unless `clamp=True` moves it to the nearest limit; NaN
     /// raises `InvalidInput` (`NON_FINITE_POSE`); an unknown joint name
-    /// `NotFound`. Nothing moves on error.
+    /// `NotFound` (`UNKNOWN_NAME`). Nothing moves on error.
     #[pyo3(signature = (robot, positions, *, base = None, clamp = false))]
     fn set_joints(
         &mut self,

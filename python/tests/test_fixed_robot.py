@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 import gjkd
 from conftest import unique_service
 
@@ -29,3 +31,14 @@ def test_a_robot_without_moving_joints_moves_by_its_base(client: gjkd.Client) ->
     client.set_joints(table, [])
     assert math.isclose(client.distance(top, ball).distance, 0.15, abs_tol=1e-9)
     client.remove(ball)
+
+
+def test_robot_faults_carry_the_codes_of_the_server(client: gjkd.Client) -> None:
+    table = client.register_robot(unique_service("coded"), urdf_text=TABLE)
+    with pytest.raises(gjkd.NotFound) as e:
+        client.set_joints(table, {"no_such_joint": 0.0})
+    assert e.value.code == gjkd.ErrorCode.UNKNOWN_NAME
+    with pytest.raises(gjkd.InvalidInput) as bad:
+        client.register_robot(unique_service("bad"), urdf_text="<robot name='x'><link")
+    assert bad.value.code == gjkd.ErrorCode.INVALID_ROBOT
+    assert bad.value.field == "urdf"

@@ -110,6 +110,11 @@ impl RobotHandle {
         base: Option<&Isometry3<f64>>,
         clamp: bool,
     ) -> Vec<Item> {
+        if positions.is_empty() {
+            // A robot without moving joints: only its base moves (or,
+            // without a base, nothing; the server still checks the robot).
+            return vec![Item::set_joints(self.id, 0, &[], base, clamp)];
+        }
         positions
             .chunks(JOINTS_PER_ITEM)
             .enumerate()
@@ -375,7 +380,9 @@ impl Client {
     /// Sets every joint of `robot` (an array in [`RobotHandle::joint_names`]
     /// order) and, if given, its base pose, in one round trip: the server
     /// computes and stores every link's pose. Positions outside their
-    /// limits are refused.
+    /// limits are refused. A robot without moving joints takes no
+    /// positions: `set_joints(robot, &[], Some(&base))` moves it by its base
+    /// alone.
     ///
     /// # Errors
     /// [`ClientError::InvalidArgument`] for the wrong number of positions;
@@ -407,7 +414,7 @@ impl Client {
         base: Option<&Isometry3<f64>>,
         mode: LimitMode,
     ) -> Result<(), ClientError> {
-        if positions.len() != robot.positions.len() || positions.is_empty() {
+        if positions.len() != robot.positions.len() {
             return Err(ClientError::InvalidArgument(
                 "one position per moving joint of the robot",
             ));

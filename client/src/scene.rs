@@ -230,7 +230,7 @@ pub struct SceneSummary {
 }
 
 impl SceneSummary {
-    fn new(reply: &SceneReply, written: usize) -> Self {
+    pub(crate) fn new(reply: &SceneReply, written: usize) -> Self {
         SceneSummary {
             written,
             total: reply.total,
@@ -342,6 +342,16 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
         self.flag(scene_flags::MOTION_BOUNDS, on)
     }
 
+    /// Exact distances on every reported row: no row answered from motion
+    /// bounds ([`Status::Bounded`](crate::Status::Bounded)) or left at a
+    /// margin's early exit ([`Status::Closer`](crate::Status::Closer)), so
+    /// `distance` and the points are exact to the tolerance on all of them.
+    /// Bounds and early exits still rule out pairs not reported, so it
+    /// costs a GJK run only per reported row (default off).
+    pub fn exact(self, on: bool) -> Self {
+        self.flag(scene_flags::EXACT, on)
+    }
+
     /// Accept, from motion bounds alone, an interval at most `absolute`
     /// wide, or at most `relative` times its upper end wide (0 for none,
     /// the default: motion bounds then only answer what they decide).
@@ -417,13 +427,38 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
 
     /// Store these poses first, as [`Client::set_pose`] would, then answer.
     /// In a path they are the first step's.
+    ///
+    /// Storing and answering are one request, which the server handles
+    /// whole before any other client's: no other client's update comes in
+    /// between, and the answer is at exactly these poses. The poses stay
+    /// stored for every client afterwards; to ask at poses without storing
+    /// them, use [`SceneQuery::at_poses`].
     pub fn with_poses(mut self, poses: &'a [(ObjectId, Isometry3<f64>)]) -> Self {
         self.poses = poses;
         self
     }
 
+    /// Answer with these objects at these poses for this question only:
+    /// the stored poses are neither used for them nor changed (a path of
+    /// one step; rows have step 0). Replaces [`SceneQuery::with_poses`].
+    pub fn at_poses(mut self, poses: &'a [(ObjectId, Isometry3<f64>)]) -> Self {
+        self.poses = poses;
+        if self.steps.is_none() && self.request.path == PathMode::Single as u32 {
+            self.request.path = PathMode::EveryStep as u32;
+        }
+        self
+    }
+
     /// Answer at every step of `steps`, the stored poses unchanged
     /// ([`Client::clearance`] or [`Client::within`]).
+    ///
+    /// A path of any length comes back whole when the buffer holds its
+    /// rows: one longer than a request takes (more items than the
+    /// server's [`ServerInfo::max_batch`](crate::ServerInfo::max_batch), or
+    /// more rows than its [`ServerInfo::max_rows`](crate::ServerInfo::max_rows))
+    /// is sent as several requests of consecutive steps, each repeating the
+    /// first step's poses for the objects later steps leave alone, and the
+    /// rows are numbered from the path's start as in one answer.
     pub fn along(mut self, steps: Steps<'a>) -> Self {
         self.request.path = PathMode::EveryStep as u32;
         self.steps = Some(steps);
@@ -500,7 +535,9 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
             None => (None, 0, 0),
         };
         let heads = [members.len(), allowed.len(), poses.len()];
-        let count = heads.iter().sum::<usize>() + per_step * step_count;
+        // A one-step path of its own poses (`at_poses`) ends with a step.
+        let own_step = usize::from(steps.is_none() && self.request.path != PathMode::Single as u32);
+        let count = heads.iter().sum::<usize>() + per_step * step_count + own_step;
         let item = move |mut i: usize| {
             if i < members.len() {
                 return Item::member(members[i]);
@@ -556,7 +593,7 @@ impl Client {
     }
 
     /// The `k` objects nearest to `object`, nearest first.
-    pub fn nearest(&mut self, object: ObjectId, k: u32) -> SceneQuery<'_, 'static> {
+    pub fn nearest<'a>(&mut self, object: ObjectId, k: u32) -> SceneQuery<'_, 'a> {
         let mut query = SceneQuery::new(self, SceneKind::Nearest, Group::Object(object));
         query.request.k = k;
         query
@@ -582,9 +619,32 @@ impl Client {
     /// layouts of their own. `request.max_rows` is the room for rows; the
     /// items follow the layout of [`SceneRequest`]'s documentation.
     ///
+    /// A path longer than one request takes (more items than the server's
+    /// [`ServerInfo::max_batch`](crate::ServerInfo::max_batch), or room for
+    /// more rows than its [`ServerInfo::max_rows`](crate::ServerInfo::max_rows))
+    /// is sent as several requests, and `read` gets all the rows at once:
+    /// see [`SceneQuery::along`].
+    ///
     /// # Errors
     /// As [`SceneQuery::into_rows`].
     pub fn scene_with(
+        &mut self,
+        request: &SceneRequest,
+        count: usize,
+        item: impl FnMut(usize) -> Item,
+        read: impl FnOnce(&[SceneRow]),
+    ) -> Result<SceneSummary, ClientError> {
+        self.ensure_connected(Instant::now() + self.timeout)?;
+        if let Some(limits) = self.request_limits()
+            && limits.must_split(request, count)
+        {
+            return self.scene_split(request, count, item, read, limits);
+        }
+        self.scene_once(request, count, item, read)
+    }
+
+    /// One scene request: [`Client::scene_with`] for what one request takes.
+    pub(crate) fn scene_once(
         &mut self,
         request: &SceneRequest,
         count: usize,

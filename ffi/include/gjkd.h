@@ -559,6 +559,10 @@ typedef struct gjkd_scene_options {
   bool self_pairs;
   // Clamp joint positions outside their limits instead of refusing.
   bool clamp;
+  // Exact distances on every reported row: none with status
+  // `GJKD_QUERY_BOUNDED` or `GJKD_QUERY_CLOSER` (motion bounds and early
+  // exits still rule out pairs not reported).
+  bool exact;
 } gjkd_scene_options;
 
 // The objects a scene question is about: `id` (a robot, whose links are
@@ -589,7 +593,14 @@ typedef struct gjkd_scene_row {
   uint32_t step;
   // The pair's `gjkd_error_code`, 0 when answered.
   uint32_t error;
-  // The pair's answer, `point_a` on `a`.
+  // The pair's answer, `point_a` on `a`. `lower` and `upper` always
+  // bound the true distance. With status `GJKD_QUERY_CONVERGED` (and
+  // `ITERATION_CAP`, `TOLERANCE_NOT_MET` within their bounds) `distance`
+  // and the points are the answer; with `GJKD_QUERY_CLOSER` (a within
+  // pair proved inside the margin by an early exit) or
+  // `GJKD_QUERY_BOUNDED` (from motion bounds, without GJK) they are an
+  // estimate inside `[lower, upper]`, which may be wide. Set
+  // `gjkd_scene_options.exact` for exact distances on every row.
   struct gjkd_answer answer;
 } gjkd_scene_row;
 
@@ -1129,7 +1140,8 @@ enum gjkd_status gjkd_robot_joint(const struct gjkd_robot *robot,
 // see `gjkd_robot_joint()`) and, if `base` is not NULL, its base pose, in
 // one round trip: the server places every link by forward kinematics. A
 // position outside its limits is refused, or moved to the nearest limit
-// when `clamp` is true.
+// when `clamp` is true. A robot without moving joints takes `count` 0
+// (`positions` may then be NULL): only its base moves.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
 // `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the

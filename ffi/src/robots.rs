@@ -430,7 +430,8 @@ fn joint_failure(e: JointError) -> Failure {
 /// see `gjkd_robot_joint()`) and, if `base` is not NULL, its base pose, in
 /// one round trip: the server places every link by forward kinematics. A
 /// position outside its limits is refused, or moved to the nearest limit
-/// when `clamp` is true.
+/// when `clamp` is true. A robot without moving joints takes `count` 0
+/// (`positions` may then be NULL): only its base moves.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
 /// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
@@ -464,7 +465,11 @@ pub unsafe extern "C" fn gjkd_set_joints(
                         "count {count}: the robot has {dof} moving joints"
                     )));
                 }
-                let q = slice(positions, count, "positions")?;
+                let q = if count == 0 {
+                    &[][..]
+                } else {
+                    slice(positions, count, "positions")?
+                };
                 set_joints(c, r, q, base.as_ref(), clamp)
             })
         }
@@ -479,9 +484,7 @@ fn set_joints(
     base: Option<&gjkd_pose>,
     clamp: bool,
 ) -> Result<(), Failure> {
-    if q.is_empty() {
-        return Err(Failure::invalid("the robot has no moving joint"));
-    }
+    // No positions for a robot without moving joints: only its base moves.
     let base = match base {
         Some(p) => Some(base_of(Some(p))?),
         None => None,

@@ -67,6 +67,10 @@ pub struct gjkd_scene_options {
     pub self_pairs: bool,
     /// Clamp joint positions outside their limits instead of refusing.
     pub clamp: bool,
+    /// Exact distances on every reported row: none with status
+    /// `GJKD_QUERY_BOUNDED` or `GJKD_QUERY_CLOSER` (motion bounds and early
+    /// exits still rule out pairs not reported).
+    pub exact: bool,
 }
 
 impl Default for gjkd_scene_options {
@@ -84,6 +88,7 @@ impl Default for gjkd_scene_options {
             all_pairs: false,
             self_pairs: false,
             clamp: false,
+            exact: false,
         }
     }
 }
@@ -107,7 +112,14 @@ pub struct gjkd_scene_row {
     pub step: u32,
     /// The pair's `gjkd_error_code`, 0 when answered.
     pub error: u32,
-    /// The pair's answer, `point_a` on `a`.
+    /// The pair's answer, `point_a` on `a`. `lower` and `upper` always
+    /// bound the true distance. With status `GJKD_QUERY_CONVERGED` (and
+    /// `ITERATION_CAP`, `TOLERANCE_NOT_MET` within their bounds) `distance`
+    /// and the points are the answer; with `GJKD_QUERY_CLOSER` (a within
+    /// pair proved inside the margin by an early exit) or
+    /// `GJKD_QUERY_BOUNDED` (from motion bounds, without GJK) they are an
+    /// estimate inside `[lower, upper]`, which may be wide. Set
+    /// `gjkd_scene_options.exact` for exact distances on every row.
     pub answer: gjkd_answer,
 }
 
@@ -210,6 +222,7 @@ impl<'a> Call<'a> {
         let bits = [
             (options.warm_start, scene_flags::WARM_START),
             (options.motion_bounds, scene_flags::MOTION_BOUNDS),
+            (options.exact, scene_flags::EXACT),
             (options.all_pairs, scene_flags::ALL_PAIRS),
             (options.self_pairs, scene_flags::SELF_PAIRS),
             (options.precision == 1, scene_flags::SINGLE_PRECISION),

@@ -193,6 +193,9 @@ pub struct ServerInfo {
     pub max_pieces: u32,
     /// Most clients per service.
     pub max_clients: u32,
+    /// Most rows in one scene answer ([`SceneRequest::max_rows`](crate::SceneRequest::max_rows)
+    /// above it is cut to it).
+    pub max_rows: u64,
     /// Most objects the server holds.
     pub max_objects: u64,
     /// Process id of the server.

@@ -243,14 +243,15 @@ impl Item {
     /// the item fails with [`ErrorCode::OutOfLimits`](crate::ErrorCode::OutOfLimits) and changes nothing.
     ///
     /// Layout: `a` is the robot, `b` the index of the first joint,
-    /// `max_iterations` the number of positions (1 to [`JOINTS_PER_ITEM`]),
+    /// `max_iterations` the number of positions (0 to [`JOINTS_PER_ITEM`]:
+    /// none moves only the base, as a robot without moving joints needs),
     /// carried in `pose_b.translation`, `pose_b.rotation`, `tolerance` and
     /// `margin`, in that order; flag [`item_flags::POSE_A`] sends a base pose
     /// in `pose_a`. A robot with more joints takes several items in one
     /// request (each computes the poses; only the last one's matter).
     ///
     /// # Panics
-    /// If `positions` is empty or longer than [`JOINTS_PER_ITEM`].
+    /// If `positions` is longer than [`JOINTS_PER_ITEM`].
     pub fn set_joints(
         robot: ObjectId,
         first: u32,
@@ -259,8 +260,8 @@ impl Item {
         clamp: bool,
     ) -> Self {
         assert!(
-            (1..=JOINTS_PER_ITEM).contains(&positions.len()),
-            "one item carries 1 to {JOINTS_PER_ITEM} joint positions"
+            positions.len() <= JOINTS_PER_ITEM,
+            "one item carries 0 to {JOINTS_PER_ITEM} joint positions"
         );
         let mut values = [0.0; JOINTS_PER_ITEM];
         values[..positions.len()].copy_from_slice(positions);
@@ -292,7 +293,7 @@ impl Item {
     /// count is out of range.
     pub fn joint_positions(&self) -> Option<([f64; JOINTS_PER_ITEM], usize)> {
         let count = self.max_iterations as usize;
-        if !(1..=JOINTS_PER_ITEM).contains(&count) {
+        if count > JOINTS_PER_ITEM {
             return None;
         }
         let [t0, t1, t2] = self.pose_b.translation;

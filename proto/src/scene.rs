@@ -111,6 +111,12 @@ pub mod scene_flags {
     /// Clamp joint positions outside their limits instead of refusing the
     /// request, as [`item_flags::CLAMP`](crate::item_flags::CLAMP).
     pub const CLAMP: u32 = 1 << 5;
+    /// Exact distances on every reported row: no row is answered from
+    /// motion bounds ([`Status::Bounded`](crate::Status::Bounded)) or
+    /// left at a margin's early exit ([`Status::Closer`](crate::Status::Closer));
+    /// each runs GJK to the tolerance. Motion bounds and early exits still
+    /// rule out pairs that are not reported.
+    pub const EXACT: u32 = 1 << 6;
     /// [`SceneKind::Within`](super::SceneKind::Within) and
     /// [`SceneKind::Clearance`](super::SceneKind::Clearance): the group's
     /// members meet each other too, but the allowed pairs (for a robot: its
@@ -119,8 +125,14 @@ pub mod scene_flags {
     /// Refused with nearest.
     pub const SELF_PAIRS: u32 = 1 << 10;
     /// Every bit this version knows; others are refused as malformed.
-    pub const ALL: u32 =
-        WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP | SELF_PAIRS;
+    pub const ALL: u32 = WARM_START
+        | MOTION_BOUNDS
+        | ALL_PAIRS
+        | SINGLE_PRECISION
+        | CUTOFF
+        | CLAMP
+        | EXACT
+        | SELF_PAIRS;
 }
 
 /// Bits of [`SceneReply::flags`].
@@ -161,7 +173,7 @@ pub struct SceneRequest {
     /// [`SceneKind::Nearest`]: how many objects.
     pub k: u32,
     /// Most rows the reply may carry (at most the server's
-    /// [`ServerInfo::max_batch`](crate::ServerInfo::max_batch)).
+    /// [`ServerInfo::max_rows`](crate::ServerInfo::max_rows)).
     pub max_rows: u32,
     /// [`scene_flags`] bits.
     pub flags: u32,
@@ -224,6 +236,12 @@ pub struct SceneRow {
     /// Zero.
     pub reserved: u32,
     /// The pair's answer, as a pair query's, with `point_a` on `a`.
+    /// `lower` and `upper` always bound the true distance; `distance` and
+    /// the points are exact (to the tolerance) for
+    /// [`Status::Converged`](crate::Status::Converged), and an estimate
+    /// inside the interval for [`Status::Closer`](crate::Status::Closer)
+    /// (a margin's early exit) and [`Status::Bounded`](crate::Status::Bounded)
+    /// (motion bounds); [`scene_flags::EXACT`] asks for exact rows only.
     pub result: ItemResult,
 }
 

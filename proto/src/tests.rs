@@ -88,6 +88,10 @@ fn joint_items_carry_their_positions() {
     let mut bad = short;
     bad.max_iterations = 10;
     assert_eq!(bad.joint_positions(), None);
+    // No position at all: the base of a robot without moving joints.
+    let base_only = Item::set_joints(robot, 0, &[], Some(&base), false);
+    assert_eq!(base_only.joint_positions(), Some(([0.0; 9], 0)));
+    assert_eq!(base_only.flags, item_flags::POSE_A);
 }
 
 #[test]

@@ -13,13 +13,23 @@ library's error against gjkd's certified interval ``[lower, upper]``.
 Needs the package installed (``pip install ./python``) and, for the peers,
 ``pip install coal python-fcl`` (left out with a note if missing). Starts its
 own server (``wait="spin"``).
+
+The Rust figure needs the ``batch_cost`` example, found in this order: the
+program ``$GJKD_BATCH_COST`` names; built with cargo in the gjkd checkout
+``--workspace`` names (default: the checkout this script sits in, if any)
+into the target directory cargo uses there (``$CARGO_TARGET_DIR`` when set);
+``batch_cost`` on ``$PATH``. Without any, its figure is left out with a
+note, so the script runs from an install or a read-only checkout as well.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
+import json
 import os
 import pathlib
+import shutil
 import statistics
 import subprocess
 import sys
@@ -93,24 +103,66 @@ def interval_error(d: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.nd
     return np.maximum(0.0, np.maximum(lower - d, d - upper))
 
 
-def rust_query_batch(service: str, ha: np.ndarray, hb: np.ndarray, pa: np.ndarray,
-                     pb: np.ndarray, repeats: int) -> Optional[float]:  # fmt: skip
-    """The Rust client's per-pair cost on the same pairs, in µs, or None if
-    the Rust example cannot be built here."""
-    target = HERE.parent.parent / "target"
-    build = subprocess.run(
-        ["cargo", "build", "--release", "--quiet", "-p", "gjkd-bench", "--example", "batch_cost"],
-        cwd=HERE,
+@functools.cache
+def batch_cost_program(workspace: Optional[pathlib.Path]) -> Optional[pathlib.Path]:
+    """The ``batch_cost`` example's program (see the module documentation),
+    or None with a note saying why there is none."""
+    named = os.environ.get("GJKD_BATCH_COST")
+    if named:
+        return pathlib.Path(named)
+    if workspace is None:
+        checkout = HERE.parent.parent
+        workspace = checkout if (checkout / "bench" / "examples").is_dir() else None
+    if workspace is not None and shutil.which("cargo"):
+        # Where cargo puts it, whatever sets that ($CARGO_TARGET_DIR, a
+        # .cargo/config.toml): cargo says.
+        meta = subprocess.run(
+            ["cargo", "metadata", "--format-version", "1", "--no-deps"],
+            cwd=workspace,
+            capture_output=True,
+            text=True,
+        )
+        build = subprocess.run(
+            [
+                "cargo",
+                "build",
+                "--release",
+                "--quiet",
+                "-p",
+                "gjkd-bench",
+                "--example",
+                "batch_cost",
+            ],
+            cwd=workspace,
+        )
+        if meta.returncode == 0 and build.returncode == 0:
+            target = pathlib.Path(json.loads(meta.stdout)["target_directory"])
+            return target / "release" / "examples" / "batch_cost"
+        print(f"(the Rust query_batch example did not build in {workspace})")
+    found = shutil.which("batch_cost")
+    if found:
+        return pathlib.Path(found)
+    print(
+        "(no batch_cost program: set GJKD_BATCH_COST, or --workspace to a gjkd checkout; "
+        "the Rust query_batch figure is left out)"
     )
-    if build.returncode != 0:
-        print("(the Rust query_batch example did not build: its figure is left out)")
+    return None
+
+
+def rust_query_batch(service: str, ha: np.ndarray, hb: np.ndarray, pa: np.ndarray,
+                     pb: np.ndarray, repeats: int,
+                     workspace: Optional[pathlib.Path]) -> Optional[float]:  # fmt: skip
+    """The Rust client's per-pair cost on the same pairs, in µs, or None
+    without the Rust example."""
+    program = batch_cost_program(workspace)
+    if program is None:
         return None
     data = np.concatenate([[len(ha)], np.hstack([ha, hb, pa, pb]).ravel()]).astype("<f8")
     with tempfile.NamedTemporaryFile(suffix=".f64", delete=False) as f:
         f.write(data.tobytes())
     try:
         out = subprocess.run(
-            [str(target / "release" / "examples" / "batch_cost"), service, f.name, str(repeats)],
+            [str(program), service, f.name, str(repeats)],
             capture_output=True,
             text=True,
             check=True,
@@ -182,6 +234,13 @@ def main() -> None:
         help="leave the server and this process unpinned (default: server on CPU 1, "
         "this process and the Rust client on CPU 0, as `gjkd bench latency` does)",
     )
+    parser.add_argument(
+        "--workspace",
+        type=pathlib.Path,
+        default=None,
+        help="a gjkd checkout to build the Rust example in (default: the one this script "
+        "sits in, if any); see GJKD_BATCH_COST",
+    )
     args = parser.parse_args()
     n = args.pairs
     ha, hb, pa, pb = box_pairs(n)
@@ -229,7 +288,7 @@ def main() -> None:
         python_1000, rust_1000 = [], []
         for _ in range(ROUNDS):
             python_1000.append(per_pair(batched(1000), n, args.repeats))
-            rust = rust_query_batch(service, ha, hb, pa, pb, args.repeats * 10)
+            rust = rust_query_batch(service, ha, hb, pa, pb, args.repeats * 10, args.workspace)
             if rust is not None:
                 rust_1000.append(rust)
         rows.append(
@@ -250,7 +309,9 @@ def main() -> None:
                 start = time.perf_counter_ns()
                 client.distance(a0, b0)
                 single.append(time.perf_counter_ns() - start)
-            one = rust_query_batch(service, ha[:1], hb[:1], pa[:1], pb[:1], args.single // ROUNDS)
+            one = rust_query_batch(
+                service, ha[:1], hb[:1], pa[:1], pb[:1], args.single // ROUNDS, args.workspace
+            )
             if one is not None:
                 rust_single.append(one)
         single_p50 = float(np.percentile(single, 50)) / 1000

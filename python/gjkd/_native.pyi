@@ -212,7 +212,17 @@ class Distances:
 
 @final
 class SceneRows:
-    """Room for the rows of scene answers, reused from call to call."""
+    """Room for the rows of scene answers, reused from call to call.
+
+    Which fields are exact depends on a row's ``status``: ``lower`` and
+    ``upper`` always bound the true distance. ``CONVERGED`` (and
+    ``ITERATION_CAP``, ``TOLERANCE_NOT_MET`` within their bounds):
+    ``distance`` and the points are the answer. ``CLOSER`` (a ``within``
+    pair proved inside the margin by an early exit) and ``BOUNDED``
+    (answered from motion bounds, without GJK): ``distance`` and the points
+    are an estimate inside ``[lower, upper]``, which may be wide. Pass
+    ``exact=True`` to a scene call for exact distances on every reported
+    row."""
 
     def __new__(cls, n: int) -> Self:
         """Zeroed room for ``n`` rows."""
@@ -434,7 +444,12 @@ class Client(_Objects):
         package_path: Sequence[_Path] = ...,
         base: Optional[_Pose] = None,
     ) -> Robot:
-        """Registers a robot from URDF (a file or text)."""
+        """Registers a robot from URDF (a file or text).
+
+        ``package://NAME/...`` mesh URLs are searched in ``package_path``,
+        then ``$GJKD_PACKAGE_PATH``, ``$ROS_PACKAGE_PATH`` and the ``share``
+        folder of each ``$AMENT_PREFIX_PATH`` prefix, as ROS searches them
+        (see the README's robot section)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
         """The robot ``name`` already on the server."""
     def set_joints(
@@ -445,7 +460,8 @@ class Client(_Objects):
         base: Optional[_Pose] = None,
         clamp: bool = False,
     ) -> None:
-        """Sets every joint (and the base) in one round trip."""
+        """Sets every joint (and the base) in one round trip; a robot without
+        moving joints takes ``[]`` and moves by ``base`` alone."""
     def clearance(
         self,
         group: _ArrayLike,
@@ -459,6 +475,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """Each member's nearest object outside ``group``."""
     def within(
@@ -476,6 +493,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """Every pair within ``margin``."""
     def nearest(
@@ -492,6 +510,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """The ``k`` objects nearest to ``object``."""
     def path(
@@ -512,6 +531,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """A question at every step of a candidate motion."""
     def path_joints(
@@ -533,6 +553,7 @@ class Client(_Objects):
         motion_bounds: bool = True,
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
+        exact: bool = False,
     ) -> SceneSummary:
         """A question at every step of a robot's motion given as ``(S, dof)`` joint positions."""
     def __enter__(self) -> Client: ...

@@ -244,11 +244,15 @@ backend_methods!(Client, {
     /// limits). `urdf` is a file path, `srdf` an optional SRDF file (its
     /// `disable_collisions` pairs); `urdf_text` / `srdf_text` give the
     /// text instead (then relative mesh paths are relative to the working
-    /// folder). `package://` mesh URLs are searched in `package_path`,
-    /// then `$GJKD_PACKAGE_PATH` and `$ROS_PACKAGE_PATH`. Returns a
-    /// `gjkd.Robot`. Raises `InvalidInput` (`field="urdf"`) for a URDF,
-    /// SRDF or mesh that cannot be read (the message names the file, link
-    /// or joint), `Refused` (`NAME_TAKEN`) when a link object of that name
+    /// folder). `package://NAME/...` mesh URLs are searched in
+    /// `package_path`, then `$GJKD_PACKAGE_PATH`, `$ROS_PACKAGE_PATH` and
+    /// the `share` folder of each `$AMENT_PREFIX_PATH` prefix, as ROS
+    /// searches them (`DIR/NAME/...` or a `DIR` named `NAME` first, then
+    /// the shallowest folder below a `DIR` whose `package.xml` names
+    /// `NAME`, up to six levels down). Returns a
+    /// `gjkd.Robot`. Raises `InvalidInput` (`INVALID_ROBOT`,
+    /// `field="urdf"`) for a URDF, SRDF or mesh that cannot be read (the
+    /// message names the file, link or joint), `Refused` (`NAME_TAKEN`) when a link object of that name
     /// exists; links registered before a failure are removed again.
     #[pyo3(signature = (name, urdf = None, *, srdf = None, urdf_text = None,
         srdf_text = None, package_path = Vec::new(), base = None))]
@@ -315,11 +319,12 @@ backend_methods!(Client, {
     /// when `base` is given: the server places every link by forward
     /// kinematics. `positions` is a `(dof,)` float64 array in
     /// `robot.joint_names` order, or a `{joint name: position}` dict
-    /// (joints not named keep their last positions). A position outside
+    /// (joints not named keep their last positions); a robot without
+    /// moving joints takes `[]` and moves by `base` alone. A position outside
     /// its limits raises `InvalidInput` (`OUT_OF_LIMITS`, `index` the
     /// joint) unless `clamp=True` moves it to the nearest limit; NaN
     /// raises `InvalidInput` (`NON_FINITE_POSE`); an unknown joint name
-    /// `NotFound`. Nothing moves on error.
+    /// `NotFound` (`UNKNOWN_NAME`). Nothing moves on error.
     #[pyo3(signature = (robot, positions, *, base = None, clamp = false))]
     fn set_joints(
         &mut self,
@@ -352,7 +357,7 @@ backend_methods!(Client, {
     }
 
     /// What the server said about itself at the last (re)connection, as a
-    /// dict (`protocol`, `wait`, `max_batch`, `max_vertices`,
+    /// dict (`protocol`, `wait`, `max_batch`, `max_rows`, `max_vertices`,
     /// `max_pieces`, `max_clients`, `max_objects`, `pid`); `None` while
     /// disconnected.
     fn server_info<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
@@ -363,6 +368,7 @@ backend_methods!(Client, {
         d.set_item("protocol", info.protocol)?;
         d.set_item("wait", info.wait)?;
         d.set_item("max_batch", info.max_batch)?;
+        d.set_item("max_rows", info.max_rows)?;
         d.set_item("max_vertices", info.max_vertices)?;
         d.set_item("max_pieces", info.max_pieces)?;
         d.set_item("max_clients", info.max_clients)?;

@@ -306,7 +306,8 @@ fn not_found(py: Python<'_>, field: &str, message: String) -> PyErr {
 fn joint_error(py: Python<'_>, handle: &RobotHandle, e: JointError) -> PyErr {
     let index_of = |joint: &str| handle.joint_names().iter().position(|n| *n == joint);
     let (kind, code, index) = match &e {
-        JointError::UnknownJoint(_) => (Kind::NotFound, None, None),
+        // The code a name that names nothing carries everywhere.
+        JointError::UnknownJoint(_) => (Kind::NotFound, Some(ErrorCode::UnknownName), None),
         JointError::NotFinite(j) => (
             Kind::InvalidInput,
             Some(ErrorCode::NonFinitePose),
@@ -392,7 +393,19 @@ pub fn register_robot(
                 &base,
             )
         })?
-        .map_err(|e| errors::client(py, e, Some("urdf")))?;
+        .map_err(|e| match e {
+            // A robot the client cannot read carries the code the server
+            // gives a robot it cannot attach (docs/errors.md).
+            gjkd_client::ClientError::Model(message) => Raise {
+                kind: Kind::InvalidInput,
+                message,
+                code: Some(ErrorCode::InvalidRobot),
+                field: Some("urdf"),
+                index: None,
+            }
+            .into_err(py),
+            e => errors::client(py, e, Some("urdf")),
+        })?;
     Ok(Robot::new(handle, base))
 }
 
@@ -424,15 +437,8 @@ pub fn set_joints(
     base: Option<&Bound<'_, PyAny>>,
     clamp: bool,
 ) -> PyResult<()> {
+    // No positions for a robot without moving joints: only its base moves.
     let q = robot.positions_of(py, positions)?;
-    if q.is_empty() {
-        return Err(invalid(
-            py,
-            "positions",
-            None,
-            "the robot has no moving joint".into(),
-        ));
-    }
     let base = checked_pose(py, base, "base")?.map(|p| isometry(&p));
     let mode = if clamp {
         LimitMode::Clamp

@@ -33,6 +33,15 @@ use crate::robots::{Robot, path_steps};
 ///   `normal`, `status` (`gjkd.Status`, `BOUNDED` for rows answered from
 ///   motion bounds), `error`, ...; `distance`, `lower`, `upper`, `status`
 ///   and `error` are also attributes of the rows themselves.
+///
+/// Which fields are exact depends on the row's `status`: `lower` and
+/// `upper` always bound the true distance. `CONVERGED` (and
+/// `ITERATION_CAP`, `TOLERANCE_NOT_MET`, within their bounds): `distance`
+/// and the points are the answer. `CLOSER` (a `within` pair proved inside
+/// the margin by an early exit) and `BOUNDED` (answered from motion
+/// bounds, without GJK): `distance` and the points are an estimate inside
+/// `[lower, upper]`, which may be wide. Pass `exact=True` for exact
+/// distances on every reported row.
 #[pyclass(module = "gjkd", name = "SceneRows")]
 pub struct SceneRows {
     a: Py<PyArray1<u64>>,
@@ -188,6 +197,8 @@ struct Options {
     motion_bounds: bool,
     accept_absolute: f64,
     accept_relative: f64,
+    /// Exact distances on every reported row.
+    exact: bool,
     cutoff: Option<f64>,
     /// Clamp a path's joint positions to their limits.
     clamp: bool,
@@ -207,6 +218,9 @@ impl Options {
         }
         if self.motion_bounds {
             r.flags |= scene_flags::MOTION_BOUNDS;
+        }
+        if self.exact {
+            r.flags |= scene_flags::EXACT;
         }
         if let Some(c) = self.cutoff {
             r.flags |= scene_flags::CUTOFF;
@@ -490,10 +504,12 @@ impl Client {
     /// never to report. `cutoff`: ignore objects farther than this (a
     /// member with nothing that near may get `b == 0`). `warm_start`,
     /// `motion_bounds`, `accept_absolute`, `accept_relative`: see the
-    /// README's "Scene queries". Raises `InvalidInput` (`UNKNOWN_OBJECT`,
+    /// README's "Scene queries"; `exact=True` runs every reported row to
+    /// convergence (no `BOUNDED` or `CLOSER` row: `distance` exact for
+    /// all). Raises `InvalidInput` (`UNKNOWN_OBJECT`,
     /// `INVALID_OPTIONS`, `MALFORMED`, ...) when the server refuses the
     /// whole request; nothing changes then.
-    #[pyo3(signature = (group, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (group, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn clearance<'py>(
         &mut self,
@@ -508,6 +524,7 @@ impl Client {
         motion_bounds: bool,
         accept_absolute: f64,
         accept_relative: f64,
+        exact: bool,
     ) -> PyResult<Summary> {
         let options = Options {
             tolerance,
@@ -516,6 +533,7 @@ impl Client {
             motion_bounds,
             accept_absolute,
             accept_relative,
+            exact,
             cutoff,
             clamp: false,
         };
@@ -537,7 +555,7 @@ impl Client {
     /// With `self_pairs=True`, also the group's members against each other
     /// but the allowed pairs (a robot's self-collisions: not its adjacent
     /// links nor the SRDF's disabled pairs). Other arguments as `clearance`.
-    #[pyo3(signature = (group, margin, *, out, all_pairs=false, self_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (group, margin, *, out, all_pairs=false, self_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn within<'py>(
         &mut self,
@@ -554,6 +572,7 @@ impl Client {
         motion_bounds: bool,
         accept_absolute: f64,
         accept_relative: f64,
+        exact: bool,
     ) -> PyResult<Summary> {
         let options = Options {
             tolerance,
@@ -562,6 +581,7 @@ impl Client {
             motion_bounds,
             accept_absolute,
             accept_relative,
+            exact,
             cutoff: None,
             clamp: false,
         };
@@ -589,7 +609,7 @@ impl Client {
 
     /// The `k` objects nearest to `object`, nearest first, into `out`.
     /// Other arguments as `clearance`.
-    #[pyo3(signature = (object, k, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (object, k, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn nearest<'py>(
         &mut self,
@@ -605,6 +625,7 @@ impl Client {
         motion_bounds: bool,
         accept_absolute: f64,
         accept_relative: f64,
+        exact: bool,
     ) -> PyResult<Summary> {
         if object.extract::<u64>().is_err() {
             return Err(invalid(py, "object", None, "object must be an id".into()));
@@ -616,6 +637,7 @@ impl Client {
             motion_bounds,
             accept_absolute,
             accept_relative,
+            exact,
             cutoff,
             clamp: false,
         };
@@ -643,7 +665,7 @@ impl Client {
     /// step in `out.step`. `self_pairs` as `within` (a clearance row's
     /// nearest object may then be another member). Other arguments as
     /// `clearance`.
-    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn path<'py>(
         &mut self,
@@ -663,6 +685,7 @@ impl Client {
         motion_bounds: bool,
         accept_absolute: f64,
         accept_relative: f64,
+        exact: bool,
     ) -> PyResult<Summary> {
         let (kind, mode) = path_question(py, question)?;
         let moving = id_array(objects, "objects")?;
@@ -682,6 +705,7 @@ impl Client {
             motion_bounds,
             accept_absolute,
             accept_relative,
+            exact,
             cutoff,
             clamp: false,
         };
@@ -707,7 +731,7 @@ impl Client {
     /// to the nearest limit; a NaN raises (`NON_FINITE_POSE`). `group` is
     /// usually the robot (`robot.id`, or the `Robot` itself, so that its
     /// allowed pairs apply). Other arguments as `path`.
-    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0))]
+    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn path_joints<'py>(
         &mut self,
@@ -728,6 +752,7 @@ impl Client {
         motion_bounds: bool,
         accept_absolute: f64,
         accept_relative: f64,
+        exact: bool,
     ) -> PyResult<Summary> {
         let (kind, mode) = path_question(py, question)?;
         let array = f64_array(positions, "positions")?;
@@ -753,6 +778,7 @@ impl Client {
             motion_bounds,
             accept_absolute,
             accept_relative,
+            exact,
             cutoff,
             clamp,
         };

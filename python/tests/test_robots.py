@@ -246,7 +246,13 @@ def test_joint_errors_change_nothing(client: gjkd.Client, arm: gjkd.Robot) -> No
         2,
     )
     raises(gjkd.InvalidInput, lambda: client.set_joints(arm, np.zeros(2)), None, "positions", None)
-    raises(gjkd.NotFound, lambda: client.set_joints(arm, {"wrist": 0.0}), None, "positions", None)
+    raises(
+        gjkd.NotFound,
+        lambda: client.set_joints(arm, {"wrist": 0.0}),
+        E.UNKNOWN_NAME,
+        "positions",
+        None,
+    )
     raises(
         gjkd.InvalidInput,
         lambda: client.set_joints(arm, np.zeros(3), base=[math.nan, 0, 0, 0, 0, 0, 1]),

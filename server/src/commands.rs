@@ -40,8 +40,8 @@ impl From<Wait> for WaitMode {
 /// The flags of `gjkd serve`.
 #[derive(Args, Debug)]
 pub struct ServeArgs {
-    /// Deployment name: the services are NAME/v1/query, NAME/v1/admin and
-    /// NAME/v1/wake.
+    /// Deployment name: the services are NAME/v1/query, NAME/v1/admin,
+    /// NAME/v1/scene and NAME/v1/wake.
     #[arg(long, default_value = DEFAULT_SERVICE)]
     pub service: String,
     /// Scene file (TOML) of read-only named objects to load at start.
@@ -71,9 +71,15 @@ pub struct ServeArgs {
     /// Most processes (iceoryx2 nodes) per service.
     #[arg(long, default_value_t = Limits::default().max_nodes)]
     pub max_nodes: usize,
-    /// Most items per query request.
+    /// Most items per query or scene request.
     #[arg(long, default_value_t = Limits::default().max_batch)]
     pub max_batch: usize,
+    /// Most rows per scene answer. Its shared memory is reserved for four
+    /// answers a client (152 bytes a row; sparse: resident only as answers
+    /// fill it). Clients split a longer path into several requests by
+    /// themselves.
+    #[arg(long, default_value_t = Limits::default().max_rows)]
+    pub max_rows: usize,
     /// Most vertices per registered object.
     #[arg(long, default_value_t = Limits::default().max_vertices)]
     pub max_vertices: usize,
@@ -173,6 +179,7 @@ pub fn serve_until(
         max_clients: args.max_clients.max(1),
         max_nodes: args.max_nodes.max(2),
         max_batch: args.max_batch.max(1),
+        max_rows: args.max_rows.max(1),
         max_vertices: args.max_vertices.max(1),
         max_pieces: MAX_PIECES,
         max_objects: args.max_objects,

@@ -227,10 +227,10 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .server_builder()
         .create()
         .map_err(server_port_error(&options.service, "admin server"))?;
-    // Sized as the query server (below): at most `max_batch` rows a reply.
+    // Sized as the query server (below), for `max_rows` rows a reply.
     let scene: SceneServer = scene_service
         .server_builder()
-        .initial_max_slice_len(limits.max_batch)
+        .initial_max_slice_len(limits.max_rows)
         .allocation_strategy(AllocationStrategy::Static)
         .override_response_preallocation(move |_| response_chunks(clients))
         .create()
@@ -644,7 +644,7 @@ fn serve_scenes(scene: &SceneServer, state: &mut State, scratch: &mut Vec<SceneR
                 );
                 return;
             }
-            let rows = (header.max_rows as usize).min(max_batch);
+            let rows = (header.max_rows as usize).min(state.limits().max_rows);
             if scratch.len() < rows {
                 scratch.resize(rows, SceneRow::default());
             }

@@ -458,9 +458,15 @@ mod tests {
         let mut bad_base = Item::set_joints(robot, 0, &[0.1], Some(&Isometry3::identity()), false);
         bad_base.pose_a.rotation = [0.0, 0.0, 0.0, 2.0];
         check(&mut s, bad_base, ErrorCode::BadQuaternion);
-        let mut zero = Item::set_joints(robot, 0, &[0.1], None, false);
-        zero.max_iterations = 0;
-        check(&mut s, zero, ErrorCode::Malformed);
+        let mut over = Item::set_joints(robot, 0, &[0.1], None, false);
+        over.max_iterations = 10;
+        check(&mut s, over, ErrorCode::Malformed);
+        // No position: the base alone moves (here to where it is), the
+        // joints stay.
+        let before = s.robots.get(robot.raw()).unwrap().positions.clone();
+        let r = one(&mut s, Item::set_joints(robot, 0, &[], None, false));
+        assert_eq!(r.error_code(), ErrorCode::Ok);
+        assert_eq!(s.robots.get(robot.raw()).unwrap().positions, before);
         // Clamping moves the slide to its upper limit.
         let r = one(&mut s, Item::set_joints(robot, 0, &[0.5, 0.6], None, true));
         assert_eq!(r.error_code(), ErrorCode::Ok);

@@ -25,8 +25,12 @@ pub struct Limits {
     pub max_clients: usize,
     /// Most iceoryx2 nodes (processes or `Client`s) attached to a service.
     pub max_nodes: usize,
-    /// Most items in one query request.
+    /// Most items in one query or scene request.
     pub max_batch: usize,
+    /// Most rows in one scene answer. Separate from `max_batch` because
+    /// one item of a path asks for a row per group member and step: a
+    /// robot path's answer has many more rows than its request has items.
+    pub max_rows: usize,
     /// Most vertices in one registration (all pieces together).
     pub max_vertices: usize,
     /// Most pieces in a compound, at most [`MAX_PIECES`].
@@ -43,6 +47,7 @@ impl Default for Limits {
             max_clients: 128,
             max_nodes: 256,
             max_batch: 1024,
+            max_rows: 4096,
             max_vertices: 100_000,
             max_pieces: MAX_PIECES,
             max_objects: 1 << 20,
@@ -227,6 +232,7 @@ impl State {
             max_vertices: clamp(self.limits.max_vertices),
             max_pieces: clamp(self.limits.max_pieces.min(MAX_PIECES)),
             max_clients: clamp(self.limits.max_clients),
+            max_rows: self.limits.max_rows as u64,
             max_objects: self.limits.max_objects as u64,
             pid: self.pid,
         }

@@ -208,7 +208,9 @@ fn by_travel(
     let w = widen_by(bound, travelled(ea.travel, then, moves));
     let outcome = if w.lower > q.margin {
         Outcome::Ruled
-    } else if w.upper <= q.margin || accepted(&w, q.accept_absolute, q.accept_relative) {
+    } else if !q.exact
+        && (w.upper <= q.margin || accepted(&w, q.accept_absolute, q.accept_relative))
+    {
         Outcome::Answer(bounded_result(bound, &w, ea, eb))
     } else {
         return None;

@@ -51,7 +51,7 @@ impl Search<'_, '_> {
                 ctx.counters.bounded += 1;
                 return None;
             }
-            if accepted(&w, q.accept_absolute, q.accept_relative) {
+            if !q.exact && accepted(&w, q.accept_absolute, q.accept_relative) {
                 let r = bounded_result(bound, &w, ea, eb);
                 ctx.counters.bounded += 1;
                 self.approximate.push((leaf, r.lower));

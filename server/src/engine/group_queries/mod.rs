@@ -79,6 +79,9 @@ pub(crate) struct Question {
     self_pairs: bool,
     /// [`scene_flags::MOTION_BOUNDS`].
     pub motion: bool,
+    /// [`scene_flags::EXACT`]: every reported row converged (no early exit,
+    /// no row from motion bounds; bounds still rule pairs out).
+    pub exact: bool,
     /// [`scene_flags::WARM_START`].
     pub warm: bool,
     clamp: bool,
@@ -177,6 +180,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         all_pairs: has(scene_flags::ALL_PAIRS),
         self_pairs: has(scene_flags::SELF_PAIRS),
         motion: has(scene_flags::MOTION_BOUNDS),
+        exact: has(scene_flags::EXACT),
         warm: has(scene_flags::WARM_START),
         clamp: has(scene_flags::CLAMP),
         options: gjk::Options {

@@ -2,7 +2,7 @@
 //! the question or is as narrow as the caller accepts, by GJK (the query
 //! service's own pair query, warm-started from the same cache) otherwise.
 
-use gjkd_proto::{ErrorCode, ItemResult};
+use gjkd_proto::{ErrorCode, ItemResult, Status};
 
 use super::broadphase::Broadphase;
 use super::entry::Entry;
@@ -132,9 +132,11 @@ impl Ctx<'_> {
         let mut kept: Option<(EntryAt, Option<WarmStart>)> = None;
         if let Some((at, bound, d, w)) = kept_bound(q, self.cache, &key, ea, eb) {
             let ok = accepted(&w, q.accept_absolute, q.accept_relative);
+            // An exact question takes bounds to rule pairs out, never to
+            // answer a row.
             let (ruled, settled) = match ask {
-                Ask::Within(m) => (w.lower > m, w.upper <= m || ok),
-                Ask::Below(best) => (w.lower >= best, ok),
+                Ask::Within(m) => (w.lower > m, !q.exact && (w.upper <= m || ok)),
+                Ask::Below(best) => (w.lower >= best, !q.exact && ok),
                 Ask::BelowExactly(best) => (w.lower >= best, false),
             };
             let outcome = if ruled {
@@ -152,7 +154,11 @@ impl Ctx<'_> {
                 return outcome;
             }
             let (bound, d) = (*bound, d);
-            let rechecked = if bound.penetration > 0.0 && matches!(ask, Ask::Within(_)) {
+            let rechecked = if q.exact && bound.penetration > 0.0 {
+                // An overlap re-certified answers a row: not exact.
+                kept = Some((at, None));
+                None
+            } else if bound.penetration > 0.0 && matches!(ask, Ask::Within(_)) {
                 let warm = self.cache.get_at(at);
                 kept = Some((at, Some(warm)));
                 self.recheck_overlap(&bound, ea, eb, &warm)
@@ -285,13 +291,30 @@ impl Ctx<'_> {
         }
         let warm = if q.warm { warm } else { None };
         self.counters.gjk_runs += 1;
-        match run_pair(
+        let mut outcome = run_pair(
             self.workspace,
             (&oa.shape, &ea.pose),
             (&ob.shape, &eb.pose),
             &options,
             warm.as_ref(),
-        ) {
+        );
+        if q.exact
+            && let Ok((result, next)) = &outcome
+            && result.status == Status::Closer as u32
+        {
+            // An exact question reports a pair within the margin with its
+            // converged distance: on from where the early exit stopped.
+            options.margin = None;
+            self.counters.gjk_runs += 1;
+            outcome = run_pair(
+                self.workspace,
+                (&oa.shape, &ea.pose),
+                (&ob.shape, &eb.pose),
+                &options,
+                Some(next),
+            );
+        }
+        match outcome {
             Ok((result, next)) => {
                 let key = self.key(a, b);
                 if q.motion {

@@ -39,6 +39,7 @@ use std::path::PathBuf;
 
 #[cfg(feature = "measure")]
 pub mod busy;
+#[cfg(feature = "measure")]
 pub mod collision_sweep;
 pub mod demo;
 #[cfg(feature = "measure")]
@@ -47,11 +48,13 @@ pub mod extremes;
 pub mod latency;
 #[cfg(feature = "measure")]
 pub mod latency_objects;
+#[cfg(feature = "measure")]
 pub mod paper;
 #[cfg(feature = "measure")]
 pub mod plot;
 #[cfg(feature = "measure")]
 pub mod raw_ipc;
+#[cfg(feature = "measure")]
 pub mod robot;
 pub mod robot_demo;
 pub mod scene_call;
@@ -249,6 +252,7 @@ pub(crate) fn spawn_child(
 }
 
 /// Creates the output directory.
+#[cfg(feature = "measure")]
 pub(crate) fn out_dir(common: &CommonArgs) -> Result<PathBuf, BenchError> {
     io(
         format!("create {}", common.out.display()),

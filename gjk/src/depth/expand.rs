@@ -24,21 +24,23 @@ pub(super) struct DepthFound {
     /// Certified upper bound: the least support value seen, with its
     /// round-off.
     pub(super) upper: f64,
-    /// The estimate, between the two: the nearest face's distance.
+    /// The estimate, between the two.
     pub(super) depth: f64,
-    /// The unit normal of the nearest face (from A towards B), or the
-    /// direction of the least support value when no polytope was built.
+    /// The unit direction of the least support value (from A towards B).
     pub(super) normal: Vector3<f64>,
-    /// A's and B's points on the nearest face, when a polytope was built.
-    pub(super) witnesses: Option<(Vector3<f64>, Vector3<f64>)>,
+    /// A's point on the nearest face, when a polytope was built: B's is
+    /// `depth · normal` behind it.
+    pub(super) witness_a: Option<Vector3<f64>>,
     /// Support points added to the polytope.
     pub(super) expansions: u32,
     /// Whether the nearest face met the tolerance.
     pub(super) converged: bool,
 }
 
-/// The least support value seen, and along which direction.
+/// The least support value seen (as computed, and certified), and along
+/// which direction.
 struct Upper {
+    computed: f64,
     value: f64,
     normal: Vector3<f64>,
 }
@@ -59,6 +61,7 @@ impl Upper {
         // vector's length by a few ε of `|w|`.
         let certified = h + frame.delta + 8.0 * f64::EPSILON * w.y.norm();
         if certified < self.value {
+            self.computed = h;
             self.value = certified;
             self.normal = unit;
         }
@@ -76,6 +79,7 @@ pub(super) fn expand(
     max_points: usize,
 ) -> DepthFound {
     let mut upper = Upper {
+        computed: f64::INFINITY,
         value: f64::INFINITY,
         normal: Vector3::zeros(),
     };
@@ -83,9 +87,9 @@ pub(super) fn expand(
         return DepthFound {
             lower: 0.0,
             upper: upper.value,
-            depth: 0.0f64.min(upper.value),
+            depth: upper.computed.max(0.0).min(upper.value),
             normal: upper.normal,
-            witnesses: None,
+            witness_a: None,
             expansions: 0,
             converged: true,
         };
@@ -111,20 +115,15 @@ pub(super) fn expand(
         expansions += 1;
     }
     let lower = polytope.certified_depth(frame.delta);
-    let (depth, normal, witnesses) = match last {
-        Some(face) => (
-            face.distance,
-            face.unit_normal(),
-            Some(polytope.witnesses(&face)),
-        ),
-        None => (0.0, upper.normal, None),
-    };
     DepthFound {
         lower,
         upper: upper.value,
-        depth: depth.max(lower).min(upper.value),
-        normal,
-        witnesses,
+        // The least support value: exact where the face is one of `K`'s,
+        // and where `K` is round it errs by the square of the normal's
+        // error, where the face's distance errs by the square of its size.
+        depth: upper.computed.max(lower).min(upper.value),
+        normal: upper.normal,
+        witness_a: last.map(|face| polytope.witness_a(&face)),
         expansions,
         converged,
     }

@@ -81,8 +81,13 @@ pub(super) fn piece_signed_distance(
     } else {
         Vector3::zeros()
     };
-    let (core_a, core_b): (Point3<f64>, Point3<f64>) = match found.witnesses {
-        Some((wa, wb)) => (frame.world_point(&wa), frame.world_point(&wb)),
+    // B's witness is A's moved by the signed distance along the normal,
+    // so that the two agree with the value exactly.
+    let (core_a, core_b): (Point3<f64>, Point3<f64>) = match found.witness_a {
+        Some(wa) => {
+            let core_a = frame.world_point(&wa);
+            (core_a, core_a + normal * core_value)
+        }
         None => (
             answer.point_a - answer.normal * ra,
             answer.point_b + answer.normal * rb,

@@ -17,7 +17,6 @@
 use nalgebra::Vector3;
 
 use super::frame::Vertex;
-use crate::johnson::triangle_weights;
 
 /// One oriented face: its points, `n = (q - p) × (r - p)` (outward), `n·p`,
 /// `|n|²` and the signed distance from the origin to its plane (negative
@@ -49,11 +48,6 @@ impl Face {
             len2,
             distance,
         }
-    }
-
-    /// The unit outward normal.
-    pub(super) fn unit_normal(&self) -> Vector3<f64> {
-        self.normal / self.len2.sqrt()
     }
 }
 
@@ -150,25 +144,14 @@ impl Polytope {
         true
     }
 
-    /// A's and B's points whose difference is the origin's projection on
-    /// `face`'s plane: the projection's weights in the face (clamped to the
-    /// triangle when round-off puts it just outside, equal for a face too
-    /// thin for weights).
-    pub(super) fn witnesses(&self, face: &Face) -> (Vector3<f64>, Vector3<f64>) {
+    /// A's point of the convex combination of `face`'s points nearest the
+    /// origin (the origin's projection on the face when it falls inside,
+    /// as it does on a converged face): by barycentric regions, which
+    /// stay defined on a sliver of a face.
+    pub(super) fn witness_a(&self, face: &Face) -> Vector3<f64> {
         let v = face.points.map(|i| self.points[i as usize]);
-        let projection = face.unit_normal() * face.distance;
-        let weights = triangle_weights(v.map(|p| p.y), &projection)
-            .map(|w| w.map(|x| x.max(0.0)))
-            .filter(|w| w.iter().sum::<f64>() > 0.0)
-            .unwrap_or([1.0; 3]);
-        let sum: f64 = weights.iter().sum();
-        let mut a = Vector3::zeros();
-        let mut y = Vector3::zeros();
-        for (p, w) in v.iter().zip(weights) {
-            a += p.a * (w / sum);
-            y += p.y * (w / sum);
-        }
-        (a, a - y)
+        let weights = nearest_weights(v.map(|p| p.y));
+        v.iter().zip(weights).map(|(p, w)| p.a * w).sum()
     }
 }
 
@@ -191,4 +174,48 @@ fn certified_distance(face: &Face, points: &[Vertex], delta: f64) -> f64 {
     // The offset `n·p`: the normal's error, the point's, its own sum.
     let doff = dn * (m + delta) + n * delta + 4.0 * U * n * m;
     (face.offset - doff) / (n + dn) * (1.0 - 4.0 * U)
+}
+
+/// The barycentric weights of the point of triangle `y` nearest the
+/// origin (Ericson, Real-Time Collision Detection 5.1.5), by its Voronoi
+/// regions: a vertex, an edge or the inside, each with weights that sum
+/// to 1 whatever the triangle's shape.
+fn nearest_weights(y: [Vector3<f64>; 3]) -> [f64; 3] {
+    let [a, b, c] = y;
+    let (ab, ac, ap) = (b - a, c - a, -a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = -b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = -c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = va + vb + vc;
+    if !(denom.is_finite() && denom != 0.0) {
+        return [1.0 / 3.0; 3];
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    [1.0 - v - w, v, w]
 }

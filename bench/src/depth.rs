@@ -19,6 +19,7 @@ use std::time::Instant;
 use gjk::{Convex, DepthOptions, Shape, signed_distance};
 use gjkd_testkit::minkowski_depth::minkowski_depth;
 use gjkd_testkit::reference::P;
+use gjkd_testkit::sweep::Rng;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::BenchError;
@@ -49,30 +50,21 @@ struct Pair {
     truth: f64,
 }
 
-/// A small deterministic generator (xorshift64*), so that every run
-/// measures the same pairs.
-struct Rng(u64);
+/// A uniform vector in the cube `[-1, 1)³`.
+fn vector(rng: &mut Rng) -> Vector3<f64> {
+    Vector3::new(
+        rng.uniform(-1.0, 1.0),
+        rng.uniform(-1.0, 1.0),
+        rng.uniform(-1.0, 1.0),
+    )
+}
 
-impl Rng {
-    /// Uniform in `[-1, 1)`.
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let bits = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        bits as f64 / (1u64 << 52) as f64 - 1.0
-    }
-
-    fn vector(&mut self) -> Vector3<f64> {
-        Vector3::new(self.next(), self.next(), self.next())
-    }
-
-    fn pose(&mut self, spread: f64) -> Isometry3<f64> {
-        Isometry3::from_parts(
-            Translation3::from(self.vector() * spread),
-            UnitQuaternion::from_scaled_axis(self.vector() * std::f64::consts::PI),
-        )
-    }
+/// A translation of up to `spread` along each axis and any rotation.
+fn pose(rng: &mut Rng, spread: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::from(vector(rng) * spread),
+        UnitQuaternion::from_scaled_axis(vector(rng) * std::f64::consts::PI),
+    )
 }
 
 /// Overlapping random polytope pairs, with the brute-force depth.
@@ -80,11 +72,11 @@ fn polytopes(n: usize, rng: &mut Rng) -> Vec<Pair> {
     let mut out = Vec::with_capacity(n);
     while out.len() < n {
         let cloud = |rng: &mut Rng| -> Vec<P> {
-            let k = 4 + (rng.next().abs() * 5.0) as usize;
-            (0..k).map(|_| P::from(rng.vector())).collect()
+            let k = 4 + rng.below(5);
+            (0..k).map(|_| P::from(vector(rng))).collect()
         };
         let (a, b) = (cloud(rng), cloud(rng));
-        let (pose_a, pose_b) = (rng.pose(0.6), rng.pose(0.6));
+        let (pose_a, pose_b) = (pose(rng, 0.6), pose(rng, 0.6));
         let placed = |s: &[P], p: &Isometry3<f64>| s.iter().map(|x| p * x).collect::<Vec<_>>();
         let Some((depth, _)) = minkowski_depth(&placed(&a, &pose_a), &placed(&b, &pose_b)) else {
             continue;
@@ -109,16 +101,16 @@ fn polytopes(n: usize, rng: &mut Rng) -> Vec<Pair> {
 fn cylinders(n: usize, rng: &mut Rng) -> Vec<Pair> {
     let mut out = Vec::with_capacity(n);
     while out.len() < n {
-        let (ra, ha) = (0.5 + 0.5 * rng.next().abs(), 0.5 + rng.next().abs());
-        let (rb, hb) = (0.2 + 0.5 * rng.next().abs(), 0.3 + rng.next().abs());
-        let angle = std::f64::consts::PI * rng.next();
-        let e = (ra + rb) * rng.next().abs();
-        let z = (ha + hb) * rng.next();
+        let (ra, ha) = (rng.uniform(0.5, 1.0), rng.uniform(0.5, 1.5));
+        let (rb, hb) = (rng.uniform(0.2, 0.7), rng.uniform(0.3, 1.3));
+        let angle = rng.uniform(-std::f64::consts::PI, std::f64::consts::PI);
+        let e = (ra + rb) * rng.unit_interval();
+        let z = (ha + hb) * rng.uniform(-1.0, 1.0);
         let depth = (ra + rb - e).min(ha + hb - z.abs());
         if depth <= 1e-3 * (ra + rb) {
             continue;
         }
-        let frame = rng.pose(2.0);
+        let frame = pose(rng, 2.0);
         let offset = Isometry3::translation(e * angle.cos(), e * angle.sin(), z);
         let (Ok(a), Ok(b)) = (Convex::cylinder(ra, ha, 0.0), Convex::cylinder(rb, hb, 0.0)) else {
             continue;
@@ -149,7 +141,7 @@ struct Row {
 /// # Errors
 /// A query that fails (none should).
 pub fn run(args: &DepthArgs) -> Result<(), BenchError> {
-    let mut rng = Rng(0x5eed_de97_0001);
+    let mut rng = Rng::new(0x5eed_de97_0001);
     let families = [
         ("polytopes", polytopes(args.pairs, &mut rng)),
         ("cylinders", cylinders(args.pairs, &mut rng)),

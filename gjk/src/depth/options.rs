@@ -14,9 +14,14 @@ pub struct DepthOptions {
     /// normal. The interval in the answer says what was reached. Finite
     /// and `>= 0`; the default is `1e-9`.
     pub tolerance: f64,
-    /// The most points the expanding polytope may have, at least 4 (a
-    /// polytope pair converges long before; curved shapes take more for a
-    /// small tolerance). The answer's interval holds wherever it stops.
+    /// The most points the expanding polytope may have, at least 4; the
+    /// default is 256. A polytope pair converges long before (a few
+    /// points); a round difference whose least support value is reached
+    /// along a whole ring of directions (coaxial cylinders) would need
+    /// thousands for its lower bound to meet a small tolerance, at a cost
+    /// that grows with their square, while the value, the least support
+    /// value seen, is exact there already. The answer's interval holds
+    /// wherever it stops.
     pub max_points: u32,
 }
 
@@ -25,7 +30,7 @@ impl Default for DepthOptions {
         DepthOptions {
             distance: Options::default(),
             tolerance: 1e-9,
-            max_points: 2048,
+            max_points: 256,
         }
     }
 }

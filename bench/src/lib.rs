@@ -43,6 +43,8 @@ pub mod busy;
 pub mod collision_sweep;
 pub mod demo;
 #[cfg(feature = "measure")]
+pub mod depth;
+#[cfg(feature = "measure")]
 pub mod extremes;
 #[cfg(feature = "measure")]
 pub mod latency;
@@ -94,6 +96,10 @@ enum BenchCommand {
     /// margins and f32 support search on the paper's family and an extremes
     /// family, and the f32 search on box clouds of 16 to 16 384 points.
     Tradeoff(tradeoff::TradeoffArgs),
+    /// The penetration depth's tolerance: time, error against the
+    /// brute-force depth and interval width on overlapping polytopes and
+    /// cylinders.
+    Depth(depth::DepthArgs),
     /// The paper's Section 7: time per query and per vertex against M.
     Paper(paper::PaperArgs),
     /// A 7-joint robot moved by one joint request with 70 link-obstacle
@@ -190,6 +196,10 @@ pub fn run(args: BenchArgs) -> Result<(), BenchError> {
         BenchCommand::Tradeoff(a) => {
             tradeoff::run(&a)?;
             "tradeoff"
+        }
+        BenchCommand::Depth(a) => {
+            depth::run(&a)?;
+            "depth"
         }
         BenchCommand::Paper(a) => {
             paper::run(&a)?;

@@ -154,6 +154,10 @@ pub use gjkd_proto::{
     ShapeError, Status, WaitMode, item_flags, result_flags, scene_flags, scene_reply_flags,
 };
 
+/// The signed distance of a pair query asked with
+/// [`QueryOptions::signed_distance`].
+pub use gjkd_proto::SignedDistance;
+
 // The crate's own plumbing, shared by the files that make up `Client`.
 pub(crate) use connection::Waited;
 pub(crate) use error::{ipc_err, reply_accepted};

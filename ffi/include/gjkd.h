@@ -54,6 +54,9 @@
 // hard case).
 #define GJKD_RESULT_BACKUP_USED 2
 
+// `gjkd_result::flags` bit: the signed-distance fields hold an answer.
+#define GJKD_RESULT_SIGNED_DISTANCE 4
+
 // What a call returns. `GJKD_OK` (0) is success; every other value is a
 // failure, described in words by `gjkd_last_error()`.
 typedef enum gjkd_status {
@@ -346,6 +349,11 @@ typedef struct gjkd_query_options {
   // Start from the simplex the server kept for this pair after this
   // handle's previous query of it (default true). Changes the time only.
   bool warm_start;
+  // Also answer the signed distance with its certified interval
+  // (`gjkd_answer::signed_distance`; default false): the penetration
+  // depth, negated, for overlapping pairs. Costs nothing for a pair
+  // proved apart.
+  bool signed_distance;
 } gjkd_query_options;
 
 // A rigid pose: translation, then rotation quaternion `[qx, qy, qz, qw]`.
@@ -429,6 +437,18 @@ typedef struct gjkd_answer {
   bool warm_started;
   // gjk's Backup Procedure ran (a numerically hard case).
   bool backup_used;
+  // Whether the signed-distance fields hold an answer (the query asked
+  // with `gjkd_query_options::signed_distance`).
+  bool has_signed_distance;
+  // The signed distance: the distance apart, minus the penetration
+  // depth (the shortest separating translation) overlapping. `point_a`,
+  // `point_b` and `normal` are then its witnesses and direction
+  // (`point_b - point_a = signed_distance * normal`).
+  double signed_distance;
+  // Certified lower bound on the signed distance.
+  double signed_lower;
+  // Certified upper bound on the signed distance.
+  double signed_upper;
 } gjkd_answer;
 
 // Caller-owned output arrays of `gjkd_distances()`, one row per pair. Each
@@ -525,6 +545,16 @@ typedef struct gjkd_result {
   uint32_t flags;
   // Pieces of A and B that realise the distance (0 for convex objects).
   uint32_t pieces[2];
+  // The signed distance when `flags` has `GJKD_RESULT_SIGNED_DISTANCE`
+  // (the query asked with `gjkd_query_options::signed_distance`), else
+  // 0: the distance apart, minus the penetration depth overlapping.
+  // `point_a`, `point_b` and `normal` are then its witnesses and
+  // direction.
+  double signed_distance;
+  // Certified lower bound on the signed distance (when flagged).
+  double signed_lower;
+  // Certified upper bound on the signed distance (when flagged).
+  double signed_upper;
 } gjkd_result;
 
 // Options of a scene query; start from `gjkd_scene_options_default()`.

@@ -34,13 +34,18 @@ const _: () = assert!(GJKD_RESULT_WARM_STARTED == gjkd_proto::result_flags::WARM
 pub const GJKD_RESULT_BACKUP_USED: u32 = 2;
 const _: () = assert!(GJKD_RESULT_BACKUP_USED == gjkd_proto::result_flags::BACKUP_USED);
 
+/// `gjkd_result::flags` bit: the signed-distance fields hold an answer.
+pub const GJKD_RESULT_SIGNED_DISTANCE: u32 = 4;
+const _: () = assert!(GJKD_RESULT_SIGNED_DISTANCE == gjkd_proto::result_flags::SIGNED_DISTANCE);
+
 /// `flags` bits a row of `gjkd_query_pairs()` may carry: the two pose bits
 /// and the bits `gjkd_pair_query_of()` sets from the options.
 const ROW_FLAGS: u32 = item_flags::POSE_A
     | item_flags::POSE_B
     | item_flags::MARGIN
     | item_flags::WARM_START
-    | item_flags::SINGLE_PRECISION;
+    | item_flags::SINGLE_PRECISION
+    | item_flags::SIGNED_DISTANCE;
 
 /// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
 /// server reads (so a batch of rows is copied into it in one piece). Make
@@ -126,6 +131,16 @@ pub struct gjkd_result {
     pub flags: u32,
     /// Pieces of A and B that realise the distance (0 for convex objects).
     pub pieces: [u32; 2],
+    /// The signed distance when `flags` has `GJKD_RESULT_SIGNED_DISTANCE`
+    /// (the query asked with `gjkd_query_options::signed_distance`), else
+    /// 0: the distance apart, minus the penetration depth overlapping.
+    /// `point_a`, `point_b` and `normal` are then its witnesses and
+    /// direction.
+    pub signed_distance: f64,
+    /// Certified lower bound on the signed distance (when flagged).
+    pub signed_lower: f64,
+    /// Certified upper bound on the signed distance (when flagged).
+    pub signed_upper: f64,
 }
 
 // `gjkd_result` is `ItemResult` under a C name: same size, alignment and
@@ -145,6 +160,9 @@ const _: () = {
     assert!(offset_of!(gjkd_result, iterations) == offset_of!(ItemResult, iterations));
     assert!(offset_of!(gjkd_result, flags) == offset_of!(ItemResult, flags));
     assert!(offset_of!(gjkd_result, pieces) == offset_of!(ItemResult, pieces));
+    assert!(offset_of!(gjkd_result, signed_distance) == offset_of!(ItemResult, signed_distance));
+    assert!(offset_of!(gjkd_result, signed_lower) == offset_of!(ItemResult, signed_lower));
+    assert!(offset_of!(gjkd_result, signed_upper) == offset_of!(ItemResult, signed_upper));
 };
 
 /// A row asking the distance of `a` and `b` at their stored poses, with
@@ -171,6 +189,9 @@ pub unsafe extern "C" fn gjkd_pair_query_of(
     }
     if o.precision == gjkd_precision::GJKD_PRECISION_SINGLE as u32 {
         flags |= item_flags::SINGLE_PRECISION;
+    }
+    if o.signed_distance {
+        flags |= item_flags::SIGNED_DISTANCE;
     }
     let identity = gjkd_pose {
         translation: [0.0; 3],

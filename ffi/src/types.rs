@@ -144,6 +144,11 @@ pub struct gjkd_query_options {
     /// Start from the simplex the server kept for this pair after this
     /// handle's previous query of it (default true). Changes the time only.
     pub warm_start: bool,
+    /// Also answer the signed distance with its certified interval
+    /// (`gjkd_answer::signed_distance`; default false): the penetration
+    /// depth, negated, for overlapping pairs. Costs nothing for a pair
+    /// proved apart.
+    pub signed_distance: bool,
 }
 
 impl Default for gjkd_query_options {
@@ -155,6 +160,7 @@ impl Default for gjkd_query_options {
             precision: gjkd_precision::GJKD_PRECISION_DOUBLE as u32,
             use_margin: false,
             warm_start: true,
+            signed_distance: false,
         }
     }
 }
@@ -187,6 +193,7 @@ impl gjkd_query_options {
             margin: self.use_margin.then_some(self.margin),
             warm_start: self.warm_start,
             precision,
+            signed_distance: self.signed_distance,
         })
     }
 }
@@ -304,6 +311,18 @@ pub struct gjkd_answer {
     pub warm_started: bool,
     /// gjk's Backup Procedure ran (a numerically hard case).
     pub backup_used: bool,
+    /// Whether the signed-distance fields hold an answer (the query asked
+    /// with `gjkd_query_options::signed_distance`).
+    pub has_signed_distance: bool,
+    /// The signed distance: the distance apart, minus the penetration
+    /// depth (the shortest separating translation) overlapping. `point_a`,
+    /// `point_b` and `normal` are then its witnesses and direction
+    /// (`point_b - point_a = signed_distance * normal`).
+    pub signed_distance: f64,
+    /// Certified lower bound on the signed distance.
+    pub signed_lower: f64,
+    /// Certified upper bound on the signed distance.
+    pub signed_upper: f64,
 }
 
 impl From<&ItemResult> for gjkd_answer {
@@ -321,6 +340,10 @@ impl From<&ItemResult> for gjkd_answer {
             pieces: r.pieces,
             warm_started: r.flags & gjkd_proto::result_flags::WARM_STARTED != 0,
             backup_used: r.flags & gjkd_proto::result_flags::BACKUP_USED != 0,
+            has_signed_distance: r.flags & gjkd_proto::result_flags::SIGNED_DISTANCE != 0,
+            signed_distance: r.signed_distance,
+            signed_lower: r.signed_lower,
+            signed_upper: r.signed_upper,
         }
     }
 }

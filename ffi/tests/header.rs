@@ -180,6 +180,21 @@ fn c_sees_the_wire_layouts_rust_sends() {
     );
     check("gjkd_result", "flags", offset_of!(ItemResult, flags));
     check("gjkd_result", "pieces", offset_of!(ItemResult, pieces));
+    check(
+        "gjkd_result",
+        "signed_distance",
+        offset_of!(ItemResult, signed_distance),
+    );
+    check(
+        "gjkd_result",
+        "signed_lower",
+        offset_of!(ItemResult, signed_lower),
+    );
+    check(
+        "gjkd_result",
+        "signed_upper",
+        offset_of!(ItemResult, signed_upper),
+    );
 
     let dir = std::env::temp_dir().join(format!("gjkd-layout-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");

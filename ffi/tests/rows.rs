@@ -260,6 +260,9 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
             iterations: want.iterations,
             flags: want.flags,
             pieces: want.pieces,
+            signed_distance: want.signed_distance,
+            signed_lower: want.signed_lower,
+            signed_upper: want.signed_upper,
         };
         assert_eq!(bits(got), bits(&want_row), "row {i}");
         assert_eq!(

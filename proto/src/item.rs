@@ -69,9 +69,22 @@ pub mod item_flags {
     /// round trip is made of. Refused as malformed on any other item and
     /// outside a path.
     pub const END_STEP: u32 = 1 << 6;
+    /// For [`super::ItemKind::Distance`]: also answer the signed distance
+    /// (negative inside, the penetration depth by an expanding polytope)
+    /// with its certified interval, in
+    /// [`ItemResult::signed_distance`](crate::ItemResult::signed_distance)
+    /// and the two fields after it. Costs nothing for a pair the distance
+    /// query proves apart.
+    pub const SIGNED_DISTANCE: u32 = 1 << 7;
     /// Every bit this version knows; others are rejected as malformed.
-    pub const ALL: u32 =
-        POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION | CLAMP | END_STEP;
+    pub const ALL: u32 = POSE_A
+        | POSE_B
+        | MARGIN
+        | WARM_START
+        | SINGLE_PRECISION
+        | CLAMP
+        | END_STEP
+        | SIGNED_DISTANCE;
 }
 
 /// Per-query options, the client-side view of [`Item`]'s option fields.
@@ -92,6 +105,11 @@ pub struct QueryOptions {
     pub warm_start: bool,
     /// Arithmetic of the support search (default [`Precision::Double`]).
     pub precision: Precision,
+    /// Also answer the signed distance with its certified interval
+    /// ([`Answer::signed`](crate::Answer::signed)); default off. With a
+    /// margin, a pair proved farther keeps the margin's interval (its
+    /// signed distance is its distance); the others are answered in full.
+    pub signed_distance: bool,
 }
 
 /// Arithmetic of the support search, the step whose cost grows with the
@@ -117,6 +135,7 @@ impl Default for QueryOptions {
             margin: None,
             warm_start: true,
             precision: Precision::Double,
+            signed_distance: false,
         }
     }
 }
@@ -192,6 +211,9 @@ impl Item {
         }
         if options.precision == Precision::Single {
             flags |= item_flags::SINGLE_PRECISION;
+        }
+        if options.signed_distance {
+            flags |= item_flags::SIGNED_DISTANCE;
         }
         Item {
             kind: ItemKind::Distance as u32,
@@ -366,6 +388,7 @@ impl Item {
             } else {
                 Precision::Double
             },
+            signed_distance: self.flags & item_flags::SIGNED_DISTANCE != 0,
         }
     }
 }

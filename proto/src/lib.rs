@@ -62,7 +62,7 @@ pub use geometry::{
 };
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
 pub use pose::{Pose, UNIT_TOLERANCE};
-pub use result::{Answer, ItemResult, ReplyHeader, Status, result_flags};
+pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
     PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags, scene_reply_flags,
 };

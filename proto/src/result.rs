@@ -56,6 +56,9 @@ pub mod result_flags {
     pub const WARM_STARTED: u32 = 1;
     /// gjk's Backup Procedure ran (a sign of a numerically hard case).
     pub const BACKUP_USED: u32 = 1 << 1;
+    /// The signed-distance fields hold an answer (the item asked for it
+    /// with [`item_flags::SIGNED_DISTANCE`](crate::item_flags::SIGNED_DISTANCE)).
+    pub const SIGNED_DISTANCE: u32 = 1 << 2;
 }
 
 /// The answer to one [`Item`](crate::Item). For a pose update only `error` is meaningful.
@@ -90,6 +93,17 @@ pub struct ItemResult {
     pub flags: u32,
     /// Pieces of A and B that realise the distance (0 for convex objects).
     pub pieces: [u32; 2],
+    /// The signed distance when [`result_flags::SIGNED_DISTANCE`] is set
+    /// (else 0): the distance apart, minus the penetration depth
+    /// overlapping. `point_a`, `point_b` and `normal` are then its
+    /// witnesses and direction (`point_b - point_a = signed_distance ·
+    /// normal`; `pieces` the deepest piece pair), the same as the
+    /// distance's when apart.
+    pub signed_distance: f64,
+    /// Certified lower bound on the signed distance (when flagged).
+    pub signed_lower: f64,
+    /// Certified upper bound on the signed distance (when flagged).
+    pub signed_upper: f64,
 }
 
 impl ItemResult {
@@ -108,6 +122,9 @@ impl ItemResult {
             iterations: 0,
             flags: 0,
             pieces: [0; 2],
+            signed_distance: 0.0,
+            signed_lower: 0.0,
+            signed_upper: 0.0,
         }
     }
 
@@ -133,6 +150,13 @@ impl ItemResult {
                 pieces: self.pieces,
                 warm_started: self.flags & result_flags::WARM_STARTED != 0,
                 backup_used: self.flags & result_flags::BACKUP_USED != 0,
+                signed: (self.flags & result_flags::SIGNED_DISTANCE != 0).then_some(
+                    SignedDistance {
+                        value: self.signed_distance,
+                        lower: self.signed_lower,
+                        upper: self.signed_upper,
+                    },
+                ),
             }),
             code => Err(code),
         }
@@ -175,6 +199,24 @@ pub struct Answer {
     pub warm_started: bool,
     /// gjk's Backup Procedure ran.
     pub backup_used: bool,
+    /// The signed distance with its certified interval, when the query
+    /// asked for it ([`QueryOptions::signed_distance`](crate::QueryOptions::signed_distance));
+    /// `point_a`, `point_b` and `normal` are then its witnesses and
+    /// direction, also when the shapes overlap.
+    pub signed: Option<SignedDistance>,
+}
+
+/// A signed distance with its certified interval: the distance apart,
+/// minus the penetration depth (the shortest translation that separates
+/// the shapes) overlapping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SignedDistance {
+    /// The signed distance.
+    pub value: f64,
+    /// Certified lower bound.
+    pub lower: f64,
+    /// Certified upper bound.
+    pub upper: f64,
 }
 
 /// Response header of the query service: whole-request errors. When `error`

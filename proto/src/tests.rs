@@ -37,9 +37,14 @@ fn item_encodes_options() {
         margin: Some(0.5),
         warm_start: false,
         precision: Precision::Single,
+        signed_distance: true,
     };
     let it = Item::distance(ObjectId::from_raw(3), ObjectId::from_raw(4), &o);
     assert_eq!(it.options(), o);
+    assert_eq!(
+        it.flags & item_flags::SIGNED_DISTANCE,
+        item_flags::SIGNED_DISTANCE
+    );
     assert_eq!(it.item_kind(), Some(ItemKind::Distance));
     assert_eq!(it.flags & item_flags::WARM_START, 0);
     assert_eq!(
@@ -52,6 +57,7 @@ fn item_encodes_options() {
         &QueryOptions::default(),
     );
     assert_eq!(d.flags & item_flags::SINGLE_PRECISION, 0);
+    assert_eq!(d.flags & item_flags::SIGNED_DISTANCE, 0);
     assert_eq!(d.options().precision, Precision::Double);
 }
 
@@ -113,6 +119,6 @@ fn text_round_trips_through_vertices() {
 fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<Pose>(), 56);
     assert_eq!(std::mem::size_of::<Item>(), 160);
-    assert_eq!(std::mem::size_of::<ItemResult>(), 128);
+    assert_eq!(std::mem::size_of::<ItemResult>(), 152);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
 }

@@ -160,6 +160,18 @@ class Answer:
     @property
     def backup_used(self) -> bool:
         """The Backup Procedure ran."""
+    @property
+    def signed_distance(self) -> Optional[float]:
+        """The signed distance when asked (``signed_distance=True``), else None.
+
+        The distance apart, minus the penetration depth (the shortest
+        translation that separates the shapes) overlapping; ``point_a``,
+        ``point_b`` and ``normal`` are then its witnesses and direction,
+        ``point_b - point_a = signed_distance * normal``.
+        """
+    @property
+    def signed_interval(self) -> Optional[Tuple[float, float]]:
+        """The certified ``(lower, upper)`` bounds of the signed distance, when asked."""
 
 @final
 class Distances:
@@ -395,8 +407,13 @@ class _Objects:
         max_iterations: int = 128,
         margin: Optional[float] = None,
         warm_start: bool = True,
+        signed_distance: bool = False,
     ) -> Answer:
-        """The distance between objects ``a`` and ``b``."""
+        """The distance between objects ``a`` and ``b``.
+
+        ``signed_distance=True`` also answers the signed distance (negative
+        inside) with its certified interval; free for a pair proved apart.
+        """
     def distances(
         self,
         pairs: _ArrayLike,

@@ -152,6 +152,8 @@ pub struct QueryArgs {
     pub margin: Option<f64>,
     /// Start from the pair's last simplex.
     pub warm_start: bool,
+    /// Also answer the signed distance (`distance` only).
+    pub signed_distance: bool,
 }
 
 /// One pair query.
@@ -170,6 +172,7 @@ pub fn distance(
         args.max_iterations,
         args.margin,
         args.warm_start,
+        args.signed_distance,
     )?;
     let mut item = Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(b), &opts);
     if let Some(p) = pose(pose_a, "pose_a")? {
@@ -215,6 +218,7 @@ pub fn distances(
         args.max_iterations,
         args.margin,
         args.warm_start,
+        args.signed_distance,
     )?;
     let arrays = RequestArrays::read(pairs, poses_a, poses_b)?;
     let result = Distances::reuse_or_new(py, out, arrays.len())?;
@@ -439,12 +443,17 @@ macro_rules! backend_methods {
             /// epsilon), `max_iterations` the iteration cap, `margin`
             /// an early exit (stop once the distance is proved above or at
             /// most it), `warm_start` starts from the pair's last simplex.
+            /// `signed_distance` also answers the signed distance (negative
+            /// inside: minus the penetration depth) with its certified
+            /// interval, in `Answer.signed_distance` and
+            /// `Answer.signed_interval`; it costs nothing for a pair proved
+            /// apart.
             /// Returns an `Answer`; a refused query raises (`NotFound` for
             /// an unknown id, `InvalidInput` for a bad pose).
             #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true),
-                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True)")]
+                margin = None, warm_start = true, signed_distance = false),
+                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, signed_distance=False)")]
             #[allow(clippy::too_many_arguments)]
             fn distance(
                 &mut self,
@@ -457,8 +466,11 @@ macro_rules! backend_methods {
                 max_iterations: u32,
                 margin: Option<f64>,
                 warm_start: bool,
+                signed_distance: bool,
             ) -> PyResult<crate::batch::Answer> {
-                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                let args = crate::api::QueryArgs {
+                    tolerance, max_iterations, margin, warm_start, signed_distance,
+                };
                 crate::api::distance(self, py, a, b, pose_a, pose_b, &args)
             }
 
@@ -488,7 +500,9 @@ macro_rules! backend_methods {
                 warm_start: bool,
                 out: Option<Bound<'_, crate::batch::Distances>>,
             ) -> PyResult<Py<crate::batch::Distances>> {
-                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                let args = crate::api::QueryArgs {
+                    tolerance, max_iterations, margin, warm_start, signed_distance: false,
+                };
                 crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
             }
 

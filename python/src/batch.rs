@@ -21,6 +21,7 @@ pub fn options(
     max_iterations: u32,
     margin: Option<f64>,
     warm_start: bool,
+    signed_distance: bool,
 ) -> PyResult<QueryOptions> {
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(
@@ -47,6 +48,7 @@ pub fn options(
         margin,
         warm_start,
         precision: Precision::Double,
+        signed_distance,
     })
 }
 
@@ -492,6 +494,11 @@ impl Answer {
     pub fn new(r: ItemResult) -> Self {
         Answer { r }
     }
+
+    /// Whether the signed-distance fields hold an answer.
+    fn signed(&self) -> bool {
+        self.r.flags & result_flags::SIGNED_DISTANCE != 0
+    }
 }
 
 #[pymethods]
@@ -549,6 +556,23 @@ impl Answer {
     #[getter]
     fn pieces(&self) -> (u32, u32) {
         (self.r.pieces[0], self.r.pieces[1])
+    }
+    /// The signed distance, when the query asked for it
+    /// (`signed_distance=True`), else `None`: the distance apart, minus
+    /// the penetration depth (the shortest translation that separates the
+    /// shapes) overlapping. `point_a`, `point_b` and `normal` are then its
+    /// witnesses and direction, `point_b - point_a = signed_distance *
+    /// normal`, also when the shapes overlap.
+    #[getter]
+    fn signed_distance(&self) -> Option<f64> {
+        self.signed().then_some(self.r.signed_distance)
+    }
+    /// The certified `(lower, upper)` interval of the signed distance,
+    /// when the query asked for it, else `None`.
+    #[getter]
+    fn signed_interval(&self) -> Option<(f64, f64)> {
+        self.signed()
+            .then_some((self.r.signed_lower, self.r.signed_upper))
     }
     /// The query started from the pair's last simplex.
     #[getter]

@@ -6,6 +6,8 @@
 //!
 //! - [`reference`](mod@reference): the brute-force distance between convex hulls, owing
 //!   nothing to GJK, against which gjk's answers are judged.
+//! - [`minkowski_depth`]: the brute-force penetration depth, from the
+//!   Minkowski difference's facets, for the signed distance's tests.
 //! - [`check`]: one answer against that reference, every property at once.
 //! - [`paper`]: the polytopes and pairs of the paper's Section 7 and the
 //!   collision sweep of its Section 8, rebuilt deterministically.
@@ -23,6 +25,7 @@
 
 pub mod check;
 pub mod input;
+pub mod minkowski_depth;
 /// The paper's test data (crate `gjkd-paper`, apart so that `gjkd demo`
 /// does not link the test kit).
 pub use gjkd_paper as paper;

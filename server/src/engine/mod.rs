@@ -19,6 +19,7 @@ pub mod objects;
 pub mod pair_query;
 pub mod records;
 pub mod robots;
+mod signed_pair;
 pub mod state;
 pub mod tokens;
 pub mod warm_cache;

@@ -50,6 +50,9 @@ pub(crate) fn run_pair(
         iterations: answer.iterations,
         flags,
         pieces: answer.pieces,
+        signed_distance: 0.0,
+        signed_lower: 0.0,
+        signed_upper: 0.0,
     };
     Ok((result, answer.warm_start))
 }

@@ -83,6 +83,9 @@ pub(crate) fn bounded_result(bound: &PairBound, w: &Widened, a: &Entry, b: &Entr
         iterations: 0,
         flags: 0,
         pieces: bound.pieces,
+        signed_distance: 0.0,
+        signed_lower: 0.0,
+        signed_upper: 0.0,
     }
 }
 

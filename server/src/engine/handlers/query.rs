@@ -5,6 +5,7 @@ use gjkd_proto::{ErrorCode, Item, ItemKind, ItemResult, item_flags};
 
 use crate::engine::checks::check_pose;
 use crate::engine::pair_query::run_pair;
+use crate::engine::signed_pair::add_signed_distance;
 use crate::engine::state::State;
 use crate::engine::warm_cache::PairKey;
 
@@ -109,7 +110,7 @@ impl State {
             b: item.b,
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
-        let (result, next) = run_pair(
+        let (mut result, next) = run_pair(
             &mut self.workspace,
             (&a.shape, &pose_a),
             (&b.shape, &pose_b),
@@ -118,6 +119,14 @@ impl State {
         )?;
         if warm_on {
             self.cache.put(key, next);
+        }
+        if item.flags & item_flags::SIGNED_DISTANCE != 0 {
+            add_signed_distance(
+                &mut result,
+                (&a.shape, &pose_a),
+                (&b.shape, &pose_b),
+                &options,
+            )?;
         }
         Ok(result)
     }

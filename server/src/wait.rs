@@ -314,7 +314,10 @@ mod tests {
                 delayed += spun;
             }
         }
-        assert!(delayed * 100 < n, "{delayed} of {n} requests waited for a spin");
+        assert!(
+            delayed * 100 < n,
+            "{delayed} of {n} requests waited for a spin"
+        );
     }
 
     #[test]

@@ -159,9 +159,17 @@ pub extern "C" fn gjkd_last_error() -> *const c_char {
     status::last_message()
 }
 
-/// The server's `gjkd_error_code` of the last call on this thread that
-/// failed, when it returned `GJKD_ERR_REJECTED`; `GJKD_CODE_OK` (0) when the
-/// last failure was of another kind.
+/// The `gjkd_error_code` of the last call on this thread that failed: the
+/// server's refusal for `GJKD_ERR_REJECTED`; for
+/// `GJKD_ERR_INVALID_ARGUMENT`, the code the server gives the same fault,
+/// when the library found it before sending (`GJKD_CODE_NON_FINITE_POSE`,
+/// `GJKD_CODE_BAD_QUATERNION`, `GJKD_CODE_INVALID_OPTIONS`,
+/// `GJKD_CODE_OUT_OF_LIMITS`, `GJKD_CODE_UNKNOWN_NAME`, ...);
+/// `GJKD_CODE_OK` (0) when no code applies (a NULL pointer, a count, a
+/// connection failure). So one fault has one status and one code whichever
+/// call meets it: a NaN pose given to `gjkd_set_pose()`, `gjkd_distance()`
+/// or `gjkd_register()`, or a NaN joint position, is
+/// `GJKD_ERR_INVALID_ARGUMENT` with `GJKD_CODE_NON_FINITE_POSE`.
 #[unsafe(no_mangle)]
 pub extern "C" fn gjkd_last_error_code() -> u32 {
     status::last_code()

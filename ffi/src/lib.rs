@@ -69,3 +69,10 @@ const _: () = assert!(GJKD_MAX_PIECES == gjkd_proto::MAX_PIECES);
 /// Longest object name, in bytes of UTF-8 (not counting the NUL).
 pub const GJKD_MAX_NAME_LEN: usize = 64;
 const _: () = assert!(GJKD_MAX_NAME_LEN == gjkd_proto::MAX_NAME_LEN);
+
+/// The largest magnitude of a pose's translation component, 2^998 (about
+/// 2.68e300): a pose beyond is refused with `GJKD_CODE_NON_FINITE_POSE`
+/// when it is set, so that any two stored poses stay within what a query
+/// accepts.
+pub const GJKD_MAX_TRANSLATION: f64 = 2.6787715179656683e300;
+const _: () = assert!(GJKD_MAX_TRANSLATION == gjkd_proto::MAX_TRANSLATION);

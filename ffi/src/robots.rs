@@ -297,8 +297,9 @@ pub unsafe extern "C" fn gjkd_robot_link(
 /// geometry).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`robot`, `name`, `out_id`),
-/// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_NAME` (no link of that
-/// name).
+/// `GJKD_ERR_INVALID_ARGUMENT` with last error code
+/// `GJKD_CODE_UNKNOWN_NAME` (no link of that name: looked up in the
+/// handle, nothing is asked of the server).
 ///
 /// # Safety
 /// `robot` is NULL or live; `name` NULL or NUL-terminated; `out_id` NULL
@@ -316,10 +317,12 @@ pub unsafe extern "C" fn gjkd_robot_link_id(
             *slot = 0;
             let r = required(robot, "robot")?;
             let name = req_str(name, "name")?;
+            // Looked up here, in the robot's own list: a caller's mistake,
+            // not a refusal by the server.
             if !r.handle.link_names().iter().any(|l| l == name) {
-                return Err(Failure::rejected(
+                return Err(Failure::invalid_code(
                     ErrorCode::UnknownName,
-                    &format!("link `{name}`: "),
+                    format!("the robot has no link `{name}`"),
                 ));
             }
             *slot = r.handle.link(name).map_or(0, |l| l.raw());
@@ -418,7 +421,8 @@ fn joint_failure(e: JointError) -> Failure {
     let code = match e {
         JointError::OutOfLimits { .. } => ErrorCode::OutOfLimits.raw(),
         JointError::NotFinite(_) | JointError::BadBase => ErrorCode::NonFinitePose.raw(),
-        JointError::UnknownJoint(_) | JointError::WrongCount { .. } => 0,
+        JointError::UnknownJoint(_) => ErrorCode::UnknownName.raw(),
+        JointError::WrongCount { .. } => 0,
     };
     Failure {
         code,

@@ -86,6 +86,16 @@ impl Failure {
         Failure::new(GJKD_ERR_INVALID_ARGUMENT, message)
     }
 
+    /// An argument out of its domain, found here before anything was
+    /// sent, that the server refuses with `code`: the caller sees the
+    /// same code whichever side finds the fault.
+    pub fn invalid_code(code: ErrorCode, message: impl Into<String>) -> Self {
+        Failure {
+            code: code.raw(),
+            ..Failure::invalid(message)
+        }
+    }
+
     /// A refusal by the server with `code`.
     pub fn rejected(code: ErrorCode, context: &str) -> Self {
         Failure {

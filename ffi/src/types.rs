@@ -5,7 +5,7 @@
 
 use gjkd_proto::{Pose, Precision};
 use nalgebra::Isometry3;
-use rust_client::{ItemResult, QueryOptions, ServerInfo, ServerStats};
+use rust_client::{ErrorCode, ItemResult, QueryOptions, ServerInfo, ServerStats};
 
 use crate::status::Failure;
 
@@ -39,22 +39,22 @@ impl gjkd_pose {
         self.wire().to_isometry_unchecked()
     }
 
-    /// Checks what the server would: finite, and a unit quaternion within
-    /// the server's tolerance.
-    pub fn check(&self) -> Result<(), &'static str> {
-        if !self
-            .translation
-            .iter()
-            .chain(&self.rotation)
-            .all(|c| c.is_finite())
-        {
-            return Err("has a NaN or infinite component");
+    /// Checks what the server checks ([`Pose::checked`]): finite, each
+    /// translation component within `GJKD_MAX_TRANSLATION`, a unit
+    /// quaternion within the server's tolerance. On failure, the server's
+    /// code and why in words.
+    pub fn check(&self) -> Result<(), (ErrorCode, &'static str)> {
+        match self.wire().checked() {
+            Ok(_) => Ok(()),
+            Err(ErrorCode::BadQuaternion) => Err((
+                ErrorCode::BadQuaternion,
+                "has a rotation quaternion that is not of unit length (within 1e-6)",
+            )),
+            Err(code) => Err((
+                code,
+                "has a NaN or infinite component, or a translation beyond GJKD_MAX_TRANSLATION",
+            )),
         }
-        let n2: f64 = self.rotation.iter().map(|c| c * c).sum();
-        if (n2.sqrt() - 1.0).abs() > 1e-6 {
-            return Err("has a rotation quaternion that is not of unit length (within 1e-6)");
-        }
-        Ok(())
     }
 }
 
@@ -164,19 +164,19 @@ impl gjkd_query_options {
     /// that a bad option is refused by name, before anything is sent).
     pub fn checked(&self) -> Result<QueryOptions, Failure> {
         if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
-            return Err(Failure::invalid("tolerance must be finite and >= 0"));
+            return Err(Failure::invalid_code(ErrorCode::InvalidOptions, "tolerance must be finite and >= 0"));
         }
         if self.max_iterations == 0 {
-            return Err(Failure::invalid("max_iterations must be at least 1"));
+            return Err(Failure::invalid_code(ErrorCode::InvalidOptions, "max_iterations must be at least 1"));
         }
         if self.use_margin && !self.margin.is_finite() {
-            return Err(Failure::invalid("margin must be finite"));
+            return Err(Failure::invalid_code(ErrorCode::InvalidOptions, "margin must be finite"));
         }
         let precision = match self.precision {
             0 => Precision::Double,
             1 => Precision::Single,
             p => {
-                return Err(Failure::invalid(format!(
+                return Err(Failure::invalid_code(ErrorCode::InvalidOptions, format!(
                     "precision {p} is not a gjkd_precision"
                 )));
             }

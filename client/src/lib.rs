@@ -127,6 +127,7 @@ mod error;
 mod objects;
 mod open_failure;
 mod pairs;
+mod reuse;
 mod robots;
 mod scene;
 

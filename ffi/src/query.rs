@@ -16,7 +16,7 @@ use crate::types::{gjkd_answer, gjkd_id, gjkd_pose, gjkd_query_options, gjkd_res
 /// stored is one every later query accepts.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pose`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (nothing is sent)
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (nothing is sent)
 /// with last error code `GJKD_CODE_NON_FINITE_POSE` (a NaN or infinite
 /// component, a translation component beyond `GJKD_MAX_TRANSLATION`) or
 /// `GJKD_CODE_BAD_QUATERNION` (a quaternion off unit length by more than
@@ -153,7 +153,7 @@ pub(crate) unsafe fn template(options: *const gjkd_query_options) -> Result<Item
 /// means `gjkd_query_options_default()`.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `out_answer`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (bad options, last
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (bad options, last
 /// error code `GJKD_CODE_INVALID_OPTIONS`; a pose given here that
 /// `gjkd_set_pose()` would refuse, with the same code:
 /// `GJKD_CODE_NON_FINITE_POSE` or `GJKD_CODE_BAD_QUATERNION`; nothing is
@@ -292,7 +292,7 @@ impl<'a> Outputs<'a> {
 /// array may then be NULL).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, and with a non-zero count
-/// `pairs`, `out`, `out->distance`, `out->error`), `GJKD_ERR_WRONG_THREAD`,
+/// `pairs`, `out`, `out->distance`, `out->error`), `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_INVALID_ARGUMENT` (bad options, a count larger than any
 /// array); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks
 /// answered before are written, the others left as they were).

@@ -987,13 +987,14 @@ fn every_mesh_and_robot_error_has_its_status() {
             + frames[3].rotation * Vector3::z() * 0.3;
         let b = ball(c, 0.05, &at(p.x, p.y, p.z));
         assert!((dist(c, tip, b) - 0.2).abs() < 1e-9);
-        // The client belongs to its thread; the robot holds no connection.
+        // The client and the robot serve any thread, one call at a time.
         let (c_addr, robot_addr) = (c as usize, robot as usize);
         let other = std::thread::spawn(move || {
             let (c, r) = (c_addr as *mut gjkd_client, robot_addr as *mut gjkd_robot);
-            gjkd_set_joints(c, r, [0.0; 3].as_ptr(), 3, null(), false)
+            gjkd_set_joints(c, r, [0.1, 0.2, 0.05].as_ptr(), 3, null(), false)
         });
-        assert_eq!(other.join().unwrap(), GJKD_ERR_WRONG_THREAD);
+        assert_eq!(other.join().unwrap(), GJKD_OK);
+        assert!((dist(c, tip, b) - 0.2).abs() < 1e-9);
         ok(gjkd_robot_free(robot));
         ok(gjkd_close(c));
     }

@@ -572,8 +572,14 @@ mod tests {
             .iter()
             .map(|n| s.lookup(n).unwrap())
             .collect();
-        assert_eq!(remove_robot(&mut s, "two", CLIENT + 1), Err(ErrorCode::NotOwner));
-        assert_eq!(remove_robot(&mut s, "nobody", CLIENT), Err(ErrorCode::UnknownName));
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT + 1),
+            Err(ErrorCode::NotOwner)
+        );
+        assert_eq!(
+            remove_robot(&mut s, "nobody", CLIENT),
+            Err(ErrorCode::UnknownName)
+        );
         assert_eq!(s.len(), before, "nothing removed on refusal");
         assert!(s.robots.get(id).is_some());
         assert_eq!(remove_robot(&mut s, "two", CLIENT), Ok(id));
@@ -583,9 +589,15 @@ mod tests {
         }
         assert!(s.robots.get(id).is_none());
         assert_eq!(s.robots.lookup("two"), None);
-        let r = one(&mut s, Item::set_joints(ObjectId::from_raw(id), 0, &[0.0, 0.0], None, false));
+        let r = one(
+            &mut s,
+            Item::set_joints(ObjectId::from_raw(id), 0, &[0.0, 0.0], None, false),
+        );
         assert_eq!(r.error_code(), ErrorCode::UnknownObject);
-        assert_eq!(remove_robot(&mut s, "two", CLIENT), Err(ErrorCode::UnknownName));
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT),
+            Err(ErrorCode::UnknownName)
+        );
         // The scene's ball is untouched; the names are free again.
         assert!(s.lookup("ball").is_some());
         assert_eq!(insert_links(&mut s, CLIENT), 3);
@@ -599,7 +611,10 @@ mod tests {
         insert_links(&mut s, CLIENT + 1);
         let id = attach_text(&mut s, URDF, CLIENT).unwrap();
         let before = s.len();
-        assert_eq!(remove_robot(&mut s, "two", CLIENT), Err(ErrorCode::NotOwner));
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT),
+            Err(ErrorCode::NotOwner)
+        );
         assert_eq!(s.len(), before);
         assert!(s.robots.get(id).is_some());
     }

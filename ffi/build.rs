@@ -24,7 +24,10 @@ fn main() {
         // library record its name and ABI version rather than the path it
         // was linked from, and a newer incompatible library can be
         // installed beside it.
-        println!("cargo::rustc-cdylib-link-arg=-Wl,-soname,libgjkd_c.so.{}", soname_version());
+        println!(
+            "cargo::rustc-cdylib-link-arg=-Wl,-soname,libgjkd_c.so.{}",
+            soname_version()
+        );
         // Only the gjkd_* functions are exported: a dependency's
         // #[no_mangle] functions (iceoryx2's logger hook) stay inside.
         println!("cargo::rustc-cdylib-link-arg=-Wl,--version-script={dir}/gjkd_c.map");

@@ -67,7 +67,9 @@ fn install(dir: &Path) -> std::path::PathBuf {
         assert_eq!(target, Path::new(&format!("libgjkd_c.so.{version}")));
     }
     if present("readelf") {
-        let dynamic = ok(Command::new("readelf").arg("-d").arg(lib.join("libgjkd_c.so")));
+        let dynamic = ok(Command::new("readelf")
+            .arg("-d")
+            .arg(lib.join("libgjkd_c.so")));
         assert!(dynamic.contains(&format!("[{soname}]")), "{dynamic}");
     }
     if present("nm") {
@@ -76,7 +78,11 @@ fn install(dir: &Path) -> std::path::PathBuf {
             .arg(lib.join("libgjkd_c.so")));
         let stray: Vec<&str> = symbols
             .lines()
-            .filter(|l| !l.split_whitespace().last().is_some_and(|s| s.starts_with("gjkd_")))
+            .filter(|l| {
+                !l.split_whitespace()
+                    .last()
+                    .is_some_and(|s| s.starts_with("gjkd_"))
+            })
             .collect();
         assert!(stray.is_empty(), "exported beside the C API: {stray:?}");
         assert!(symbols.contains(" T gjkd_connect"), "{symbols}");

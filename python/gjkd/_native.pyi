@@ -437,6 +437,8 @@ class Client(_Objects):
         """Registers a robot from URDF (a file or text)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
         """The robot ``name`` already on the server."""
+    def remove_robot(self, robot: Union[Robot, str]) -> None:
+        """Removes a robot (or the robot named so) with every link."""
     def set_joints(
         self,
         robot: Robot,

@@ -1276,7 +1276,7 @@ enum gjkd_status gjkd_set_joints(struct gjkd_client *client,
 //
 // Errors: as `gjkd_set_joints()`, plus `GJKD_ERR_NULL_POINTER` (`names`,
 // a name, `values`) and `GJKD_ERR_INVALID_ARGUMENT` for a name that is no
-// moving joint.
+// moving joint (last error code `GJKD_CODE_UNKNOWN_NAME`).
 //
 // # Safety
 // `names` NULL or `count` pointers to NUL-terminated strings, `values`

@@ -13,6 +13,24 @@ fn soname_version() -> String {
     }
 }
 
+/// Links `soname` to `libgjkd_c.so` where cargo puts the library
+/// (`target/<profile>` and its `deps`, three folders above `OUT_DIR`), so
+/// that a program linked against the build tree, which records the
+/// soname, finds the library there too (`LD_LIBRARY_PATH=target/release`),
+/// as it would in an install. Best effort: the links are a convenience.
+fn link_soname_in_build_tree(out: &str, soname: &str) {
+    let Some(profile) = std::path::Path::new(out).ancestors().nth(3) else {
+        return;
+    };
+    for dir in [profile.to_path_buf(), profile.join("deps")] {
+        let link = dir.join(soname);
+        if std::fs::symlink_metadata(&link).is_err() {
+            #[cfg(unix)]
+            let _ = std::os::unix::fs::symlink("libgjkd_c.so", &link);
+        }
+    }
+}
+
 fn main() {
     let dir = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
     let out = std::env::var("OUT_DIR").expect("cargo sets OUT_DIR");
@@ -24,10 +42,9 @@ fn main() {
         // library record its name and ABI version rather than the path it
         // was linked from, and a newer incompatible library can be
         // installed beside it.
-        println!(
-            "cargo::rustc-cdylib-link-arg=-Wl,-soname,libgjkd_c.so.{}",
-            soname_version()
-        );
+        let soname = format!("libgjkd_c.so.{}", soname_version());
+        println!("cargo::rustc-cdylib-link-arg=-Wl,-soname,{soname}");
+        link_soname_in_build_tree(&out, &soname);
         // Only the gjkd_* functions are exported: a dependency's
         // #[no_mangle] functions (iceoryx2's logger hook) stay inside.
         println!("cargo::rustc-cdylib-link-arg=-Wl,--version-script={dir}/gjkd_c.map");

@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
 # Installs the gjkd C library, headers, CMake package and pkg-config file:
 #
-#   ffi/install.sh PREFIX              # builds with cargo --release first
+#   ffi/install.sh PREFIX              # builds with cargo --profile dist
+#                                      # first (stripped, into target/dist)
 #   ffi/install.sh --from DIR PREFIX   # copies an existing build (DIR holds
 #                                      # libgjkd_c.so and libgjkd_c.a)
+#
+# The shared library is installed as libgjkd_c.so.VERSION, with links
+# from its soname (libgjkd_c.so.0.MINOR, what programs record) and from
+# libgjkd_c.so (what the linker looks for).
 #
 # Then find_package(gjkd) finds it with -DCMAKE_PREFIX_PATH=PREFIX, and
 # pkg-config with PKG_CONFIG_PATH=PREFIX/lib/pkgconfig.
@@ -18,18 +23,33 @@ fi
 prefix="${1:?usage: ffi/install.sh [--from DIR] PREFIX}"
 
 if [[ -z "$from" ]]; then
-  (cd "$here/.." && cargo build --release -p gjkd-c --lib)
+  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib)
   target="$(cd "$here/.." && cargo metadata --format-version 1 --no-deps \
     | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')"
-  from="$target/release"
+  from="$target/dist"
 fi
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$here/../Cargo.toml" | head -n1)"
 
 mkdir -p "$prefix/lib/cmake/gjkd" "$prefix/lib/pkgconfig" "$prefix/include"
 prefix="$(cd "$prefix" && pwd)"
 install -m 644 "$here/include/gjkd.h" "$here/include/gjkd.hpp" "$prefix/include/"
-install -m 755 "$from/libgjkd_c.so" "$prefix/lib/"
+soname="$(readelf -d "$from/libgjkd_c.so" 2>/dev/null \
+  | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')"
+soname="${soname:-libgjkd_c.so}"
+rm -f "$prefix/lib/libgjkd_c.so" "$prefix/lib/$soname"
+install -m 755 "$from/libgjkd_c.so" "$prefix/lib/libgjkd_c.so.$version"
+if [[ "$soname" != "libgjkd_c.so.$version" ]]; then
+  ln -s "libgjkd_c.so.$version" "$prefix/lib/$soname"
+fi
+if [[ "$soname" != libgjkd_c.so ]]; then
+  ln -s "libgjkd_c.so.$version" "$prefix/lib/libgjkd_c.so"
+fi
 install -m 644 "$from/libgjkd_c.a" "$prefix/lib/"
+# The static library carries the debug info of the Rust standard library
+# it bundles, whatever the profile: of no use to a C program's build.
+if command -v strip >/dev/null; then
+  strip --strip-debug "$prefix/lib/libgjkd_c.a"
+fi
 install -m 644 "$here/cmake/gjkdConfig.cmake" "$prefix/lib/cmake/gjkd/"
 sed "s|@VERSION@|$version|g" "$here/cmake/gjkdConfigVersion.cmake.in" \
   > "$prefix/lib/cmake/gjkd/gjkdConfigVersion.cmake"

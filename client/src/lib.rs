@@ -128,6 +128,7 @@ mod objects;
 mod open_failure;
 mod pairs;
 mod path_split;
+mod reuse;
 mod robots;
 mod scene;
 

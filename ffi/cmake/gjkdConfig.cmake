@@ -12,7 +12,6 @@ if(NOT TARGET gjkd::gjkd)
   add_library(gjkd::gjkd SHARED IMPORTED)
   set_target_properties(gjkd::gjkd PROPERTIES
     IMPORTED_LOCATION "${_gjkd_prefix}/lib/libgjkd_c.so"
-    IMPORTED_SONAME "libgjkd_c.so"
     INTERFACE_INCLUDE_DIRECTORIES "${_gjkd_prefix}/include")
 endif()
 

@@ -10,9 +10,18 @@
  * field, or gjkd_query_pairs, the fastest, rows in and rows out), then
  * gjkd_close(). Every function returns a gjkd_status; on failure,
  * gjkd_last_error() says why in words and, for GJKD_ERR_REJECTED,
- * gjkd_last_error_code() gives the server's gjkd_error_code. A handle
- * belongs to the thread that created it. Units are the caller's (the server
- * is unit-free); poses are translation + unit quaternion [qx, qy, qz, qw].
+ * gjkd_last_error_code() gives the server's gjkd_error_code (also, for
+ * GJKD_ERR_INVALID_ARGUMENT, the code of a fault found before sending). A
+ * handle serves one call at a time, from any thread. Units are the
+ * caller's (the server is unit-free; joint positions are radians, or the
+ * URDF's length unit for prismatic joints); poses are translation + unit
+ * quaternion [qx, qy, qz, qw] (Eigen's Quaterniond(w, x, y, z) constructor
+ * takes w first; its coeffs() are x, y, z, w as here).
+ *
+ * Objects outlive the handle that registered them: they stay on the
+ * server until removed, and a server with persistence (the default) keeps
+ * them across restarts. Remove them (gjkd_remove, gjkd_remove_robot), or
+ * register them to end with the handle (gjkd_set_registration_options).
  */
 
 #ifndef GJKD_H
@@ -37,6 +46,12 @@
 
 // Longest object name, in bytes of UTF-8 (not counting the NUL).
 #define GJKD_MAX_NAME_LEN 64
+
+// The largest magnitude of a pose's translation component, 2^998 (about
+// 2.68e300): a pose beyond is refused with `GJKD_CODE_NON_FINITE_POSE`
+// when it is set, so that any two stored poses stay within what a query
+// accepts.
+#define GJKD_MAX_TRANSLATION 2.6787715179656683e300
 
 // `gjkd_pair_query::flags` bit: this row's `pose_a` replaces the stored
 // pose of `a`, for this query only.
@@ -77,8 +92,9 @@ typedef enum gjkd_status {
   GJKD_ERR_INVALID_ARGUMENT = 4,
   // A pointer that must not be NULL was NULL. Nothing was sent.
   GJKD_ERR_NULL_POINTER = 5,
-  // The handle was used from a thread other than the one that created
-  // it. Nothing was sent.
+  // No longer returned: a handle may be used from any thread, one call
+  // at a time (see `GJKD_ERR_BUSY`). Kept so that code naming it
+  // still compiles.
   GJKD_ERR_WRONG_THREAD = 6,
   // A server serves the name with another protocol version than this
   // library's `GJKD_PROTOCOL_VERSION`.
@@ -97,6 +113,10 @@ typedef enum gjkd_status {
   // A bug inside the library was caught before it reached the caller;
   // the handle may be left in any state but is safe to close.
   GJKD_ERR_PANIC = 13,
+  // The handle was in a call on another thread at that moment: a handle
+  // serves one call at a time, from any thread. Nothing was sent; hold
+  // a mutex around the handle's calls, or use one handle per thread.
+  GJKD_ERR_BUSY = 14,
 } gjkd_status;
 
 // The server's error codes: per item in `gjkd_results::error`, and for a
@@ -124,8 +144,13 @@ enum gjkd_error_code
   GJKD_CODE_TOO_MANY_VERTICES = 6,
   // A radius is negative, NaN or infinite.
   GJKD_CODE_INVALID_RADIUS = 7,
-  // A batch has more items than the server accepts (never seen through
-  // this library: batches are split).
+  // A request has more items than the server accepts. Pair batches
+  // (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) are
+  // split by this library and never see it; a scene question sent as
+  // one request does: `gjkd_clearance()` and `gjkd_within()` with more
+  // members and allowed pairs, `gjkd_path()` and `gjkd_path_joints()`
+  // with more steps times moving objects (or joint items), than the
+  // server's `max_batch` (`gjkd_server_info()`).
   GJKD_CODE_BATCH_TOO_LARGE = 8,
   // A batch has no items.
   GJKD_CODE_EMPTY_BATCH = 9,
@@ -177,7 +202,9 @@ enum gjkd_query_status
   GJKD_QUERY_NONE = 0,
   // The stopping rule held: the distance is exact to the tolerance.
   GJKD_QUERY_CONVERGED = 1,
-  // Early exit: the distance is proved greater than the margin.
+  // Early exit: the distance is proved greater than the margin (never
+  // reported without a margin; with one, `GJKD_QUERY_CONVERGED` may
+  // come instead, see `gjkd_query_options::margin`).
   GJKD_QUERY_FARTHER = 2,
   // Early exit: the distance is proved at most the margin.
   GJKD_QUERY_CLOSER = 3,
@@ -210,16 +237,18 @@ enum gjkd_shape_kind
   GJKD_SHAPE_SPHERE = 1,
   // The segment from `a` to `b` grown by `radius`.
   GJKD_SHAPE_CAPSULE = 2,
-  // A box of half extents `a`, centred on the body origin, its edges
-  // rounded by `radius` (0 for a sharp box).
+  // A box of half extents `a`, centred on the body origin, grown by
+  // `radius` (every point within `radius` of the box: each half extent
+  // grows by `radius`, edges and corners become round; 0 for a sharp
+  // box).
   GJKD_SHAPE_BOX = 3,
   // The convex hull of `vertex_count` points at `vertices` grown by
   // `radius`.
   GJKD_SHAPE_POLYTOPE = 4,
   // An exact cylinder about the body z axis, centred on the body origin:
-  // the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`, its
-  // rims rounded by `radius` (0 for sharp rims). Never approximated by
-  // a polytope.
+  // the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`,
+  // grown by `radius` (radius and half-height each grow by it, the rims
+  // become round; 0 for sharp rims). Never approximated by a polytope.
   GJKD_SHAPE_CYLINDER = 5,
 };
 #ifndef __cplusplus
@@ -274,7 +303,7 @@ typedef uint32_t gjkd_path_question;
 #endif // __cplusplus
 
 // A connection to a gjkd server. Opaque: create it with `gjkd_connect()`,
-// use it from the thread that created it, free it with `gjkd_close()`.
+// use it from any thread, one call at a time, free it with `gjkd_close()`.
 typedef struct gjkd_client gjkd_client;
 
 // A robot registered on a server: its links (objects) and moving joints.
@@ -338,7 +367,10 @@ typedef struct gjkd_query_options {
   double tolerance;
   // Early-exit margin, used when `use_margin` is true: stop once the
   // distance is proved greater than it (`GJKD_QUERY_FARTHER`) or at most
-  // it (`GJKD_QUERY_CLOSER`). Finite.
+  // it (`GJKD_QUERY_CLOSER`). Finite. A query may still end
+  // `GJKD_QUERY_CONVERGED` (the exact distance found before a bound
+  // crossed the margin, as for objects that touch or are near the
+  // margin): compare `distance` with the margin then.
   double margin;
   // Iteration cap, at least 1 (default `GJKD_DEFAULT_MAX_ITERATIONS`).
   uint32_t max_iterations;
@@ -355,6 +387,24 @@ typedef struct gjkd_query_options {
   // proved apart.
   bool signed_distance;
 } gjkd_query_options;
+
+// How a handle's registrations treat names and the handle's end; set with
+// `gjkd_set_registration_options()`. Both off by default.
+typedef struct gjkd_registration_options {
+  // A registration whose name is taken gives the id of the object
+  // already under that name (its shape not compared, its pose not
+  // changed; a mesh's `out_info` then zeroed), and a robot registration
+  // whose name is taken gives that robot (attached again to its link
+  // objects if a restarted server kept them but not the robot): what a
+  // restarted node needs to get its objects back instead of
+  // `GJKD_CODE_NAME_TAKEN`.
+  bool reuse_names;
+  // Objects and robots registered from now on are removed when the
+  // handle is closed (`gjkd_close()`, the C++ destructor). A process
+  // that dies without closing leaves them, unless the server runs with
+  // `--remove-departed`.
+  bool remove_on_close;
+} gjkd_registration_options;
 
 // A rigid pose: translation, then rotation quaternion `[qx, qy, qz, qw]`.
 // Laid out as 7 consecutive doubles `[x, y, z, qx, qy, qz, qw]`, so an
@@ -386,7 +436,9 @@ typedef struct gjkd_mesh_info {
 typedef struct gjkd_shape {
   // A `gjkd_shape_kind` value.
   uint32_t kind;
-  // Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
+  // Rounding radius, finite and `>= 0`: the shape is grown by it (every
+  // point within `radius` of it), so each of its sizes grows by it (the
+  // ball's radius for a sphere).
   double radius;
   // Capsule: one end. Box: the half extents, each `>= 0`. Cylinder:
   // `{radius, half_height, 0}`, each `>= 0`.
@@ -672,8 +724,13 @@ extern "C" {
 // - `out_client`: receives the handle, owned by the caller, to be freed
 //   with `gjkd_close()`; set to NULL on failure.
 //
-// The handle belongs to the calling thread: calls from another thread
-// return `GJKD_ERR_WRONG_THREAD` (create one handle per thread).
+// The handle may be used from any thread, one call at a time: a call
+// made while another thread's call is using it returns `GJKD_ERR_BUSY`
+// and sends nothing. So a handle may be created on one thread, used on
+// others (a ROS 2 `MultiThreadedExecutor` runs one callback group's
+// callbacks on any of its threads) and closed on yet another. Share one
+// handle between callbacks that may run at once only behind a mutex (or
+// a `MutuallyExclusive` callback group), or give each its own handle.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`out_client`),
 // `GJKD_ERR_INVALID_ARGUMENT` (a timeout, a service name not UTF-8),
@@ -690,11 +747,15 @@ enum gjkd_status gjkd_connect(const char *service,
                               double connect_timeout_s,
                               struct gjkd_client **out_client);
 
-// Closes the connection and frees the handle. NULL is accepted and does
-// nothing. Objects the handle registered stay on the server until removed.
+// Closes the connection and frees the handle, from any thread. NULL is
+// accepted and does nothing. Objects the handle registered stay on the
+// server until removed (and, under a server with persistence, the
+// default, across server restarts too), except those registered while
+// `gjkd_registration_options::remove_on_close` was set, which are removed
+// now.
 //
-// Errors: `GJKD_ERR_WRONG_THREAD` (the handle is then not freed: close it
-// from its own thread).
+// Errors: `GJKD_ERR_BUSY` (a call on another thread is using the handle:
+// it is then not freed).
 //
 // # Safety
 // `client` is NULL or a handle from `gjkd_connect()` not yet closed; it
@@ -704,7 +765,7 @@ enum gjkd_status gjkd_close(struct gjkd_client *client);
 // What the server said about itself at the last (re)connection, into
 // `*out_info`.
 //
-// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 // `GJKD_ERR_SERVER_GONE` while disconnected (the next call reconnects).
 //
 // # Safety
@@ -713,7 +774,7 @@ enum gjkd_status gjkd_server_info(struct gjkd_client *client, struct gjkd_info *
 
 // The server's counters, into `*out_stats` (one round trip).
 //
-// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 // `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 //
 // # Safety
@@ -725,9 +786,17 @@ enum gjkd_status gjkd_stats(struct gjkd_client *client, struct gjkd_server_stats
 // gjkd call on this thread; copy it to keep it. Never NULL.
 const char *gjkd_last_error(void);
 
-// The server's `gjkd_error_code` of the last call on this thread that
-// failed, when it returned `GJKD_ERR_REJECTED`; `GJKD_CODE_OK` (0) when the
-// last failure was of another kind.
+// The `gjkd_error_code` of the last call on this thread that failed: the
+// server's refusal for `GJKD_ERR_REJECTED`; for
+// `GJKD_ERR_INVALID_ARGUMENT`, the code the server gives the same fault,
+// when the library found it before sending (`GJKD_CODE_NON_FINITE_POSE`,
+// `GJKD_CODE_BAD_QUATERNION`, `GJKD_CODE_INVALID_OPTIONS`,
+// `GJKD_CODE_OUT_OF_LIMITS`, `GJKD_CODE_UNKNOWN_NAME`, ...);
+// `GJKD_CODE_OK` (0) when no code applies (a NULL pointer, a count, a
+// connection failure). So one fault has one status and one code whichever
+// call meets it: a NaN pose given to `gjkd_set_pose()`, `gjkd_distance()`
+// or `gjkd_register()`, or a NaN joint position, is
+// `GJKD_ERR_INVALID_ARGUMENT` with `GJKD_CODE_NON_FINITE_POSE`.
 uint32_t gjkd_last_error_code(void);
 
 // The name of a `gjkd_status` value, such as `"GJKD_ERR_TIMEOUT"`
@@ -753,6 +822,46 @@ uint32_t gjkd_protocol_version(void);
 // double precision.
 struct gjkd_query_options gjkd_query_options_default(void);
 
+// Sets how the handle's later registrations treat names and the handle's
+// end (see `gjkd_registration_options`); registrations made before keep
+// what was set then. NULL `options` means both off, the default.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`), `GJKD_ERR_BUSY`.
+//
+// # Safety
+// `client` is NULL or a live handle; `options` NULL or readable.
+enum gjkd_status gjkd_set_registration_options(struct gjkd_client *client,
+                                               const struct gjkd_registration_options *options);
+
+// Removes `robot` from the server as a whole: its kinematics and every
+// link object, in one step (all or nothing; removing one link with
+// `gjkd_remove()` would leave a robot with a hole). `robot` stays to be
+// freed with `gjkd_robot_free()`; it names nothing on the server then.
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`), `GJKD_ERR_BUSY`,
+// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_NAME` (no robot of that
+// name: removed already, or a server restarted since, which keeps link
+// objects but not robots), `GJKD_CODE_NOT_OWNER` (another client's robot
+// or link), `GJKD_CODE_READ_ONLY` (a robot of the server's scene file),
+// `GJKD_CODE_STORAGE_FULL`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
+//
+// # Safety
+// `client` and `robot` are NULL or live.
+enum gjkd_status gjkd_remove_robot(struct gjkd_client *client, const struct gjkd_robot *robot);
+
+// Removes the robot named `name` as a whole, as `gjkd_remove_robot()`
+// does, for a program that holds no `gjkd_robot` of it (one restarted,
+// cleaning up after its previous run; that run's robot is another
+// client's unless this handle attached it again).
+//
+// Errors: as `gjkd_remove_robot()`, `GJKD_ERR_NULL_POINTER` for `name`,
+// `GJKD_ERR_INVALID_ARGUMENT` for a name not UTF-8 or longer than
+// `GJKD_MAX_NAME_LEN`.
+//
+// # Safety
+// `client` is NULL or live; `name` NULL or NUL-terminated.
+enum gjkd_status gjkd_remove_robot_named(struct gjkd_client *client, const char *name);
+
 // Registers the triangle mesh in the file at `path` (binary or ASCII STL,
 // OBJ, COLLADA `.dae`) and writes its id to `*out_id`.
 //
@@ -765,7 +874,7 @@ struct gjkd_query_options gjkd_query_options_default(void);
 // - `out_info`: NULL, or receives the pieces and the deviation.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `path`, `out_id`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a file missing or
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a file missing or
 // not a mesh, a bad scale, a decomposition that finds no pieces, a bad
 // pose or name; the message says which), `GJKD_ERR_REJECTED` with the
 // codes of `gjkd_register()` (`GJKD_CODE_TOO_MANY_PIECES` for a
@@ -815,7 +924,7 @@ enum gjkd_status gjkd_register_mesh(struct gjkd_client *client,
 // - `out_id`: receives the id (0 on failure).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `shape`, `out_id`, or a
-// polytope's `vertices` with a non-zero count), `GJKD_ERR_WRONG_THREAD`,
+// polytope's `vertices` with a non-zero count), `GJKD_ERR_BUSY`,
 // `GJKD_ERR_INVALID_ARGUMENT` (an unknown kind, a negative half extent, a
 // bad pose, a name empty, too long or not UTF-8),
 // `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`,
@@ -848,7 +957,8 @@ enum gjkd_status gjkd_register_sphere(struct gjkd_client *client,
 
 // Registers an exact cylinder about the body z axis, centred on the body
 // origin: the disk of `radius` swept from `z = -half_height` to
-// `z = +half_height`, its rims rounded by `rounding` (0 for sharp rims).
+// `z = +half_height`, grown by `rounding` (radius and half-height each
+// grow by it, the rims become round; 0 for sharp rims).
 // Arguments and errors as `gjkd_register()` (a negative, NaN or infinite
 // size is `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`).
 //
@@ -877,7 +987,8 @@ enum gjkd_status gjkd_register_capsule(struct gjkd_client *client,
                                        gjkd_id *out_id);
 
 // Registers a box of `half_extents` (three doubles, each `>= 0`) centred
-// on the body origin, its edges rounded by `radius` (0 for a sharp box).
+// on the body origin, grown by `radius` (each half extent grows by it,
+// edges and corners become round; 0 for a sharp box).
 // Arguments and errors as `gjkd_register()`, plus `GJKD_ERR_NULL_POINTER`
 // for `half_extents`.
 //
@@ -922,9 +1033,12 @@ enum gjkd_status gjkd_register_compound(struct gjkd_client *client,
                                         const struct gjkd_pose *pose,
                                         gjkd_id *out_id);
 
-// Removes an object this client registered. Its id is never reused.
+// Removes an object this client registered. Its id is never reused. A
+// robot's link removed so leaves the robot with a hole: remove a robot
+// whole with `gjkd_remove_robot()`. A robot's id (`gjkd_robot_info()`) is
+// no object id: given here, it is `GJKD_CODE_UNKNOWN_OBJECT`.
 //
-// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 // `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`,
 // `GJKD_CODE_NOT_OWNER` (another client's object) or
 // `GJKD_CODE_READ_ONLY` (a scene object); `GJKD_ERR_SERVER_GONE`,
@@ -938,7 +1052,7 @@ enum gjkd_status gjkd_remove(struct gjkd_client *client, gjkd_id id);
 // with a name by any client), into `*out_id` (0 on failure).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `out_id`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (not UTF-8, longer
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (not UTF-8, longer
 // than `GJKD_MAX_NAME_LEN`), `GJKD_ERR_REJECTED` with
 // `GJKD_CODE_UNKNOWN_NAME`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 //
@@ -950,10 +1064,15 @@ enum gjkd_status gjkd_lookup(struct gjkd_client *client, const char *name, gjkd_
 // Stores a new pose for object `id`, used by every later query (of any
 // client) that does not give its own.
 //
+// The pose is checked as the server checks it, when it is set: a pose
+// stored is one every later query accepts.
+//
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pose`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a NaN or infinite
-// component, a quaternion off unit length by more than 1e-6: nothing is
-// sent), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (nothing is sent)
+// with last error code `GJKD_CODE_NON_FINITE_POSE` (a NaN or infinite
+// component, a translation component beyond `GJKD_MAX_TRANSLATION`) or
+// `GJKD_CODE_BAD_QUATERNION` (a quaternion off unit length by more than
+// 1e-6), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
 // `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 //
 // # Safety
@@ -987,11 +1106,13 @@ enum gjkd_status gjkd_set_poses(struct gjkd_client *client,
 // means `gjkd_query_options_default()`.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `out_answer`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (bad options),
-// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`,
-// `GJKD_CODE_NON_FINITE_POSE` or `GJKD_CODE_BAD_QUATERNION` (a pose given
-// here); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`. On failure
-// `*out_answer` is zeroed.
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (bad options, last
+// error code `GJKD_CODE_INVALID_OPTIONS`; a pose given here that
+// `gjkd_set_pose()` would refuse, with the same code:
+// `GJKD_CODE_NON_FINITE_POSE` or `GJKD_CODE_BAD_QUATERNION`; nothing is
+// sent), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
+// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`. On failure `*out_answer` is
+// zeroed.
 //
 // # Safety
 // `client` is NULL or a live handle; the poses and options NULL or
@@ -1017,11 +1138,11 @@ enum gjkd_status gjkd_distance(struct gjkd_client *client,
 //
 // Batches larger than the server takes are split. The pairs go straight
 // into shared memory and the answers straight into `out`: nothing is
-// allocated per pair. A count of 0 does nothing (every array may then be
-// NULL).
+// allocated per pair. A count of 0 does nothing (`pairs`, `out` and every
+// array may then be NULL).
 //
-// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pairs`, `out`,
-// `out->distance`, `out->error`), `GJKD_ERR_WRONG_THREAD`,
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, and with a non-zero count
+// `pairs`, `out`, `out->distance`, `out->error`), `GJKD_ERR_BUSY`,
 // `GJKD_ERR_INVALID_ARGUMENT` (bad options, a count larger than any
 // array); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks
 // answered before are written, the others left as they were).
@@ -1053,7 +1174,7 @@ enum gjkd_status gjkd_distances(struct gjkd_client *client,
 //   folder.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_path`,
-// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a
+// `out_robot`), `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a
 // URDF, SRDF or mesh that cannot be read: the message names the file,
 // link or joint; a bad base pose), `GJKD_ERR_REJECTED` with
 // `GJKD_CODE_NAME_TAKEN` (an object `<name>/<link>` exists),
@@ -1093,7 +1214,7 @@ enum gjkd_status gjkd_register_robot_text(struct gjkd_client *client,
 // the joint order and link names. Writes a new robot to `*out_robot`.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_text`,
-// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT`
+// `out_robot`), `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT`
 // (URDF text that cannot be read), `GJKD_ERR_REJECTED` with
 // `GJKD_CODE_UNKNOWN_NAME`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 //
@@ -1111,7 +1232,10 @@ enum gjkd_status gjkd_open_robot(struct gjkd_client *client,
 enum gjkd_status gjkd_robot_free(struct gjkd_robot *robot);
 
 // The robot's id and its numbers of links and moving joints (each
-// output may be NULL).
+// output may be NULL). The robot's id is the group id of scene questions
+// about the robot (`gjkd_group::id`); it is no object id (robot ids are
+// their own namespace): its links are the objects, see
+// `gjkd_robot_link()`. Remove the robot with `gjkd_remove_robot()`.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`robot`).
 //
@@ -1140,8 +1264,9 @@ enum gjkd_status gjkd_robot_link(const struct gjkd_robot *robot,
 // geometry).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`robot`, `name`, `out_id`),
-// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_NAME` (no link of that
-// name).
+// `GJKD_ERR_INVALID_ARGUMENT` with last error code
+// `GJKD_CODE_UNKNOWN_NAME` (no link of that name: looked up in the
+// handle, nothing is asked of the server).
 //
 // # Safety
 // `robot` is NULL or live; `name` NULL or NUL-terminated; `out_id` NULL
@@ -1174,7 +1299,7 @@ enum gjkd_status gjkd_robot_joint(const struct gjkd_robot *robot,
 // (`positions` may then be NULL): only its base moves.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
 // number of moving joints; a position NaN or infinite, last error code
 // `GJKD_CODE_NON_FINITE_POSE`; outside its limits without `clamp`,
 // `GJKD_CODE_OUT_OF_LIMITS`; the message names the joint; a bad base
@@ -1197,7 +1322,7 @@ enum gjkd_status gjkd_set_joints(struct gjkd_client *client,
 //
 // Errors: as `gjkd_set_joints()`, plus `GJKD_ERR_NULL_POINTER` (`names`,
 // a name, `values`) and `GJKD_ERR_INVALID_ARGUMENT` for a name that is no
-// moving joint.
+// moving joint (last error code `GJKD_CODE_UNKNOWN_NAME`).
 //
 // # Safety
 // `names` NULL or `count` pointers to NUL-terminated strings, `values`
@@ -1252,7 +1377,7 @@ struct gjkd_pair_query gjkd_pair_query_of(gjkd_id a,
 // nothing (`queries` and `out` may then be NULL).
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `queries`, `out`),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
 // than any array; a row not made by `gjkd_pair_query_of()`, or whose
 // `flags` has bits other than those it set and `GJKD_POSE_A |
 // GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);
@@ -1273,17 +1398,20 @@ struct gjkd_scene_options gjkd_scene_options_default(void);
 
 // For each member of `group`, the nearest object outside the group: one
 // row per member into `rows` (room for `capacity`), the counts into
-// `*summary`. `options` NULL means `gjkd_scene_options_default()`.
+// `*summary`. `options` NULL means `gjkd_scene_options_default()`. An
+// empty group (`id` 0 and no members) has no member to answer for:
+// `GJKD_OK` with no rows (`written` and `total` 0), here and in
+// `gjkd_within()`.
 //
 // Errors: `GJKD_ERR_NULL_POINTER` (`client`, `group`, `summary`, `rows`
 // with a non-zero `capacity`, the group's arrays with non-zero counts),
-// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a precision that
+// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a precision that
 // is no `gjkd_precision`), `GJKD_ERR_REJECTED` with
 // `GJKD_CODE_UNKNOWN_OBJECT` (the group or a member),
 // `GJKD_CODE_INVALID_OPTIONS` (tolerance, iteration cap, accepted
-// accuracy, cut-off out of their domain), `GJKD_CODE_MALFORMED` (an empty
-// group), `GJKD_CODE_BATCH_TOO_LARGE` (more members and allowed pairs
-// than the server's `max_batch`); `GJKD_ERR_SERVER_GONE`,
+// accuracy, cut-off out of their domain), `GJKD_CODE_BATCH_TOO_LARGE`
+// (more members and allowed pairs than the server's `max_batch`, see
+// `gjkd_server_info()`); `GJKD_ERR_SERVER_GONE`,
 // `GJKD_ERR_TIMEOUT`, `GJKD_ERR_PROTOCOL` (a server without scene
 // queries). On failure nothing changed on the server and `*summary` is
 // zeroed.

@@ -2,11 +2,29 @@
 //
 // gjkd::Client owns a gjkd_client* (RAII, movable, not copyable) and turns
 // every failed call into a gjkd::Error carrying the gjkd_status, the
-// server's gjkd_error_code (for GJKD_ERR_REJECTED) and the message. Batches
-// take pointer + count, std::vector, or (C++20) std::span, and write into
-// a gjkd::Distances the caller keeps and reuses, or (query_pairs(), the
-// fastest) read PairQuery rows and write Result rows. Like the handle it wraps,
-// a Client belongs to the thread that created it.
+// gjkd_error_code (for GJKD_ERR_REJECTED, and for GJKD_ERR_INVALID_ARGUMENT
+// when the fault has one) and the message. Batches take pointer + count,
+// std::vector, or (C++20) std::span, and write into a gjkd::Distances the
+// caller keeps and reuses, or (query_pairs(), the fastest) read PairQuery
+// rows and write Result rows.
+//
+// Threads: a Client may be used from any thread, one call at a time (a
+// call overlapping another thread's call on the same Client throws
+// GJKD_ERR_BUSY), and destroyed on any thread. Under a ROS 2
+// MultiThreadedExecutor, give each callback group that may run at once
+// its own Client, or guard a shared one with a std::mutex.
+//
+// Units are the caller's (the server has none): lengths in whatever unit
+// the shapes were given in, joint positions in radians (prismatic joints
+// in the URDF's length unit). A Pose is a translation and a unit
+// quaternion stored x, y, z, w; Eigen's Quaterniond(w, x, y, z)
+// constructor takes w first (see quat(), and to_eigen() / from_eigen()
+// with GJKD_WITH_EIGEN defined before this header is included).
+//
+// Objects outlive the Client that registered them: they stay on the
+// server until removed, and a server with persistence (the default) keeps
+// them across restarts. Remove them (remove(), remove_robot()), or set
+// RegistrationOptions::remove_on_close to have them end with the Client.
 //
 //   gjkd::Client client("gjkd");
 //   gjkd::Id box = client.register_box({1, 1, 1});
@@ -16,12 +34,17 @@
 #define GJKD_HPP
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#ifdef GJKD_WITH_EIGEN
+#include <Eigen/Geometry>
+#endif
 
 #if __cplusplus >= 202002L && __has_include(<span>)
 #include <span>
@@ -56,21 +79,30 @@ using SceneRow = gjkd_scene_row;
 using SceneSummary = gjkd_scene_summary;
 /// Scene query options; start from default_scene_options().
 using SceneOptions = gjkd_scene_options;
+/// What a mesh registration made: its pieces and their deviation.
+using MeshInfo = gjkd_mesh_info;
+/// How registrations treat names and the Client's end (see
+/// Client::set_registration_options()).
+using RegistrationOptions = gjkd_registration_options;
+/// A unit quaternion, stored x, y, z, w (as Pose::rotation).
+using Quat = std::array<double, 4>;
 
-/// A failed call: what gjkd_status it returned, the server's code for
-/// GJKD_ERR_REJECTED (GJKD_CODE_OK otherwise), and the message.
+/// A failed call: what gjkd_status it returned, its gjkd_error_code (the
+/// server's for GJKD_ERR_REJECTED; for GJKD_ERR_INVALID_ARGUMENT the code
+/// the server gives the same fault, when it has one; GJKD_CODE_OK
+/// otherwise, see gjkd_last_error_code()), and the message.
 class Error : public std::runtime_error {
 public:
     Error(gjkd_status status, uint32_t code, const std::string &message)
-        : std::runtime_error(message), status_(status), code_(code) {}
+        : std::runtime_error(message), status_(status), code_(static_cast<gjkd_error_code>(code)) {}
     /// The call's status.
     gjkd_status status() const noexcept { return status_; }
-    /// The server's gjkd_error_code, for GJKD_ERR_REJECTED.
-    uint32_t code() const noexcept { return code_; }
+    /// The fault's code (GJKD_CODE_OK when none applies).
+    gjkd_error_code code() const noexcept { return code_; }
 
 private:
     gjkd_status status_;
-    uint32_t code_;
+    gjkd_error_code code_;
 };
 
 /// Throws the thread's last error if `status` is not GJKD_OK.
@@ -87,6 +119,97 @@ inline Pose identity() { return Pose{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}}; }
 inline Pose at(double x, double y, double z) {
     return Pose{{x, y, z}, {0.0, 0.0, 0.0, 1.0}};
 }
+
+/// The quaternion of components w, x, y, z, given in Eigen's constructor
+/// order (w first) and stored as a Pose stores it (x, y, z, w).
+inline Quat quat(double w, double x, double y, double z) { return Quat{x, y, z, w}; }
+
+/// The rotation by `angle` radians about `axis` (any non-zero length).
+inline Quat axis_angle(const std::array<double, 3> &axis, double angle) {
+    const double n = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    const double s = n > 0.0 ? std::sin(angle / 2.0) / n : 0.0;
+    return Quat{axis[0] * s, axis[1] * s, axis[2] * s, std::cos(angle / 2.0)};
+}
+
+/// The rotation by `yaw` about z, then `pitch` about the new y, then
+/// `roll` about the newest x (radians): R = Rz(yaw) Ry(pitch) Rx(roll), as
+/// URDF's `rpy` and ROS's tf2 setRPY(roll, pitch, yaw).
+inline Quat rpy(double roll, double pitch, double yaw) {
+    const double cr = std::cos(roll / 2), sr = std::sin(roll / 2);
+    const double cp = std::cos(pitch / 2), sp = std::sin(pitch / 2);
+    const double cy = std::cos(yaw / 2), sy = std::sin(yaw / 2);
+    return Quat{sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+                cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy};
+}
+
+/// The product a b: the rotation b, then a. (Named functions, not
+/// operators: Pose and Quat are C and std types, which argument-dependent
+/// lookup would not find gjkd's operators for.)
+inline Quat multiply(const Quat &a, const Quat &b) {
+    const double ax = a[0], ay = a[1], az = a[2], aw = a[3];
+    const double bx = b[0], by = b[1], bz = b[2], bw = b[3];
+    return Quat{aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz};
+}
+
+/// `q` applied to the vector `v`.
+inline std::array<double, 3> rotate(const Quat &q, const std::array<double, 3> &v) {
+    const Quat r = multiply(multiply(q, Quat{v[0], v[1], v[2], 0.0}), Quat{-q[0], -q[1], -q[2], q[3]});
+    return {r[0], r[1], r[2]};
+}
+
+/// The pose of translation (x, y, z) and rotation `q`.
+inline Pose pose(double x, double y, double z, const Quat &q) {
+    return Pose{{x, y, z}, {q[0], q[1], q[2], q[3]}};
+}
+
+/// The rotation of `p`.
+inline Quat rotation_of(const Pose &p) {
+    return Quat{p.rotation[0], p.rotation[1], p.rotation[2], p.rotation[3]};
+}
+
+/// The composition a b: `b`, expressed in `a`'s frame, placed in the
+/// world (a link's pose is compose(its parent's pose, its offset)).
+inline Pose compose(const Pose &a, const Pose &b) {
+    const Quat qa = rotation_of(a);
+    const std::array<double, 3> t =
+        rotate(qa, {b.translation[0], b.translation[1], b.translation[2]});
+    return pose(a.translation[0] + t[0], a.translation[1] + t[1], a.translation[2] + t[2],
+                multiply(qa, rotation_of(b)));
+}
+
+/// The inverse of `p`: compose(p, inverse(p)) is the identity.
+inline Pose inverse(const Pose &p) {
+    const Quat q{-p.rotation[0], -p.rotation[1], -p.rotation[2], p.rotation[3]};
+    const std::array<double, 3> t =
+        rotate(q, {-p.translation[0], -p.translation[1], -p.translation[2]});
+    return pose(t[0], t[1], t[2], q);
+}
+
+#ifdef GJKD_WITH_EIGEN
+/// `p` as an Eigen isometry (define GJKD_WITH_EIGEN before including this
+/// header; gjkd itself needs no Eigen).
+inline Eigen::Isometry3d to_eigen(const Pose &p) {
+    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+    iso.linear() =
+        Eigen::Quaterniond(p.rotation[3], p.rotation[0], p.rotation[1], p.rotation[2])
+            .toRotationMatrix();
+    iso.translation() = Eigen::Vector3d(p.translation[0], p.translation[1], p.translation[2]);
+    return iso;
+}
+
+/// The Pose of an Eigen isometry (its linear part must be a rotation).
+inline Pose from_eigen(const Eigen::Isometry3d &iso) {
+    const Eigen::Quaterniond q(iso.linear());
+    const Eigen::Vector3d t = iso.translation();
+    return pose(t.x(), t.y(), t.z(), Quat{q.x(), q.y(), q.z(), q.w()});
+}
+
+/// The Pose of an Eigen translation and quaternion.
+inline Pose from_eigen(const Eigen::Vector3d &t, const Eigen::Quaterniond &q) {
+    return pose(t.x(), t.y(), t.z(), Quat{q.x(), q.y(), q.z(), q.w()});
+}
+#endif
 
 /// A row asking the distance of `a` and `b` at their stored poses.
 inline PairQuery pair(Id a, Id b, const Options *options = nullptr) {
@@ -138,9 +261,17 @@ inline Shape capsule(const Vec3 &a, const Vec3 &b, double radius) {
     return Shape{GJKD_SHAPE_CAPSULE, radius, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, nullptr, 0};
 }
 
-/// A box of half extents `h`, edges rounded by `radius`.
+/// A box of half extents `h`, grown by `radius` (each half extent grows
+/// by it, edges and corners become round).
 inline Shape box(const Vec3 &h, double radius = 0.0) {
     return Shape{GJKD_SHAPE_BOX, radius, {h[0], h[1], h[2]}, {0, 0, 0}, nullptr, 0};
+}
+
+/// An exact cylinder about z: the disk of `radius` swept over
+/// [-half_height, half_height], grown by `rounding` (radius and
+/// half-height each grow by it, the rims become round).
+inline Shape cylinder(double radius, double half_height, double rounding = 0.0) {
+    return Shape{GJKD_SHAPE_CYLINDER, rounding, {radius, half_height, 0}, {0, 0, 0}, nullptr, 0};
 }
 
 /// The hull of `count` points (3 doubles each at `xyz`) grown by `radius`.
@@ -168,7 +299,9 @@ public:
         normal.resize(n);
         status.resize(n);
         iterations.resize(n);
+        pieces.resize(n);
         error.resize(n);
+        warm_started.resize(n);
     }
 
     /// Rows.
@@ -186,9 +319,15 @@ public:
         r.normal = normal.empty() ? nullptr : normal[0].data();
         r.status = status.data();
         r.iterations = iterations.data();
+        r.pieces = pieces.empty() ? nullptr : pieces[0].data();
         r.error = error.data();
+        // std::vector<bool> has no array: the flags go through bytes.
+        r.warm_started = reinterpret_cast<bool *>(warm_started.data());
         return r;
     }
+
+    /// Whether row `i` started from the pair's last simplex.
+    bool warm(std::size_t i) const { return warm_started[i] != 0; }
 
     std::vector<double> distance;    ///< Distances.
     std::vector<double> lower;       ///< Certified lower bounds.
@@ -199,8 +338,14 @@ public:
     std::vector<Vec3> normal;        ///< Unit normals from A towards B.
     std::vector<uint32_t> status;    ///< gjkd_query_status values.
     std::vector<uint32_t> iterations; ///< Iterations.
+    /// Pieces of A and B that realise the distance (0 for convex objects).
+    std::vector<std::array<uint32_t, 2>> pieces;
     std::vector<uint32_t> error;     ///< gjkd_error_code values, 0 if answered.
+    /// Whether each query started warm (see warm()); bytes of a bool.
+    std::vector<unsigned char> warm_started;
 };
+
+static_assert(sizeof(bool) == sizeof(unsigned char), "warm_started holds one bool per byte");
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
 
@@ -225,7 +370,9 @@ public:
 
     /// The C handle; still owned here.
     gjkd_robot *native_handle() const noexcept { return handle_; }
-    /// The robot's object id.
+    /// The robot's id: the Group id of scene questions about it. No object
+    /// id (remove() does not take it): its links are the objects, see
+    /// link(); remove the robot with Client::remove_robot().
     Id id() const { return info().id; }
     /// Number of moving joints.
     std::size_t dof() const { return info().joints; }
@@ -250,10 +397,46 @@ public:
         return names;
     }
     /// The object id of link `name` (0 for a link without geometry).
+    /// Throws GJKD_ERR_INVALID_ARGUMENT with GJKD_CODE_UNKNOWN_NAME for a
+    /// name that is no link (looked up here, not on the server).
     Id link(const std::string &name) const {
         Id id = 0;
         check(gjkd_robot_link_id(handle_, name.c_str(), &id));
         return id;
+    }
+    /// The number of links.
+    std::size_t links() const { return info().links; }
+    /// Moving joint `index`'s limits (-inf, inf for a continuous joint).
+    std::pair<double, double> joint_limits(std::size_t index) const {
+        double lower = 0, upper = 0;
+        check(gjkd_robot_joint(handle_, index, nullptr, &lower, &upper, nullptr));
+        return {lower, upper};
+    }
+    /// The joint positions last set, in joint_names() order.
+    std::vector<double> positions() const {
+        std::vector<double> q(dof());
+        for (std::size_t i = 0; i < q.size(); ++i) {
+            check(gjkd_robot_joint(handle_, i, nullptr, nullptr, nullptr, &q[i]));
+        }
+        return q;
+    }
+    /// Every link's pose (URDF order, into `out`, resized to links()) by
+    /// forward kinematics, computed here as the server computes it, for
+    /// `count` positions (none: the positions last set) and `base` (null:
+    /// the base last sent).
+    void link_poses(std::vector<Pose> &out, const double *positions = nullptr,
+                    std::size_t count = 0, const Pose *base = nullptr,
+                    bool clamp = false) const {
+        out.resize(links());
+        check(gjkd_robot_link_poses(handle_, positions, count, base, clamp, out.data(),
+                                    out.size()));
+    }
+    /// Every link's pose for `positions` and `base`.
+    std::vector<Pose> link_poses(const std::vector<double> &positions,
+                                 const Pose &base = identity(), bool clamp = false) const {
+        std::vector<Pose> out;
+        link_poses(out, positions.data(), positions.size(), &base, clamp);
+        return out;
     }
 
 private:
@@ -280,8 +463,10 @@ public:
                     double connect_timeout_s = 0.0) {
         check(gjkd_connect(service.c_str(), timeout_s, connect_timeout_s, &handle_));
     }
-    /// Closes the connection. Destroy a Client on the thread that created
-    /// it: gjkd_close() refuses other threads, and the handle would leak.
+    /// Closes the connection, on any thread, removing what was registered
+    /// with RegistrationOptions::remove_on_close. (Only a call running on
+    /// another thread at that moment could stop it: destroying an object
+    /// in use is a bug in any case.)
     ~Client() { gjkd_close(handle_); }
     Client(const Client &) = delete;
     Client &operator=(const Client &) = delete;
@@ -332,7 +517,7 @@ public:
         return id;
     }
     /// Registers an exact cylinder about z: the disk of `radius` swept over
-    /// `[-half_height, half_height]`, rims rounded by `rounding`.
+    /// `[-half_height, half_height]`, grown by `rounding` (see cylinder()).
     Id register_cylinder(double radius, double half_height, double rounding = 0.0,
                          const Pose &pose = identity(), const char *name = nullptr) {
         Id id = 0;
@@ -350,6 +535,33 @@ public:
                                       decompose, name, &pose, &id, nullptr));
         return id;
     }
+    /// Registers the triangle mesh of `vertices` (and `triangles`, vertex
+    /// indices, three per triangle; may be empty for a hull), scaled by
+    /// `scale` (null: 1), as its hull (`decompose` 0) or a V-HACD
+    /// decomposition at that resolution; what it made into `*info` if not
+    /// null.
+    Id register_mesh(const std::vector<Vec3> &vertices,
+                     const std::vector<std::array<uint32_t, 3>> &triangles = {},
+                     const Vec3 *scale = nullptr, uint32_t decompose = 0,
+                     const Pose &pose = identity(), const char *name = nullptr,
+                     MeshInfo *info = nullptr) {
+        Id id = 0;
+        check(gjkd_register_mesh(handle_, vertices.empty() ? nullptr : vertices[0].data(),
+                                 vertices.size(),
+                                 triangles.empty() ? nullptr : triangles[0].data(),
+                                 triangles.size(), scale ? scale->data() : nullptr, decompose,
+                                 name, &pose, &id, info));
+        return id;
+    }
+    /// register_mesh_file() with what it made into `*info`.
+    Id register_mesh_file(const std::string &path, MeshInfo &info, const Vec3 *scale = nullptr,
+                          uint32_t decompose = 0, const Pose &pose = identity(),
+                          const char *name = nullptr) {
+        Id id = 0;
+        check(gjkd_register_mesh_file(handle_, path.c_str(), scale ? scale->data() : nullptr,
+                                      decompose, name, &pose, &id, &info));
+        return id;
+    }
     /// Registers a robot from a URDF file (`srdf` and `package_path`, a
     /// `:`-separated folder list, may be null).
     Robot register_robot(const std::string &name, const std::string &urdf_path,
@@ -360,15 +572,90 @@ public:
                                   package_path, &base, &robot));
         return Robot(robot);
     }
-    /// Sets every joint of `robot` (and its base, if not null) in one round
-    /// trip; out-of-limit positions throw unless `clamp`.
+    /// Registers a robot from URDF text (and SRDF text, or null) in
+    /// memory; relative mesh paths are relative to `mesh_dir` (null: the
+    /// working folder).
+    Robot register_robot_text(const std::string &name, const std::string &urdf_text,
+                              const char *srdf_text = nullptr, const char *mesh_dir = nullptr,
+                              const char *package_path = nullptr,
+                              const Pose &base = identity()) {
+        gjkd_robot *robot = nullptr;
+        check(gjkd_register_robot_text(handle_, name.c_str(), urdf_text.c_str(), srdf_text,
+                                       mesh_dir, package_path, &base, &robot));
+        return Robot(robot);
+    }
+    /// The robot named `name` already on the server, given its URDF text
+    /// for the joint order and link names.
+    Robot open_robot(const std::string &name, const std::string &urdf_text) {
+        gjkd_robot *robot = nullptr;
+        check(gjkd_open_robot(handle_, name.c_str(), urdf_text.c_str(), &robot));
+        return Robot(robot);
+    }
+    /// Sets every joint of `robot` (`count` positions, in
+    /// Robot::joint_names() order, radians or the URDF's length unit) and
+    /// its base, if not null, in one round trip; out-of-limit positions
+    /// throw unless `clamp`. Allocates nothing: call it every control step.
+    void set_joints(Robot &robot, const double *positions, std::size_t count,
+                    const Pose *base = nullptr, bool clamp = false) {
+        check(gjkd_set_joints(handle_, robot.native_handle(), positions, count, base, clamp));
+    }
+    /// As above, with a base pose (a temporary will do).
+    void set_joints(Robot &robot, const double *positions, std::size_t count, const Pose &base,
+                    bool clamp = false) {
+        set_joints(robot, positions, count, &base, clamp);
+    }
+    /// Sets every joint of `robot` (and its base, if not null).
     void set_joints(Robot &robot, const std::vector<double> &positions,
                     const Pose *base = nullptr, bool clamp = false) {
-        check(gjkd_set_joints(handle_, robot.native_handle(), positions.data(),
-                              positions.size(), base, clamp));
+        set_joints(robot, positions.data(), positions.size(), base, clamp);
     }
-    /// Removes an object this client registered.
+    /// Sets every joint of `robot` from a fixed-size array.
+    template <std::size_t N>
+    void set_joints(Robot &robot, const std::array<double, N> &positions,
+                    const Pose *base = nullptr, bool clamp = false) {
+        set_joints(robot, positions.data(), N, base, clamp);
+    }
+#ifdef GJKD_HAS_SPAN
+    /// Sets every joint of `robot` (C++20).
+    void set_joints(Robot &robot, std::span<const double> positions, const Pose *base = nullptr,
+                    bool clamp = false) {
+        set_joints(robot, positions.data(), positions.size(), base, clamp);
+    }
+#endif
+    /// Sets the joints named `names[i]` to `values[i]`; the others keep
+    /// their positions last set.
+    void set_joints_by_name(Robot &robot, const std::vector<std::string> &names,
+                            const std::vector<double> &values, bool clamp = false) {
+        if (names.size() != values.size()) {
+            throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                        "set_joints_by_name: " + std::to_string(names.size()) + " names for " +
+                            std::to_string(values.size()) + " values");
+        }
+        std::vector<const char *> c_names;
+        c_names.reserve(names.size());
+        for (const std::string &n : names) c_names.push_back(n.c_str());
+        check(gjkd_set_joints_by_name(handle_, robot.native_handle(), c_names.data(),
+                                      values.data(), values.size(), clamp));
+    }
+    /// Removes an object this client registered. (A robot's link so
+    /// removed leaves a hole: use remove_robot(); a robot's id is no
+    /// object id.)
     void remove(Id id) { check(gjkd_remove(handle_, id)); }
+    /// Removes `robot` as a whole: its kinematics and every link object,
+    /// all or nothing. `robot` then names nothing on the server.
+    void remove_robot(const Robot &robot) {
+        check(gjkd_remove_robot(handle_, robot.native_handle()));
+    }
+    /// Removes the robot named `name` as a whole.
+    void remove_robot(const std::string &name) {
+        check(gjkd_remove_robot_named(handle_, name.c_str()));
+    }
+    /// How later registrations treat taken names (reuse_names: get the
+    /// object or robot already under the name, as a restarted node needs)
+    /// and this Client's end (remove_on_close).
+    void set_registration_options(const RegistrationOptions &options) {
+        check(gjkd_set_registration_options(handle_, &options));
+    }
     /// The id of the object named `name`.
     Id lookup(const std::string &name) {
         Id id = 0;
@@ -396,6 +683,18 @@ public:
         check(gjkd_distance(handle_, a, b, pose_a, pose_b, options, &answer));
         return answer;
     }
+    /// The distance between `a` at `pose_a` and `b` at `pose_b`, for this
+    /// query only (temporaries will do; the stored poses are neither used
+    /// nor changed).
+    Answer distance(Id a, Id b, const Pose &pose_a, const Pose &pose_b,
+                    const Options *options = nullptr) {
+        return distance(a, b, &pose_a, &pose_b, options);
+    }
+    /// The distance between `a` and `b` at their stored poses, with
+    /// `options`.
+    Answer distance(Id a, Id b, const Options &options) {
+        return distance(a, b, nullptr, nullptr, &options);
+    }
 
     /// The distances of `count` pairs (`2 * count` ids) into `out`, resized
     /// to `count` rows. Rows that fail carry their code in `out.error`.
@@ -411,6 +710,22 @@ public:
                    const Options *options = nullptr) {
         const Id *ids = pairs.empty() ? nullptr : pairs[0].data();
         distances(ids, pairs.size(), out, nullptr, nullptr, options);
+    }
+    /// The distances of `pairs` at `poses_a` and `poses_b` (as many each,
+    /// or empty for the stored poses), for these queries only, into `out`.
+    void distances(const std::vector<std::array<Id, 2>> &pairs, const std::vector<Pose> &poses_a,
+                   const std::vector<Pose> &poses_b, Distances &out,
+                   const Options *options = nullptr) {
+        for (std::size_t n : {poses_a.size(), poses_b.size()}) {
+            if (n != 0 && n != pairs.size()) {
+                throw Error(GJKD_ERR_INVALID_ARGUMENT, GJKD_CODE_OK,
+                            "distances: " + std::to_string(n) + " poses for " +
+                                std::to_string(pairs.size()) + " pairs");
+            }
+        }
+        const Id *ids = pairs.empty() ? nullptr : pairs[0].data();
+        distances(ids, pairs.size(), out, poses_a.empty() ? nullptr : poses_a.data(),
+                  poses_b.empty() ? nullptr : poses_b.data(), options);
     }
 
     /// The answers of `count` rows (made by pair() or pair_at(), which

@@ -107,9 +107,10 @@ pub unsafe fn req_str<'a>(ptr: *const c_char, what: &str) -> Result<&'a str, Fai
     unsafe { opt_str(ptr, what) }?.ok_or_else(|| Failure::null(what))
 }
 
-/// A pose that must be finite and of unit rotation (the check the server
-/// makes), named `what` in the error.
+/// A pose that must pass the server's check (finite, within
+/// `GJKD_MAX_TRANSLATION`, of unit rotation), named `what` in the error,
+/// which carries the server's code for the fault.
 pub fn checked_pose(pose: &gjkd_pose, what: &str) -> Result<(), Failure> {
     pose.check()
-        .map_err(|why| Failure::invalid(format!("{what} {why}")))
+        .map_err(|(code, why)| Failure::invalid_code(code, format!("{what} {why}")))
 }

@@ -32,8 +32,13 @@ fn seconds(s: f64, what: &str) -> Result<Duration, Failure> {
 /// - `out_client`: receives the handle, owned by the caller, to be freed
 ///   with `gjkd_close()`; set to NULL on failure.
 ///
-/// The handle belongs to the calling thread: calls from another thread
-/// return `GJKD_ERR_WRONG_THREAD` (create one handle per thread).
+/// The handle may be used from any thread, one call at a time: a call
+/// made while another thread's call is using it returns `GJKD_ERR_BUSY`
+/// and sends nothing. So a handle may be created on one thread, used on
+/// others (a ROS 2 `MultiThreadedExecutor` runs one callback group's
+/// callbacks on any of its threads) and closed on yet another. Share one
+/// handle between callbacks that may run at once only behind a mutex (or
+/// a `MutuallyExclusive` callback group), or give each its own handle.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`out_client`),
 /// `GJKD_ERR_INVALID_ARGUMENT` (a timeout, a service name not UTF-8),
@@ -73,11 +78,15 @@ pub unsafe extern "C" fn gjkd_connect(
     })
 }
 
-/// Closes the connection and frees the handle. NULL is accepted and does
-/// nothing. Objects the handle registered stay on the server until removed.
+/// Closes the connection and frees the handle, from any thread. NULL is
+/// accepted and does nothing. Objects the handle registered stay on the
+/// server until removed (and, under a server with persistence, the
+/// default, across server restarts too), except those registered while
+/// `gjkd_registration_options::remove_on_close` was set, which are removed
+/// now.
 ///
-/// Errors: `GJKD_ERR_WRONG_THREAD` (the handle is then not freed: close it
-/// from its own thread).
+/// Errors: `GJKD_ERR_BUSY` (a call on another thread is using the handle:
+/// it is then not freed).
 ///
 /// # Safety
 /// `client` is NULL or a handle from `gjkd_connect()` not yet closed; it
@@ -88,8 +97,13 @@ pub unsafe extern "C" fn gjkd_close(client: *mut gjkd_client) -> gjkd_status {
         if client.is_null() {
             return Ok(());
         }
-        // SAFETY: the caller's promise; the thread is checked first.
-        unsafe { with_client(client, |_| Ok(())) }?;
+        // SAFETY: the caller's promise; the busy flag is checked first.
+        unsafe {
+            with_client(client, |c| {
+                c.remove_doomed();
+                Ok(())
+            })
+        }?;
         // SAFETY: created by Box::into_raw in gjkd_connect, not yet freed.
         drop(unsafe { Box::from_raw(client) });
         Ok(())
@@ -99,7 +113,7 @@ pub unsafe extern "C" fn gjkd_close(client: *mut gjkd_client) -> gjkd_status {
 /// What the server said about itself at the last (re)connection, into
 /// `*out_info`.
 ///
-/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_SERVER_GONE` while disconnected (the next call reconnects).
 ///
 /// # Safety
@@ -129,7 +143,7 @@ pub unsafe extern "C" fn gjkd_server_info(
 
 /// The server's counters, into `*out_stats` (one round trip).
 ///
-/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 ///
 /// # Safety
@@ -159,9 +173,17 @@ pub extern "C" fn gjkd_last_error() -> *const c_char {
     status::last_message()
 }
 
-/// The server's `gjkd_error_code` of the last call on this thread that
-/// failed, when it returned `GJKD_ERR_REJECTED`; `GJKD_CODE_OK` (0) when the
-/// last failure was of another kind.
+/// The `gjkd_error_code` of the last call on this thread that failed: the
+/// server's refusal for `GJKD_ERR_REJECTED`; for
+/// `GJKD_ERR_INVALID_ARGUMENT`, the code the server gives the same fault,
+/// when the library found it before sending (`GJKD_CODE_NON_FINITE_POSE`,
+/// `GJKD_CODE_BAD_QUATERNION`, `GJKD_CODE_INVALID_OPTIONS`,
+/// `GJKD_CODE_OUT_OF_LIMITS`, `GJKD_CODE_UNKNOWN_NAME`, ...);
+/// `GJKD_CODE_OK` (0) when no code applies (a NULL pointer, a count, a
+/// connection failure). So one fault has one status and one code whichever
+/// call meets it: a NaN pose given to `gjkd_set_pose()`, `gjkd_distance()`
+/// or `gjkd_register()`, or a NaN joint position, is
+/// `GJKD_ERR_INVALID_ARGUMENT` with `GJKD_CODE_NON_FINITE_POSE`.
 #[unsafe(no_mangle)]
 pub extern "C" fn gjkd_last_error_code() -> u32 {
     status::last_code()

@@ -1,53 +1,84 @@
-//! The opaque handle behind `gjkd_client*`: the Rust client and the
-//! thread it belongs to.
+//! The opaque handle behind `gjkd_client*`: the Rust client, the flag
+//! that lets one call at a time use it, from any thread, and what this
+//! handle registered to remove when it closes.
+//!
+//! The Rust client is not `Send`: iceoryx2's ports share their state
+//! through `Rc`s, which two threads must never touch at once. Every one
+//! of those `Rc`s lives inside this handle, so a handle used by one call
+//! at a time (the `busy` flag, taken with `Acquire` and given back with
+//! `Release`, orders each call after the previous one, on whatever thread)
+//! never has two threads touching them at once: moving it from thread to
+//! thread between calls, and closing it on another thread, is sound.
 
 #![allow(non_camel_case_types)]
 
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 
-use rust_client::{Client, ClientError, ErrorCode, Item, ItemResult};
+use rust_client::{Client, ClientError, ErrorCode, Item, ItemResult, ObjectId};
 
 use crate::status::{Failure, gjkd_status};
+use crate::types::gjkd_registration_options;
 
 /// Batch size assumed before a server has said its own.
 const DEFAULT_MAX_BATCH: usize = 1024;
 
 /// A connection to a gjkd server. Opaque: create it with `gjkd_connect()`,
-/// use it from the thread that created it, free it with `gjkd_close()`.
+/// use it from any thread, one call at a time, free it with `gjkd_close()`.
 pub struct gjkd_client {
     /// The Rust client.
     pub client: Client,
-    /// The thread that created the handle (iceoryx2 ports are bound to it).
-    owner: u64,
+    /// Set while a call uses the handle (see the module's words).
+    busy: AtomicBool,
     /// A chunk's items, made here and then copied into the request in one
     /// piece (faster than writing shared memory item by item), kept from
     /// call to call.
     scratch: Vec<Item>,
-}
-
-/// A number per thread, for telling the owner thread from others without
-/// the cost of `std::thread::current()`.
-fn thread_token() -> u64 {
-    static NEXT: AtomicU64 = AtomicU64::new(1);
-    thread_local! {
-        static TOKEN: Cell<u64> = const { Cell::new(0) };
-    }
-    TOKEN.with(|t| {
-        if t.get() == 0 {
-            t.set(NEXT.fetch_add(1, Ordering::Relaxed));
-        }
-        t.get()
-    })
+    /// How registrations treat names and the handle's end.
+    pub registration: gjkd_registration_options,
+    /// Objects to remove when the handle closes (registered while
+    /// `registration.remove_on_close` was set).
+    pub doomed_objects: Vec<ObjectId>,
+    /// Robots (by name) to remove when the handle closes.
+    pub doomed_robots: Vec<String>,
 }
 
 impl gjkd_client {
-    /// A handle owned by the calling thread.
+    /// A handle, idle.
     pub fn new(client: Client) -> Self {
         gjkd_client {
             client,
-            owner: thread_token(),
+            busy: AtomicBool::new(false),
             scratch: Vec::new(),
+            registration: gjkd_registration_options::default(),
+            doomed_objects: Vec::new(),
+            doomed_robots: Vec::new(),
+        }
+    }
+
+    /// Notes a registered object, to remove at close if so asked.
+    pub fn registered(&mut self, id: ObjectId) {
+        if self.registration.remove_on_close {
+            self.doomed_objects.push(id);
+        }
+    }
+
+    /// Notes a registered robot, to remove at close if so asked.
+    pub fn registered_robot(&mut self, name: &str) {
+        if self.registration.remove_on_close && !self.doomed_robots.iter().any(|n| n == name) {
+            self.doomed_robots.push(name.to_owned());
+        }
+    }
+
+    /// Removes what was registered to end with the handle: robots whole,
+    /// then the other objects. Best effort: an object removed already, or
+    /// a server gone, is skipped (a server gone keeps them; see
+    /// `gjkd_registration_options`).
+    pub fn remove_doomed(&mut self) {
+        for name in std::mem::take(&mut self.doomed_robots) {
+            let _ = self.client.remove_robot(&name);
+        }
+        for id in std::mem::take(&mut self.doomed_objects) {
+            let _ = self.client.remove(id);
         }
     }
 
@@ -118,19 +149,18 @@ impl gjkd_client {
     }
 }
 
-/// Whether the calling thread is the handle's `owner`.
-fn check_thread(owner: u64) -> Result<(), Failure> {
-    if owner == thread_token() {
-        Ok(())
-    } else {
-        Err(Failure::new(
-            gjkd_status::GJKD_ERR_WRONG_THREAD,
-            "the handle belongs to another thread: create one handle per thread",
-        ))
+/// Gives the handle back when a call ends, also by a panic.
+struct Release<'a>(&'a AtomicBool);
+
+impl Drop for Release<'_> {
+    fn drop(&mut self) {
+        self.0.store(false, Ordering::Release);
     }
 }
 
-/// Runs `body` on the handle at `client` after the NULL and thread checks.
+/// Runs `body` on the handle at `client` after the NULL check, holding the
+/// handle's `busy` flag: a call on another thread at the same moment is
+/// refused with `GJKD_ERR_BUSY`, not run beside this one.
 ///
 /// # Safety
 /// A non-NULL `client` must come from `gjkd_connect()` and not be closed.
@@ -141,11 +171,22 @@ pub unsafe fn with_client(
     if client.is_null() {
         return Err(Failure::null("client"));
     }
-    // The owner is read alone, without a reference to the whole handle,
-    // which its own thread may be using at this moment; it never changes.
-    // SAFETY: non-NULL, from gjkd_connect() by the caller's promise.
-    let owner = unsafe { std::ptr::addr_of!((*client).owner).read() };
-    check_thread(owner)?;
-    // SAFETY: as above; only the owner thread gets here, one call at a time.
+    // The flag is reached alone, without a reference to the whole handle,
+    // which another thread may be using at this moment.
+    // SAFETY: non-NULL, from gjkd_connect() by the caller's promise; an
+    // atomic may be shared.
+    let busy = unsafe { &*std::ptr::addr_of!((*client).busy) };
+    if busy
+        .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)
+        .is_err()
+    {
+        return Err(Failure::new(
+            gjkd_status::GJKD_ERR_BUSY,
+            "the handle is in a call on another thread: a handle serves one call at a \
+             time (hold a mutex around its calls, or use one handle per thread)",
+        ));
+    }
+    let _release = Release(busy);
+    // SAFETY: as above; the flag makes this the only call using it.
     body(unsafe { &mut *client })
 }

@@ -9,7 +9,7 @@
 //! [`gjkd_last_error`] (thread-local), a server's refusal code in
 //! [`gjkd_last_error_code`]. No panic crosses the boundary: each entry
 //! point runs in `catch_unwind`, and a caught panic is `GJKD_ERR_PANIC`.
-//! The handle is bound to the thread that created it (iceoryx2 ports are).
+//! A handle serves one call at a time, from any thread (see `handle.rs`).
 //! Batch calls make their items straight into the request's shared memory
 //! and copy the answers straight from the response's into the caller's
 //! arrays, with no buffer in between (`Client::query_batch_with`);
@@ -27,6 +27,7 @@
 mod args;
 mod connect;
 mod handle;
+mod lifetime;
 mod meshes;
 mod objects;
 mod query;
@@ -39,6 +40,7 @@ mod types;
 
 pub use connect::*;
 pub use handle::gjkd_client;
+pub use lifetime::*;
 pub use meshes::*;
 pub use objects::*;
 pub use query::*;
@@ -69,3 +71,10 @@ const _: () = assert!(GJKD_MAX_PIECES == gjkd_proto::MAX_PIECES);
 /// Longest object name, in bytes of UTF-8 (not counting the NUL).
 pub const GJKD_MAX_NAME_LEN: usize = 64;
 const _: () = assert!(GJKD_MAX_NAME_LEN == gjkd_proto::MAX_NAME_LEN);
+
+/// The largest magnitude of a pose's translation component, 2^998 (about
+/// 2.68e300): a pose beyond is refused with `GJKD_CODE_NON_FINITE_POSE`
+/// when it is set, so that any two stored poses stay within what a query
+/// accepts.
+pub const GJKD_MAX_TRANSLATION: f64 = 2.6787715179656683e300;
+const _: () = assert!(GJKD_MAX_TRANSLATION == gjkd_proto::MAX_TRANSLATION);

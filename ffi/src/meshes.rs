@@ -5,7 +5,7 @@ use std::ffi::c_char;
 use std::path::Path;
 
 use nalgebra::{Isometry3, Point3};
-use rust_client::{Mesh, MeshMode};
+use rust_client::{ClientError, ErrorCode, Mesh, MeshMode};
 
 use crate::args::{checked_pose, opt_str, out, req_str, slice};
 use crate::handle::{gjkd_client, with_client};
@@ -64,15 +64,29 @@ fn register(
         r => MeshMode::Decompose(r),
     };
     let pose = pose.map_or_else(Isometry3::identity, gjkd_pose::isometry);
-    let made = c
+    let made = match c
         .client
-        .register_mesh(name.unwrap_or(""), &mesh, mode, &pose)?;
-    *out_id = made.id.raw();
+        .register_mesh(name.unwrap_or(""), &mesh, mode, &pose)
+    {
+        Err(ClientError::Rejected(ErrorCode::NameTaken)) if c.registration.reuse_names => {
+            // The object of that name, as it is: what it was made of is
+            // not known here.
+            let id = c.client.lookup(name.unwrap_or(""))?;
+            (id, gjkd_mesh_info::default())
+        }
+        made => {
+            let made = made?;
+            let info = gjkd_mesh_info {
+                pieces: made.pieces,
+                deviation: made.deviation,
+            };
+            (made.id, info)
+        }
+    };
+    c.registered(made.0);
+    *out_id = made.0.raw();
     if let Some(info) = out_info {
-        *info = gjkd_mesh_info {
-            pieces: made.pieces,
-            deviation: made.deviation,
-        };
+        *info = made.1;
     }
     Ok(())
 }
@@ -89,7 +103,7 @@ fn register(
 /// - `out_info`: NULL, or receives the pieces and the deviation.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `path`, `out_id`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a file missing or
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a file missing or
 /// not a mesh, a bad scale, a decomposition that finds no pieces, a bad
 /// pose or name; the message says which), `GJKD_ERR_REJECTED` with the
 /// codes of `gjkd_register()` (`GJKD_CODE_TOO_MANY_PIECES` for a

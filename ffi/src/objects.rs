@@ -111,9 +111,15 @@ fn register(
     // On the wire an empty name means none: one request registers an
     // unnamed object at its pose too, with nothing to undo if a second
     // request (a set_pose) failed.
-    let id = c
-        .client
-        .register_named(name.unwrap_or(""), geometry, &pose)?;
+    let id = match name {
+        Some(name) if c.registration.reuse_names => {
+            c.client.register_named_or_get(name, geometry, &pose)?
+        }
+        _ => c
+            .client
+            .register_named(name.unwrap_or(""), geometry, &pose)?,
+    };
+    c.registered(id);
     *out_id = id.raw();
     Ok(())
 }
@@ -170,7 +176,7 @@ unsafe fn register_entry(
 /// - `out_id`: receives the id (0 on failure).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `shape`, `out_id`, or a
-/// polytope's `vertices` with a non-zero count), `GJKD_ERR_WRONG_THREAD`,
+/// polytope's `vertices` with a non-zero count), `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_INVALID_ARGUMENT` (an unknown kind, a negative half extent, a
 /// bad pose, a name empty, too long or not UTF-8),
 /// `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`,
@@ -224,7 +230,8 @@ pub unsafe extern "C" fn gjkd_register_sphere(
 
 /// Registers an exact cylinder about the body z axis, centred on the body
 /// origin: the disk of `radius` swept from `z = -half_height` to
-/// `z = +half_height`, its rims rounded by `rounding` (0 for sharp rims).
+/// `z = +half_height`, grown by `rounding` (radius and half-height each
+/// grow by it, the rims become round; 0 for sharp rims).
 /// Arguments and errors as `gjkd_register()` (a negative, NaN or infinite
 /// size is `GJKD_ERR_REJECTED` with `GJKD_CODE_INVALID_RADIUS`).
 ///
@@ -281,7 +288,8 @@ pub unsafe extern "C" fn gjkd_register_capsule(
 }
 
 /// Registers a box of `half_extents` (three doubles, each `>= 0`) centred
-/// on the body origin, its edges rounded by `radius` (0 for a sharp box).
+/// on the body origin, grown by `radius` (each half extent grows by it,
+/// edges and corners become round; 0 for a sharp box).
 /// Arguments and errors as `gjkd_register()`, plus `GJKD_ERR_NULL_POINTER`
 /// for `half_extents`.
 ///
@@ -406,9 +414,12 @@ pub unsafe extern "C" fn gjkd_register_compound(
     }
 }
 
-/// Removes an object this client registered. Its id is never reused.
+/// Removes an object this client registered. Its id is never reused. A
+/// robot's link removed so leaves the robot with a hole: remove a robot
+/// whole with `gjkd_remove_robot()`. A robot's id (`gjkd_robot_info()`) is
+/// no object id: given here, it is `GJKD_CODE_UNKNOWN_OBJECT`.
 ///
-/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_WRONG_THREAD`,
+/// Errors: `GJKD_ERR_NULL_POINTER`, `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`,
 /// `GJKD_CODE_NOT_OWNER` (another client's object) or
 /// `GJKD_CODE_READ_ONLY` (a scene object); `GJKD_ERR_SERVER_GONE`,
@@ -428,7 +439,7 @@ pub unsafe extern "C" fn gjkd_remove(client: *mut gjkd_client, id: gjkd_id) -> g
 /// with a name by any client), into `*out_id` (0 on failure).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `out_id`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (not UTF-8, longer
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (not UTF-8, longer
 /// than `GJKD_MAX_NAME_LEN`), `GJKD_ERR_REJECTED` with
 /// `GJKD_CODE_UNKNOWN_NAME`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 ///

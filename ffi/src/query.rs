@@ -12,10 +12,15 @@ use crate::types::{gjkd_answer, gjkd_id, gjkd_pose, gjkd_query_options, gjkd_res
 /// Stores a new pose for object `id`, used by every later query (of any
 /// client) that does not give its own.
 ///
+/// The pose is checked as the server checks it, when it is set: a pose
+/// stored is one every later query accepts.
+///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pose`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a NaN or infinite
-/// component, a quaternion off unit length by more than 1e-6: nothing is
-/// sent), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (nothing is sent)
+/// with last error code `GJKD_CODE_NON_FINITE_POSE` (a NaN or infinite
+/// component, a translation component beyond `GJKD_MAX_TRANSLATION`) or
+/// `GJKD_CODE_BAD_QUATERNION` (a quaternion off unit length by more than
+/// 1e-6), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
 /// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 ///
 /// # Safety
@@ -148,11 +153,13 @@ pub(crate) unsafe fn template(options: *const gjkd_query_options) -> Result<Item
 /// means `gjkd_query_options_default()`.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `out_answer`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (bad options),
-/// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`,
-/// `GJKD_CODE_NON_FINITE_POSE` or `GJKD_CODE_BAD_QUATERNION` (a pose given
-/// here); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`. On failure
-/// `*out_answer` is zeroed.
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (bad options, last
+/// error code `GJKD_CODE_INVALID_OPTIONS`; a pose given here that
+/// `gjkd_set_pose()` would refuse, with the same code:
+/// `GJKD_CODE_NON_FINITE_POSE` or `GJKD_CODE_BAD_QUATERNION`; nothing is
+/// sent), `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_OBJECT`;
+/// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`. On failure `*out_answer` is
+/// zeroed.
 ///
 /// # Safety
 /// `client` is NULL or a live handle; the poses and options NULL or
@@ -173,6 +180,14 @@ pub unsafe extern "C" fn gjkd_distance(
             with_client(client, |c| {
                 let slot = out(out_answer, "out_answer")?;
                 *slot = gjkd_answer::default();
+                // Checked here as `gjkd_set_pose()` checks a pose, so that
+                // a bad pose fails alike whichever call it is given to.
+                if let Some(p) = pose_a.as_ref() {
+                    checked_pose(p, "pose_a")?;
+                }
+                if let Some(p) = pose_b.as_ref() {
+                    checked_pose(p, "pose_b")?;
+                }
                 let item = pair_item(&template(options)?, a, b, pose_a.as_ref(), pose_b.as_ref());
                 let mut result = [ItemResult::default()];
                 c.client.query_batch(&[item], &mut result)?;
@@ -273,11 +288,11 @@ impl<'a> Outputs<'a> {
 ///
 /// Batches larger than the server takes are split. The pairs go straight
 /// into shared memory and the answers straight into `out`: nothing is
-/// allocated per pair. A count of 0 does nothing (every array may then be
-/// NULL).
+/// allocated per pair. A count of 0 does nothing (`pairs`, `out` and every
+/// array may then be NULL).
 ///
-/// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `pairs`, `out`,
-/// `out->distance`, `out->error`), `GJKD_ERR_WRONG_THREAD`,
+/// Errors: `GJKD_ERR_NULL_POINTER` (`client`, and with a non-zero count
+/// `pairs`, `out`, `out->distance`, `out->error`), `GJKD_ERR_BUSY`,
 /// `GJKD_ERR_INVALID_ARGUMENT` (bad options, a count larger than any
 /// array); `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks
 /// answered before are written, the others left as they were).
@@ -299,11 +314,13 @@ pub unsafe extern "C" fn gjkd_distances(
         // SAFETY: the caller's promises.
         unsafe {
             with_client(client, |c| {
-                let results = required(out, "out")?;
                 let template = template(options)?;
+                // As `gjkd_query_pairs`: nothing to answer, nothing read,
+                // so `out` too may be NULL.
                 if count == 0 {
                     return Ok(());
                 }
+                let results = required(out, "out")?;
                 let pairs = slice(pairs.cast::<[gjkd_id; 2]>(), count, "pairs")?;
                 let poses_a = optional(poses_a, count, "poses_a")?;
                 let poses_b = optional(poses_b, count, "poses_b")?;

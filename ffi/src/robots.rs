@@ -21,7 +21,7 @@ use crate::types::{gjkd_id, gjkd_pose};
 /// connection: any handle to the same server may move it, from any thread
 /// (one call at a time).
 pub struct gjkd_robot {
-    handle: RobotHandle,
+    pub(crate) handle: RobotHandle,
     /// The base pose last sent (identity at first).
     base: Isometry3<f64>,
     /// NUL-terminated link names, for `gjkd_robot_link()`.
@@ -92,7 +92,7 @@ fn packages(list: Option<&str>) -> PackagePath {
 ///   folder.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_path`,
-/// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a
+/// `out_robot`), `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a
 /// URDF, SRDF or mesh that cannot be read: the message names the file,
 /// link or joint; a bad base pose), `GJKD_ERR_REJECTED` with
 /// `GJKD_CODE_NAME_TAKEN` (an object `<name>/<link>` exists),
@@ -124,9 +124,26 @@ pub unsafe extern "C" fn gjkd_register_robot(
                 let srdf = opt_str(srdf_path, "srdf_path")?.map(Path::new);
                 let packages = packages(opt_str(package_path, "package_path")?);
                 let base = base_of(base.as_ref())?;
-                let handle = c
-                    .client
-                    .register_robot(name, urdf, srdf, &packages, &base)?;
+                let handle = if c.registration.reuse_names {
+                    let read = |p: &Path| {
+                        std::fs::read_to_string(p)
+                            .map_err(|e| Failure::invalid(format!("{}: {e}", p.display())))
+                    };
+                    let text = read(urdf)?;
+                    let srdf = srdf.map(read).transpose()?;
+                    c.client.register_robot_text_or_get(
+                        name,
+                        &text,
+                        srdf.as_deref(),
+                        urdf.parent(),
+                        &packages,
+                        &base,
+                    )?
+                } else {
+                    c.client
+                        .register_robot(name, urdf, srdf, &packages, &base)?
+                };
+                c.registered_robot(name);
                 hand_out(slot, handle, base);
                 Ok(())
             })
@@ -165,9 +182,14 @@ pub unsafe extern "C" fn gjkd_register_robot_text(
                 let dir = opt_str(mesh_dir, "mesh_dir")?.map(Path::new);
                 let packages = packages(opt_str(package_path, "package_path")?);
                 let base = base_of(base.as_ref())?;
-                let handle = c
-                    .client
-                    .register_robot_text(name, urdf, srdf, dir, &packages, &base)?;
+                let handle = if c.registration.reuse_names {
+                    c.client
+                        .register_robot_text_or_get(name, urdf, srdf, dir, &packages, &base)?
+                } else {
+                    c.client
+                        .register_robot_text(name, urdf, srdf, dir, &packages, &base)?
+                };
+                c.registered_robot(name);
                 hand_out(slot, handle, base);
                 Ok(())
             })
@@ -180,7 +202,7 @@ pub unsafe extern "C" fn gjkd_register_robot_text(
 /// the joint order and link names. Writes a new robot to `*out_robot`.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `name`, `urdf_text`,
-/// `out_robot`), `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT`
+/// `out_robot`), `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT`
 /// (URDF text that cannot be read), `GJKD_ERR_REJECTED` with
 /// `GJKD_CODE_UNKNOWN_NAME`; `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT`.
 ///
@@ -225,7 +247,10 @@ pub unsafe extern "C" fn gjkd_robot_free(robot: *mut gjkd_robot) -> gjkd_status 
 }
 
 /// The robot's id and its numbers of links and moving joints (each
-/// output may be NULL).
+/// output may be NULL). The robot's id is the group id of scene questions
+/// about the robot (`gjkd_group::id`); it is no object id (robot ids are
+/// their own namespace): its links are the objects, see
+/// `gjkd_robot_link()`. Remove the robot with `gjkd_remove_robot()`.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`robot`).
 ///
@@ -297,8 +322,9 @@ pub unsafe extern "C" fn gjkd_robot_link(
 /// geometry).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`robot`, `name`, `out_id`),
-/// `GJKD_ERR_REJECTED` with `GJKD_CODE_UNKNOWN_NAME` (no link of that
-/// name).
+/// `GJKD_ERR_INVALID_ARGUMENT` with last error code
+/// `GJKD_CODE_UNKNOWN_NAME` (no link of that name: looked up in the
+/// handle, nothing is asked of the server).
 ///
 /// # Safety
 /// `robot` is NULL or live; `name` NULL or NUL-terminated; `out_id` NULL
@@ -316,10 +342,12 @@ pub unsafe extern "C" fn gjkd_robot_link_id(
             *slot = 0;
             let r = required(robot, "robot")?;
             let name = req_str(name, "name")?;
+            // Looked up here, in the robot's own list: a caller's mistake,
+            // not a refusal by the server.
             if !r.handle.link_names().iter().any(|l| l == name) {
-                return Err(Failure::rejected(
+                return Err(Failure::invalid_code(
                     ErrorCode::UnknownName,
-                    &format!("link `{name}`: "),
+                    format!("the robot has no link `{name}`"),
                 ));
             }
             *slot = r.handle.link(name).map_or(0, |l| l.raw());
@@ -418,7 +446,8 @@ fn joint_failure(e: JointError) -> Failure {
     let code = match e {
         JointError::OutOfLimits { .. } => ErrorCode::OutOfLimits.raw(),
         JointError::NotFinite(_) | JointError::BadBase => ErrorCode::NonFinitePose.raw(),
-        JointError::UnknownJoint(_) | JointError::WrongCount { .. } => 0,
+        JointError::UnknownJoint(_) => ErrorCode::UnknownName.raw(),
+        JointError::WrongCount { .. } => 0,
     };
     Failure {
         code,
@@ -434,7 +463,7 @@ fn joint_failure(e: JointError) -> Failure {
 /// (`positions` may then be NULL): only its base moves.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `robot`, `positions`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (`count` not the
 /// number of moving joints; a position NaN or infinite, last error code
 /// `GJKD_CODE_NON_FINITE_POSE`; outside its limits without `clamp`,
 /// `GJKD_CODE_OUT_OF_LIMITS`; the message names the joint; a bad base
@@ -512,7 +541,7 @@ fn set_joints(
 ///
 /// Errors: as `gjkd_set_joints()`, plus `GJKD_ERR_NULL_POINTER` (`names`,
 /// a name, `values`) and `GJKD_ERR_INVALID_ARGUMENT` for a name that is no
-/// moving joint.
+/// moving joint (last error code `GJKD_CODE_UNKNOWN_NAME`).
 ///
 /// # Safety
 /// `names` NULL or `count` pointers to NUL-terminated strings, `values`

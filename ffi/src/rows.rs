@@ -225,7 +225,7 @@ pub unsafe extern "C" fn gjkd_pair_query_of(
 /// nothing (`queries` and `out` may then be NULL).
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `queries`, `out`),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
 /// than any array; a row not made by `gjkd_pair_query_of()`, or whose
 /// `flags` has bits other than those it set and `GJKD_POSE_A |
 /// GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);

@@ -333,17 +333,20 @@ fn scene_row(row: &SceneRow) -> gjkd_scene_row {
 
 /// For each member of `group`, the nearest object outside the group: one
 /// row per member into `rows` (room for `capacity`), the counts into
-/// `*summary`. `options` NULL means `gjkd_scene_options_default()`.
+/// `*summary`. `options` NULL means `gjkd_scene_options_default()`. An
+/// empty group (`id` 0 and no members) has no member to answer for:
+/// `GJKD_OK` with no rows (`written` and `total` 0), here and in
+/// `gjkd_within()`.
 ///
 /// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `group`, `summary`, `rows`
 /// with a non-zero `capacity`, the group's arrays with non-zero counts),
-/// `GJKD_ERR_WRONG_THREAD`, `GJKD_ERR_INVALID_ARGUMENT` (a precision that
+/// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a precision that
 /// is no `gjkd_precision`), `GJKD_ERR_REJECTED` with
 /// `GJKD_CODE_UNKNOWN_OBJECT` (the group or a member),
 /// `GJKD_CODE_INVALID_OPTIONS` (tolerance, iteration cap, accepted
-/// accuracy, cut-off out of their domain), `GJKD_CODE_MALFORMED` (an empty
-/// group), `GJKD_CODE_BATCH_TOO_LARGE` (more members and allowed pairs
-/// than the server's `max_batch`); `GJKD_ERR_SERVER_GONE`,
+/// accuracy, cut-off out of their domain), `GJKD_CODE_BATCH_TOO_LARGE`
+/// (more members and allowed pairs than the server's `max_batch`, see
+/// `gjkd_server_info()`); `GJKD_ERR_SERVER_GONE`,
 /// `GJKD_ERR_TIMEOUT`, `GJKD_ERR_PROTOCOL` (a server without scene
 /// queries). On failure nothing changed on the server and `*summary` is
 /// zeroed.

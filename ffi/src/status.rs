@@ -30,8 +30,9 @@ pub enum gjkd_status {
     GJKD_ERR_INVALID_ARGUMENT = 4,
     /// A pointer that must not be NULL was NULL. Nothing was sent.
     GJKD_ERR_NULL_POINTER = 5,
-    /// The handle was used from a thread other than the one that created
-    /// it. Nothing was sent.
+    /// No longer returned: a handle may be used from any thread, one call
+    /// at a time (see `GJKD_ERR_BUSY`). Kept so that code naming it
+    /// still compiles.
     GJKD_ERR_WRONG_THREAD = 6,
     /// A server serves the name with another protocol version than this
     /// library's `GJKD_PROTOCOL_VERSION`.
@@ -50,6 +51,10 @@ pub enum gjkd_status {
     /// A bug inside the library was caught before it reached the caller;
     /// the handle may be left in any state but is safe to close.
     GJKD_ERR_PANIC = 13,
+    /// The handle was in a call on another thread at that moment: a handle
+    /// serves one call at a time, from any thread. Nothing was sent; hold
+    /// a mutex around the handle's calls, or use one handle per thread.
+    GJKD_ERR_BUSY = 14,
 }
 
 use gjkd_status::*;
@@ -84,6 +89,16 @@ impl Failure {
     /// An argument out of its domain.
     pub fn invalid(message: impl Into<String>) -> Self {
         Failure::new(GJKD_ERR_INVALID_ARGUMENT, message)
+    }
+
+    /// An argument out of its domain, found here before anything was
+    /// sent, that the server refuses with `code`: the caller sees the
+    /// same code whichever side finds the fault.
+    pub fn invalid_code(code: ErrorCode, message: impl Into<String>) -> Self {
+        Failure {
+            code: code.raw(),
+            ..Failure::invalid(message)
+        }
     }
 
     /// A refusal by the server with `code`.
@@ -197,7 +212,7 @@ pub fn code_name(raw: u32) -> &'static str {
 
 /// The name of status value `raw` (`"GJKD_ERR_TIMEOUT"`, ...).
 pub fn status_name(raw: i32) -> &'static CStr {
-    const NAMES: [&CStr; 14] = [
+    const NAMES: [&CStr; 15] = [
         c"GJKD_OK",
         c"GJKD_ERR_SERVER_GONE",
         c"GJKD_ERR_TIMEOUT",
@@ -212,6 +227,7 @@ pub fn status_name(raw: i32) -> &'static CStr {
         c"GJKD_ERR_PROTOCOL",
         c"GJKD_ERR_IPC",
         c"GJKD_ERR_PANIC",
+        c"GJKD_ERR_BUSY",
     ];
     usize::try_from(raw)
         .ok()

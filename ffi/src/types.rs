@@ -5,7 +5,7 @@
 
 use gjkd_proto::{Pose, Precision};
 use nalgebra::Isometry3;
-use rust_client::{ItemResult, QueryOptions, ServerInfo, ServerStats};
+use rust_client::{ErrorCode, ItemResult, QueryOptions, ServerInfo, ServerStats};
 
 use crate::status::Failure;
 
@@ -39,22 +39,22 @@ impl gjkd_pose {
         self.wire().to_isometry_unchecked()
     }
 
-    /// Checks what the server would: finite, and a unit quaternion within
-    /// the server's tolerance.
-    pub fn check(&self) -> Result<(), &'static str> {
-        if !self
-            .translation
-            .iter()
-            .chain(&self.rotation)
-            .all(|c| c.is_finite())
-        {
-            return Err("has a NaN or infinite component");
+    /// Checks what the server checks ([`Pose::checked`]): finite, each
+    /// translation component within `GJKD_MAX_TRANSLATION`, a unit
+    /// quaternion within the server's tolerance. On failure, the server's
+    /// code and why in words.
+    pub fn check(&self) -> Result<(), (ErrorCode, &'static str)> {
+        match self.wire().checked() {
+            Ok(_) => Ok(()),
+            Err(ErrorCode::BadQuaternion) => Err((
+                ErrorCode::BadQuaternion,
+                "has a rotation quaternion that is not of unit length (within 1e-6)",
+            )),
+            Err(code) => Err((
+                code,
+                "has a NaN or infinite component, or a translation beyond GJKD_MAX_TRANSLATION",
+            )),
         }
-        let n2: f64 = self.rotation.iter().map(|c| c * c).sum();
-        if (n2.sqrt() - 1.0).abs() > 1e-6 {
-            return Err("has a rotation quaternion that is not of unit length (within 1e-6)");
-        }
-        Ok(())
     }
 }
 
@@ -66,16 +66,18 @@ pub enum gjkd_shape_kind {
     GJKD_SHAPE_SPHERE = 1,
     /// The segment from `a` to `b` grown by `radius`.
     GJKD_SHAPE_CAPSULE = 2,
-    /// A box of half extents `a`, centred on the body origin, its edges
-    /// rounded by `radius` (0 for a sharp box).
+    /// A box of half extents `a`, centred on the body origin, grown by
+    /// `radius` (every point within `radius` of the box: each half extent
+    /// grows by `radius`, edges and corners become round; 0 for a sharp
+    /// box).
     GJKD_SHAPE_BOX = 3,
     /// The convex hull of `vertex_count` points at `vertices` grown by
     /// `radius`.
     GJKD_SHAPE_POLYTOPE = 4,
     /// An exact cylinder about the body z axis, centred on the body origin:
-    /// the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`, its
-    /// rims rounded by `radius` (0 for sharp rims). Never approximated by
-    /// a polytope.
+    /// the disk of radius `a[0]` swept from `z = -a[1]` to `z = +a[1]`,
+    /// grown by `radius` (radius and half-height each grow by it, the rims
+    /// become round; 0 for sharp rims). Never approximated by a polytope.
     GJKD_SHAPE_CYLINDER = 5,
 }
 
@@ -86,7 +88,9 @@ pub enum gjkd_shape_kind {
 pub struct gjkd_shape {
     /// A `gjkd_shape_kind` value.
     pub kind: u32,
-    /// Rounding radius, finite and `>= 0` (the ball's radius for a sphere).
+    /// Rounding radius, finite and `>= 0`: the shape is grown by it (every
+    /// point within `radius` of it), so each of its sizes grows by it (the
+    /// ball's radius for a sphere).
     pub radius: f64,
     /// Capsule: one end. Box: the half extents, each `>= 0`. Cylinder:
     /// `{radius, half_height, 0}`, each `>= 0`.
@@ -133,7 +137,10 @@ pub struct gjkd_query_options {
     pub tolerance: f64,
     /// Early-exit margin, used when `use_margin` is true: stop once the
     /// distance is proved greater than it (`GJKD_QUERY_FARTHER`) or at most
-    /// it (`GJKD_QUERY_CLOSER`). Finite.
+    /// it (`GJKD_QUERY_CLOSER`). Finite. A query may still end
+    /// `GJKD_QUERY_CONVERGED` (the exact distance found before a bound
+    /// crossed the margin, as for objects that touch or are near the
+    /// margin): compare `distance` with the margin then.
     pub margin: f64,
     /// Iteration cap, at least 1 (default `GJKD_DEFAULT_MAX_ITERATIONS`).
     pub max_iterations: u32,
@@ -170,21 +177,31 @@ impl gjkd_query_options {
     /// that a bad option is refused by name, before anything is sent).
     pub fn checked(&self) -> Result<QueryOptions, Failure> {
         if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
-            return Err(Failure::invalid("tolerance must be finite and >= 0"));
+            return Err(Failure::invalid_code(
+                ErrorCode::InvalidOptions,
+                "tolerance must be finite and >= 0",
+            ));
         }
         if self.max_iterations == 0 {
-            return Err(Failure::invalid("max_iterations must be at least 1"));
+            return Err(Failure::invalid_code(
+                ErrorCode::InvalidOptions,
+                "max_iterations must be at least 1",
+            ));
         }
         if self.use_margin && !self.margin.is_finite() {
-            return Err(Failure::invalid("margin must be finite"));
+            return Err(Failure::invalid_code(
+                ErrorCode::InvalidOptions,
+                "margin must be finite",
+            ));
         }
         let precision = match self.precision {
             0 => Precision::Double,
             1 => Precision::Single,
             p => {
-                return Err(Failure::invalid(format!(
-                    "precision {p} is not a gjkd_precision"
-                )));
+                return Err(Failure::invalid_code(
+                    ErrorCode::InvalidOptions,
+                    format!("precision {p} is not a gjkd_precision"),
+                ));
             }
         };
         Ok(QueryOptions {
@@ -206,7 +223,9 @@ pub enum gjkd_query_status {
     GJKD_QUERY_NONE = 0,
     /// The stopping rule held: the distance is exact to the tolerance.
     GJKD_QUERY_CONVERGED = 1,
-    /// Early exit: the distance is proved greater than the margin.
+    /// Early exit: the distance is proved greater than the margin (never
+    /// reported without a margin; with one, `GJKD_QUERY_CONVERGED` may
+    /// come instead, see `gjkd_query_options::margin`).
     GJKD_QUERY_FARTHER = 2,
     /// Early exit: the distance is proved at most the margin.
     GJKD_QUERY_CLOSER = 3,
@@ -245,8 +264,13 @@ pub enum gjkd_error_code {
     GJKD_CODE_TOO_MANY_VERTICES = 6,
     /// A radius is negative, NaN or infinite.
     GJKD_CODE_INVALID_RADIUS = 7,
-    /// A batch has more items than the server accepts (never seen through
-    /// this library: batches are split).
+    /// A request has more items than the server accepts. Pair batches
+    /// (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) are
+    /// split by this library and never see it; a scene question sent as
+    /// one request does: `gjkd_clearance()` and `gjkd_within()` with more
+    /// members and allowed pairs, `gjkd_path()` and `gjkd_path_joints()`
+    /// with more steps times moving objects (or joint items), than the
+    /// server's `max_batch` (`gjkd_server_info()`).
     GJKD_CODE_BATCH_TOO_LARGE = 8,
     /// A batch has no items.
     GJKD_CODE_EMPTY_BATCH = 9,
@@ -463,4 +487,24 @@ impl From<ServerStats> for gjkd_server_stats {
             persist_errors: s.persist_errors,
         }
     }
+}
+
+/// How a handle's registrations treat names and the handle's end; set with
+/// `gjkd_set_registration_options()`. Both off by default.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct gjkd_registration_options {
+    /// A registration whose name is taken gives the id of the object
+    /// already under that name (its shape not compared, its pose not
+    /// changed; a mesh's `out_info` then zeroed), and a robot registration
+    /// whose name is taken gives that robot (attached again to its link
+    /// objects if a restarted server kept them but not the robot): what a
+    /// restarted node needs to get its objects back instead of
+    /// `GJKD_CODE_NAME_TAKEN`.
+    pub reuse_names: bool,
+    /// Objects and robots registered from now on are removed when the
+    /// handle is closed (`gjkd_close()`, the C++ destructor). A process
+    /// that dies without closing leaves them, unless the server runs with
+    /// `--remove-departed`.
+    pub remove_on_close: bool,
 }

@@ -19,11 +19,27 @@ fn last() -> (String, u32) {
     (msg.to_string_lossy().into_owned(), gjkd_last_error_code())
 }
 
+/// Asserts success.
+#[track_caller]
+fn ok(status: gjkd_status) {
+    assert_eq!(status, GJKD_OK, "{:?}", last());
+}
+
 /// Asserts that `status` is `want` and the message contains `words`.
 #[track_caller]
 fn assert_fails(status: gjkd_status, want: gjkd_status, words: &str) {
     let (msg, _) = last();
     assert_eq!(status, want, "message: {msg}");
+    assert!(msg.contains(words), "`{words}` not in `{msg}`");
+}
+
+/// Asserts an argument refused before sending, with the server's `code`
+/// for the same fault and `words` in the message.
+#[track_caller]
+fn assert_invalid(status: gjkd_status, code: gjkd_error_code, words: &str) {
+    let (msg, got) = last();
+    assert_eq!(status, GJKD_ERR_INVALID_ARGUMENT, "message: {msg}");
+    assert_eq!(got, code as u32, "message: {msg}");
     assert!(msg.contains(words), "`{words}` not in `{msg}`");
 }
 
@@ -374,30 +390,52 @@ fn nan_poses_radii_vertices_and_options_get_their_errors() {
     let mut ans = gjkd_answer::default();
     // SAFETY: valid pointers throughout.
     unsafe {
-        assert_fails(
+        // One fault, one status and one code, whichever call meets it.
+        let non_finite = gjkd_error_code::GJKD_CODE_NON_FINITE_POSE;
+        assert_invalid(
             gjkd_set_pose(c, a, &nan),
-            GJKD_ERR_INVALID_ARGUMENT,
+            non_finite,
             "gjkd_set_pose: pose has a NaN or infinite component",
         );
-        assert_fails(
+        assert_invalid(
             gjkd_set_pose(c, a, &skew),
-            GJKD_ERR_INVALID_ARGUMENT,
+            gjkd_error_code::GJKD_CODE_BAD_QUATERNION,
             "not of unit length",
         );
+        // A translation the server could store but no query could use is
+        // refused when set, not at the next query.
+        for x in [1e305, -2.7e300, f64::MAX] {
+            assert_invalid(gjkd_set_pose(c, a, &at(0.0, x, 0.0)), non_finite, "beyond");
+            assert_invalid(
+                gjkd_distance(c, a, b, &at(x, 0.0, 0.0), null(), null(), &mut ans),
+                non_finite,
+                "pose_a",
+            );
+        }
+        assert_eq!(dist(c, a, b), 3.0, "nothing stored");
+        // At the limit, two objects on opposite corners are still answered.
+        let m = GJKD_MAX_TRANSLATION;
+        ok(gjkd_set_pose(c, a, &at(m, m, m)));
+        ok(gjkd_set_pose(c, b, &at(-m, -m, -m)));
+        let far = dist(c, a, b);
+        assert!(far > 9.2e300 && far.is_finite(), "{far}");
+        ok(gjkd_set_pose(c, a, &at(0.0, 0.0, 0.0)));
+        ok(gjkd_set_pose(c, b, &at(5.0, 0.0, 0.0)));
         // A bad row fails the whole call before anything is sent: row 0,
         // good, is not stored either.
         let ids = [a, b];
         let poses = [at(1.0, 0.0, 0.0), nan];
-        assert_fails(
+        assert_invalid(
             gjkd_set_poses(c, ids.as_ptr(), poses.as_ptr(), 2),
-            GJKD_ERR_INVALID_ARGUMENT,
+            non_finite,
             "poses[1] has a NaN",
         );
         assert_eq!(dist(c, a, b), 3.0, "row 0 was not stored");
-        // A pose given for one query: the server refuses it.
-        assert_rejected(
+        // A pose given for one query: refused as gjkd_set_pose refuses it.
+        assert_invalid(
             gjkd_distance(c, a, b, null(), &nan, null(), &mut ans),
-            gjkd_error_code::GJKD_CODE_NON_FINITE_POSE,
+            non_finite,
+            "pose_b has a NaN",
         );
         assert_eq!(ans, gjkd_answer::default(), "a failed answer is zeroed");
         // In a batch, the bad row fails alone.
@@ -559,10 +597,11 @@ fn unknown_ids_and_names_are_rejected_with_their_codes() {
 }
 
 #[test]
-fn a_handle_refuses_other_threads_and_errors_stay_on_their_thread() {
+fn a_handle_serves_any_thread_one_call_at_a_time_and_errors_stay_on_their_thread() {
     let server = Server::start("ffi-thread", &["--no-persist"]);
     let c = connect(&server);
     let a = sphere(c, 1.0, &at(0.0, 0.0, 0.0));
+    let b = sphere(c, 1.0, &at(5.0, 0.0, 0.0));
     // SAFETY: valid pointers.
     unsafe {
         assert_rejected(
@@ -572,27 +611,62 @@ fn a_handle_refuses_other_threads_and_errors_stay_on_their_thread() {
     }
     let mine = last();
     let addr = c as usize;
+    // Another thread uses the handle, then this one again: each call in
+    // turn, on whatever thread.
     let other = std::thread::spawn(move || {
         let c = addr as *mut gjkd_client;
         let mut ans = gjkd_answer::default();
-        // SAFETY: a live handle, refused on this thread before any use.
-        let s = unsafe { gjkd_distance(c, a, a, null(), null(), null(), &mut ans) };
-        let use_msg = last();
-        // SAFETY: as above; refused, so not freed.
-        let close = unsafe { gjkd_close(c) };
-        (s, use_msg, close, last())
+        // SAFETY: a live handle, used by no other call meanwhile.
+        let s = unsafe { gjkd_distance(c, a, b, null(), null(), null(), &mut ans) };
+        // SAFETY: as above.
+        let refused = unsafe { gjkd_remove(c, 0x98) };
+        (s, ans.distance, refused, last())
     })
     .join()
     .expect("the thread ends");
-    assert_eq!(other.0, GJKD_ERR_WRONG_THREAD);
-    assert!(other.1.0.contains("another thread"), "{:?}", other.1);
-    assert_eq!(other.2, GJKD_ERR_WRONG_THREAD);
-    assert!(other.3.0.starts_with("gjkd_close:"), "{:?}", other.3);
+    assert_eq!((other.0, other.1), (GJKD_OK, 3.0));
+    assert_eq!(other.2, GJKD_ERR_REJECTED);
+    assert!(other.3.0.starts_with("gjkd_remove:"), "{:?}", other.3);
     // This thread's last error is its own, and the handle still works.
     assert_eq!(last(), mine);
-    assert_eq!(dist(c, a, a), 0.0);
-    // SAFETY: a live handle, on its thread.
-    assert_eq!(unsafe { gjkd_close(c) }, GJKD_OK);
+    assert_eq!(dist(c, a, b), 3.0);
+    // A call while another thread's call holds the handle is refused, not
+    // run beside it: with the server paused, a call waits its timeout
+    // (one second) for the answer, holding the handle meanwhile.
+    let pid = server.pid().expect("the server runs") as i32;
+    // SAFETY: signals to the test's own child.
+    unsafe { libc::kill(pid, libc::SIGSTOP) };
+    let waiting = std::thread::spawn(move || {
+        let mut ans = gjkd_answer::default();
+        // SAFETY: a live handle.
+        unsafe {
+            gjkd_distance(
+                addr as *mut gjkd_client,
+                a,
+                b,
+                null(),
+                null(),
+                null(),
+                &mut ans,
+            )
+        }
+    });
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let mut ans = gjkd_answer::default();
+    // SAFETY: a live handle, busy on the other thread.
+    let busy = unsafe { gjkd_distance(c, a, b, null(), null(), null(), &mut ans) };
+    assert_eq!(busy, GJKD_ERR_BUSY);
+    assert!(last().0.contains("another thread"), "{:?}", last());
+    assert_eq!(waiting.join().unwrap(), GJKD_ERR_TIMEOUT);
+    // SAFETY: as above.
+    unsafe { libc::kill(pid, libc::SIGCONT) };
+    // Closed on yet another thread: freed there (valgrind checks no leak
+    // in leak_check.c, which does the same).
+    let closed = std::thread::spawn(move || {
+        // SAFETY: a live handle, idle.
+        unsafe { gjkd_close(addr as *mut gjkd_client) }
+    });
+    assert_eq!(closed.join().unwrap(), GJKD_OK);
 }
 
 #[test]
@@ -662,7 +736,8 @@ fn status_and_code_names_cover_every_value() {
     assert_eq!(name(GJKD_OK as i32), "GJKD_OK");
     assert_eq!(name(GJKD_ERR_TIMEOUT as i32), "GJKD_ERR_TIMEOUT");
     assert_eq!(name(GJKD_ERR_PANIC as i32), "GJKD_ERR_PANIC");
-    assert_eq!(name(14), "GJKD_ERR_UNKNOWN");
+    assert_eq!(name(GJKD_ERR_BUSY as i32), "GJKD_ERR_BUSY");
+    assert_eq!(name(15), "GJKD_ERR_UNKNOWN");
     assert_eq!(name(-1), "GJKD_ERR_UNKNOWN");
     let words = unsafe { CStr::from_ptr(gjkd_error_code_describe(1000)) };
     assert_eq!(words.to_str().unwrap(), "unknown error code");

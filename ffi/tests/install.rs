@@ -52,6 +52,41 @@ fn install(dir: &Path) -> std::path::PathBuf {
     ] {
         assert!(prefix.join(f).exists(), "{f} not installed");
     }
+    // Versioned: the file, its soname's link, the linker's link; and only
+    // the C API exported.
+    let version = env!("CARGO_PKG_VERSION");
+    let soname = format!(
+        "libgjkd_c.so.{}.{}",
+        env!("CARGO_PKG_VERSION_MAJOR"),
+        env!("CARGO_PKG_VERSION_MINOR")
+    );
+    let lib = prefix.join("lib");
+    assert!(lib.join(format!("libgjkd_c.so.{version}")).is_file());
+    for link in [soname.as_str(), "libgjkd_c.so"] {
+        let target = std::fs::read_link(lib.join(link)).expect("a link");
+        assert_eq!(target, Path::new(&format!("libgjkd_c.so.{version}")));
+    }
+    if present("readelf") {
+        let dynamic = ok(Command::new("readelf")
+            .arg("-d")
+            .arg(lib.join("libgjkd_c.so")));
+        assert!(dynamic.contains(&format!("[{soname}]")), "{dynamic}");
+    }
+    if present("nm") {
+        let symbols = ok(Command::new("nm")
+            .args(["-D", "--defined-only"])
+            .arg(lib.join("libgjkd_c.so")));
+        let stray: Vec<&str> = symbols
+            .lines()
+            .filter(|l| {
+                !l.split_whitespace()
+                    .last()
+                    .is_some_and(|s| s.starts_with("gjkd_"))
+            })
+            .collect();
+        assert!(stray.is_empty(), "exported beside the C API: {stray:?}");
+        assert!(symbols.contains(" T gjkd_connect"), "{symbols}");
+    }
     prefix
 }
 

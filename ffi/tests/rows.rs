@@ -417,24 +417,26 @@ fn whole_call_errors_are_reported_and_send_nothing() {
     }
     assert_eq!(out, [gjkd_result::default(); 2], "nothing written");
     assert_eq!(stats(c), before, "nothing sent");
-    // Another thread may not use the handle.
+    // Another thread may use the handle (one call at a time).
     let handle = c as usize;
-    let status = std::thread::spawn(move || {
+    let (status, row) = std::thread::spawn(move || {
         let mut out = [gjkd_result::default()];
-        let row = [base(1, 2)];
-        // SAFETY: the handle is live; the call refuses this thread.
-        unsafe {
+        let row = [base(cube, ball)];
+        // SAFETY: the handle is live and idle.
+        let status = unsafe {
             gjkd_query_pairs(
                 handle as *mut gjkd_client,
                 row.as_ptr(),
                 1,
                 out.as_mut_ptr(),
             )
-        }
+        };
+        (status, out[0])
     })
     .join()
     .unwrap();
-    assert_eq!(status, GJKD_ERR_WRONG_THREAD);
+    assert_eq!(status, GJKD_OK);
+    assert_eq!((row.error, row.status), (0, 1), "{row:?}");
     // SAFETY: a live handle.
     ok(unsafe { gjkd_close(c) });
 }

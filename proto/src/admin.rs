@@ -29,6 +29,14 @@ pub enum AdminOp {
     /// text's length in bytes. The reply's id is the robot's id, for
     /// [`ItemKind::SetJoints`](crate::ItemKind::SetJoints); attaching a name again replaces the robot.
     AttachRobot = 6,
+    /// Remove the robot named [`AdminRequest::name`] as a whole: its
+    /// kinematics and every link object, in one commit (all or nothing).
+    /// The reply's id is the robot's id. Refused with
+    /// [`ErrorCode::UnknownName`] (no robot of that name),
+    /// [`ErrorCode::ReadOnly`] (a robot of the scene file) and
+    /// [`ErrorCode::NotOwner`] (another client's robot, or a link object
+    /// another client registered).
+    RemoveRobot = 7,
 }
 
 impl AdminOp {
@@ -41,6 +49,7 @@ impl AdminOp {
             4 => Some(AdminOp::Lookup),
             5 => Some(AdminOp::Stats),
             6 => Some(AdminOp::AttachRobot),
+            7 => Some(AdminOp::RemoveRobot),
             _ => None,
         }
     }
@@ -88,7 +97,8 @@ pub struct AdminRequest {
     /// same token with another shape or name is [`ErrorCode::Malformed`].
     pub token: u64,
     /// UTF-8 name: optional for [`AdminOp::Register`], required for
-    /// [`AdminOp::Lookup`] and [`AdminOp::AttachRobot`].
+    /// [`AdminOp::Lookup`], [`AdminOp::AttachRobot`] and
+    /// [`AdminOp::RemoveRobot`].
     pub name: [u8; MAX_NAME_LEN],
     /// Initial pose of a registered object.
     pub pose: Pose,

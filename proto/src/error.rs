@@ -16,10 +16,11 @@ pub enum ErrorCode {
     /// An object id names no registered object (never registered, removed, or
     /// registered with a server that has since restarted).
     UnknownObject = 1,
-    /// A pose or piece offset has a NaN or infinite component, a piece
-    /// reaches beyond about 5e300 from its object's origin, or a query's two
-    /// objects lie more than about 1e301 apart: gjk's arithmetic could
-    /// overflow.
+    /// A pose or piece offset has a NaN or infinite component or a
+    /// translation component beyond 2^998 (about 2.68e300,
+    /// [`MAX_TRANSLATION`](crate::MAX_TRANSLATION)), a piece reaches beyond
+    /// about 5e300 from its object's origin, or a query's two objects lie
+    /// more than about 1e301 apart: gjk's arithmetic could overflow.
     NonFinitePose = 2,
     /// A rotation quaternion is off unit length by more than 1e-6.
     BadQuaternion = 3,
@@ -120,7 +121,7 @@ impl ErrorCode {
         match self {
             ErrorCode::Ok => "ok",
             ErrorCode::UnknownObject => "unknown object id",
-            ErrorCode::NonFinitePose => "pose is not finite, or beyond 1e301",
+            ErrorCode::NonFinitePose => "pose is not finite, or beyond 2.68e300",
             ErrorCode::BadQuaternion => "rotation quaternion is not of unit length",
             ErrorCode::InvalidOptions => "invalid query options",
             ErrorCode::EmptyVertices => "empty vertex set",

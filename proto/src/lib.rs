@@ -61,7 +61,7 @@ pub use geometry::{
     Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape, hull,
 };
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
-pub use pose::{Pose, UNIT_TOLERANCE};
+pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
     PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags, scene_reply_flags,

@@ -14,6 +14,14 @@ const UNIT_ROUNDING: f64 = 8.0 * f64::EPSILON;
 /// accepted (it is normalised then).
 pub const UNIT_TOLERANCE: f64 = 1e-6;
 
+/// The largest magnitude of a pose's translation component: 2^998, about
+/// 2.68e300. A query refuses two objects whose relative translation, in
+/// the first one's frame, exceeds 2^1000 on an axis (its arithmetic could
+/// overflow beyond); two translations within 2^998 per axis differ by at
+/// most sqrt(3) * 2^999 < 2^1000 along any axis, however rotated, so a pose
+/// accepted when it is stored never makes a later query refuse it.
+pub const MAX_TRANSLATION: f64 = 2.6787715179656683e300;
+
 /// A rigid pose on the wire: translation and rotation quaternion `[i, j, k, w]`
 /// (nalgebra's coordinate order), in f64.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
@@ -54,18 +62,17 @@ impl Pose {
         )
     }
 
-    /// The isometry of this pose as the server takes it: finite, and a
-    /// rotation quaternion within [`UNIT_TOLERANCE`] of unit length
-    /// (normalised unless it already is, to round-off).
+    /// The isometry of this pose as the server takes it: finite, every
+    /// translation component within [`MAX_TRANSLATION`], and a rotation
+    /// quaternion within [`UNIT_TOLERANCE`] of unit length (normalised
+    /// unless it already is, to round-off).
     ///
     /// # Errors
     /// [`ErrorCode::NonFinitePose`], [`ErrorCode::BadQuaternion`].
     pub fn checked(&self) -> Result<Isometry3<f64>, ErrorCode> {
-        if !self
-            .translation
-            .iter()
-            .chain(&self.rotation)
-            .all(|c| c.is_finite())
+        // `<=` is false for NaN, so this also refuses NaN translations.
+        if !(self.translation.iter().all(|c| c.abs() <= MAX_TRANSLATION)
+            && self.rotation.iter().all(|c| c.is_finite()))
         {
             return Err(ErrorCode::NonFinitePose);
         }

@@ -122,3 +122,25 @@ fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<ItemResult>(), 152);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
 }
+
+/// A stored pose is held to 2^998 per translation axis, so that any two
+/// stored poses, however rotated, lie within the 2^1000 a query accepts.
+#[test]
+fn a_translation_beyond_max_translation_is_refused_when_set() {
+    assert_eq!(MAX_TRANSLATION, 2f64.powi(998));
+    let at = |x: f64| Pose {
+        translation: [0.0, x, 0.0],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+    };
+    assert!(at(MAX_TRANSLATION).checked().is_ok());
+    assert!(at(-MAX_TRANSLATION).checked().is_ok());
+    for x in [1e305, -2.7e300, f64::MAX, f64::NAN, f64::INFINITY] {
+        assert_eq!(at(x).checked(), Err(ErrorCode::NonFinitePose), "{x}");
+    }
+    // Two poses at the limit, on opposite corners and one rotated: the
+    // relative translation a query computes stays within 2^1000.
+    let corner = Isometry3::translation(MAX_TRANSLATION, MAX_TRANSLATION, MAX_TRANSLATION);
+    let far = Isometry3::new(-corner.translation.vector, Vector3::new(0.3, -1.1, 0.7));
+    let rel = far.inv_mul(&corner).translation.vector;
+    assert!(rel.iter().all(|c| c.abs() <= 2f64.powi(1000)), "{rel}");
+}

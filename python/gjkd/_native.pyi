@@ -469,6 +469,8 @@ class Client(_Objects):
         (see the README's robot section)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
         """The robot ``name`` already on the server."""
+    def remove_robot(self, robot: Union[Robot, str]) -> None:
+        """Removes a robot (or the robot named so) with every link."""
     def set_joints(
         self,
         robot: Robot,

@@ -315,6 +315,21 @@ backend_methods!(Client, {
         crate::robots::open_robot(self, py, name, urdf_text)
     }
 
+    /// Removes the robot named `name` (or the `gjkd.Robot` given) as a
+    /// whole: its kinematics and every link object, all or nothing
+    /// (`remove` of one link would leave the robot with a hole; the
+    /// robot's `id` is no object id). Raises `NotFound` (`UNKNOWN_NAME`)
+    /// when there is no such robot, and the server's refusals
+    /// (`NOT_OWNER`, `READ_ONLY`) as `remove` does.
+    fn remove_robot(&mut self, py: Python<'_>, robot: &Bound<'_, PyAny>) -> PyResult<()> {
+        let name = match robot.cast::<crate::robots::Robot>() {
+            Ok(r) => r.borrow().handle.name.clone(),
+            Err(_) => robot.extract::<String>()?,
+        };
+        self.call(py, |c| c.remove_robot(&name))?
+            .map_err(|e| errors::client(py, e, Some("robot")))
+    }
+
     /// Sets every joint of `robot` in one round trip, and its base pose
     /// when `base` is given: the server places every link by forward
     /// kinematics. `positions` is a `(dof,)` float64 array in

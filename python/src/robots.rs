@@ -48,7 +48,8 @@ fn row(p: &Isometry3<f64>) -> [f64; 7] {
 
 #[pymethods]
 impl Robot {
-    /// The robot's object id on the server.
+    /// The robot's id on the server: the group id of scene questions about
+    /// it, no object id (its links are the objects).
     #[getter]
     fn id(&self) -> u64 {
         self.handle.id.raw()

@@ -316,6 +316,27 @@ def test_robot_registration_errors(client: gjkd.Client, arm_dir: pathlib.Path) -
         assert e.value.code == gjkd.ErrorCode.UNKNOWN_NAME
 
 
+def test_a_robot_is_removed_whole(client: gjkd.Client, arm_dir: pathlib.Path) -> None:
+    """remove_robot takes the kinematics and every link, by robot or name."""
+    name = robot_name()
+    robot = client.register_robot(name, arm_dir / "arm.urdf")
+    links = [i for i in robot.link_ids if i]
+    with pytest.raises(gjkd.NotFound):
+        client.remove(robot.id)  # the robot's id is no object id
+    client.remove_robot(robot)
+    for link in links:
+        with pytest.raises(gjkd.NotFound):
+            client.distance(link, link)
+    with pytest.raises(gjkd.NotFound) as e:
+        client.remove_robot(name)
+    assert e.value.code == gjkd.ErrorCode.UNKNOWN_NAME
+    # The name is free again, and a robot is removed by name too.
+    client.register_robot(name, arm_dir / "arm.urdf")
+    client.remove_robot(name)
+    with pytest.raises(gjkd.NotFound):
+        client.lookup(f"{name}/base")
+
+
 def test_urdf_text_with_package_path(client: gjkd.Client, arm_dir: pathlib.Path) -> None:
     text = ARM_URDF.replace("meshes/fore.stl", f"package://{arm_dir.name}/meshes/fore.stl")
     robot = client.register_robot(robot_name(), urdf_text=text, package_path=[arm_dir.parent])

@@ -59,15 +59,19 @@ pub fn static_lib() -> PathBuf {
 /// `cxx`. Panics with the compiler's
 /// output on failure.
 pub fn compile(sources: &[&str], name: &str, cxx: bool) -> PathBuf {
-    let (var, default, std) = if cxx {
-        ("CXX", "c++", "-std=c++17")
-    } else {
-        ("CC", "cc", "-std=c99")
-    };
+    let std = if cxx { "-std=c++17" } else { "-std=c99" };
+    compile_with(sources, name, cxx, &[std])
+}
+
+/// [`compile`] with `flags` (the language standard among them) instead of
+/// the default standard.
+pub fn compile_with(sources: &[&str], name: &str, cxx: bool, flags: &[&str]) -> PathBuf {
+    let (var, default) = if cxx { ("CXX", "c++") } else { ("CC", "cc") };
     let compiler = std::env::var(var).unwrap_or_else(|_| default.into());
     let exe = build_dir().join(name);
     let mut cmd = Command::new(&compiler);
-    cmd.args([std, "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-g"])
+    cmd.args(flags)
+        .args(["-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-g"])
         .arg("-I")
         .arg(crate_dir().join("include"));
     for s in sources {
@@ -80,7 +84,7 @@ pub fn compile(sources: &[&str], name: &str, cxx: bool) -> PathBuf {
     cmd.arg("-L")
         .arg(&lib_dir)
         .arg(format!("-Wl,-rpath,{}", lib_dir.display()))
-        .args(["-lgjkd_c", "-lm", "-o"])
+        .args(["-lgjkd_c", "-lm", "-lpthread", "-o"])
         .arg(&exe);
     let out = cmd
         .output()

@@ -637,12 +637,7 @@ impl ObjectStore {
     /// [`ErrorCode::StorageFull`] or [`ErrorCode::Internal`] when the commit
     /// fails (nothing is removed).
     pub fn remove(&mut self, id: u64, requester: u128) -> Result<u64, ErrorCode> {
-        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
-        match object.owner {
-            Owner::Scene => return Err(ErrorCode::ReadOnly),
-            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
-            Owner::Client(_) => {}
-        }
+        self.check_removable(id, requester)?;
         let Some(object) = self.unlink_object(id) else {
             return Err(ErrorCode::UnknownObject);
         };
@@ -653,6 +648,37 @@ impl ObjectStore {
         }
         self.tokens.forget_object(id);
         Ok(id)
+    }
+
+    /// Whether `requester` may remove object `id`.
+    ///
+    /// # Errors
+    /// As [`ObjectStore::remove`], before anything changes.
+    fn check_removable(&self, id: u64, requester: u128) -> Result<(), ErrorCode> {
+        let object = self.objects.get(&id).ok_or(ErrorCode::UnknownObject)?;
+        match object.owner {
+            Owner::Scene => Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => Err(ErrorCode::NotOwner),
+            Owner::Client(_) => Ok(()),
+        }
+    }
+
+    /// Removes every object of `ids` on behalf of `requester` in one
+    /// commit, all or nothing (a robot's links: a robot is never left
+    /// with a hole).
+    ///
+    /// # Errors
+    /// As [`ObjectStore::remove`] for the first object that cannot be
+    /// removed, or for the commit; nothing is removed then.
+    pub fn remove_all(&mut self, ids: &[u64], requester: u128) -> Result<(), ErrorCode> {
+        for &id in ids {
+            self.check_removable(id, requester)?;
+        }
+        let doomed: Vec<(u64, u128)> = ids.iter().map(|&id| (id, requester)).collect();
+        match self.remove_in_bulk(&doomed) {
+            (_, Some(code)) => Err(code),
+            (_, None) => Ok(()),
+        }
     }
 }
 

@@ -68,6 +68,14 @@ impl Robots {
         self.names.get(name).copied()
     }
 
+    /// Takes robot `id` out (its link objects are the caller's to
+    /// remove).
+    pub fn take(&mut self, id: u64) -> Option<Robot> {
+        let robot = self.by_id.remove(&id)?;
+        self.names.remove(&robot.name);
+        Some(robot)
+    }
+
     /// Number of robots.
     pub fn len(&self) -> usize {
         self.by_id.len()
@@ -547,5 +555,73 @@ mod tests {
         // The name is free again for the next client.
         assert_eq!(insert_links(&mut s, CLIENT + 1), 3);
         assert!(attach_text(&mut s, URDF, CLIENT + 1).is_ok());
+    }
+
+    fn remove_robot(s: &mut State, name: &str, who: u128) -> Result<u64, ErrorCode> {
+        let mut req = AdminRequest::new(AdminOp::RemoveRobot);
+        req.set_name(name);
+        let reply = s.handle_admin(who, &req, &[]);
+        match reply.error_code() {
+            ErrorCode::Ok => Ok(reply.id),
+            e => Err(e),
+        }
+    }
+
+    /// A robot is removed as a whole, by its owner only, all or nothing:
+    /// its links, its kinematics and its name go together.
+    #[test]
+    fn a_robot_is_removed_with_every_link_by_its_owner_only() {
+        let mut s = state_with_links();
+        let id = attach_text(&mut s, URDF, CLIENT).unwrap();
+        let before = s.len();
+        let links: Vec<u64> = ["two/base", "two/arm", "two/finger"]
+            .iter()
+            .map(|n| s.lookup(n).unwrap())
+            .collect();
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT + 1),
+            Err(ErrorCode::NotOwner)
+        );
+        assert_eq!(
+            remove_robot(&mut s, "nobody", CLIENT),
+            Err(ErrorCode::UnknownName)
+        );
+        assert_eq!(s.len(), before, "nothing removed on refusal");
+        assert!(s.robots.get(id).is_some());
+        assert_eq!(remove_robot(&mut s, "two", CLIENT), Ok(id));
+        assert_eq!(s.len(), before - links.len());
+        for l in links {
+            assert!(s.object(l).is_none(), "link {l} left behind");
+        }
+        assert!(s.robots.get(id).is_none());
+        assert_eq!(s.robots.lookup("two"), None);
+        let r = one(
+            &mut s,
+            Item::set_joints(ObjectId::from_raw(id), 0, &[0.0, 0.0], None, false),
+        );
+        assert_eq!(r.error_code(), ErrorCode::UnknownObject);
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT),
+            Err(ErrorCode::UnknownName)
+        );
+        // The scene's ball is untouched; the names are free again.
+        assert!(s.lookup("ball").is_some());
+        assert_eq!(insert_links(&mut s, CLIENT), 3);
+        assert!(attach_text(&mut s, URDF, CLIENT).is_ok());
+    }
+
+    /// A link another client registered makes the removal refused whole.
+    #[test]
+    fn a_robot_with_another_clients_link_is_not_removed_at_all() {
+        let mut s = State::new(Limits::default(), WaitMode::Spin, 5);
+        insert_links(&mut s, CLIENT + 1);
+        let id = attach_text(&mut s, URDF, CLIENT).unwrap();
+        let before = s.len();
+        assert_eq!(
+            remove_robot(&mut s, "two", CLIENT),
+            Err(ErrorCode::NotOwner)
+        );
+        assert_eq!(s.len(), before);
+        assert!(s.robots.get(id).is_some());
     }
 }

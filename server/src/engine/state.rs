@@ -257,6 +257,39 @@ impl State {
         Ok(())
     }
 
+    /// Removes the robot named `name` as a whole on behalf of `requester`:
+    /// its link objects (in one commit, all or nothing), their warm
+    /// starts, then its kinematics. Returns the robot's id.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownName`] (no such robot), [`ErrorCode::ReadOnly`]
+    /// (a scene robot), [`ErrorCode::NotOwner`] (another client's robot or
+    /// link), and those of [`ObjectStore::remove_all`]; nothing changes
+    /// then.
+    pub fn remove_robot(&mut self, name: &str, requester: u128) -> Result<u64, ErrorCode> {
+        let id = self.robots.lookup(name).ok_or(ErrorCode::UnknownName)?;
+        let robot = self.robots.get(id).ok_or(ErrorCode::UnknownName)?;
+        match robot.owner {
+            Owner::Scene => return Err(ErrorCode::ReadOnly),
+            Owner::Client(c) if c != requester => return Err(ErrorCode::NotOwner),
+            Owner::Client(_) => {}
+        }
+        // Links removed since (one by one, by their owner) are gone already.
+        let links: Vec<u64> = robot
+            .links
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&l| self.store.object(l).is_some())
+            .collect();
+        self.store.remove_all(&links, requester)?;
+        for &l in &links {
+            self.cache.forget_object(l);
+        }
+        self.robots.take(id);
+        Ok(id)
+    }
+
     /// Removes the objects of every client for which `alive` is false, and
     /// their warm starts (see [`ObjectStore::remove_departed`]).
     pub fn remove_departed(

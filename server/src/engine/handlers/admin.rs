@@ -64,6 +64,10 @@ impl State {
                 _ => Err(ErrorCode::Malformed),
             },
             Some(AdminOp::AttachRobot) => self.attach_request(requester, request, vertices),
+            Some(AdminOp::RemoveRobot) => match request.name() {
+                Some(name) => self.remove_robot(name, requester),
+                None => Err(ErrorCode::Malformed),
+            },
             None => Err(ErrorCode::Malformed),
         };
         match outcome {

@@ -1,0 +1,98 @@
+//! Objects and robots found again by name, and robots removed whole: what
+//! a node restarted under the same names needs, since objects outlive the
+//! client that registered them (and, with persistence, the server).
+
+use std::path::Path;
+
+use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Geometry, ObjectId};
+use nalgebra::Isometry3;
+
+use crate::robots::{PackagePath, RobotHandle};
+use crate::{Client, ClientError};
+
+impl Client {
+    /// The object named `name`: registered as [`Client::register_named`]
+    /// would, or, when an object of that name exists already (registered
+    /// before by this program's previous run, or by anyone), that object's
+    /// id, as it is: its shape is not compared and its pose not changed.
+    /// So a node restarted under the same names gets its objects back
+    /// instead of [`ErrorCode::NameTaken`]. (An object found so keeps its
+    /// owner: only the client that registered it may remove it.)
+    ///
+    /// # Errors
+    /// As [`Client::register_named`], without [`ErrorCode::NameTaken`].
+    pub fn register_named_or_get(
+        &mut self,
+        name: &str,
+        geometry: &Geometry<'_>,
+        pose: &Isometry3<f64>,
+    ) -> Result<ObjectId, ClientError> {
+        loop {
+            match self.register_named(name, geometry, pose) {
+                Err(ClientError::Rejected(ErrorCode::NameTaken)) => {}
+                other => return other,
+            }
+            match self.lookup(name) {
+                // Removed between the two calls: register again.
+                Err(ClientError::Rejected(ErrorCode::UnknownName)) => {}
+                other => return other,
+            }
+        }
+    }
+
+    /// The robot named `name`: the one on the server if there is one
+    /// ([`Client::open_robot`]); else its link objects, if they are there
+    /// (a server restarted since, which keeps objects but not robots),
+    /// with the robot attached to them again ([`Client::attach_robot`]);
+    /// else registered from `urdf` as [`Client::register_robot_text`]
+    /// does. So a node restarted under the same name gets its robot back
+    /// instead of [`ErrorCode::NameTaken`]. A robot found is not moved;
+    /// one attached or registered is put at `base`.
+    ///
+    /// # Errors
+    /// As [`Client::register_robot_text`], without
+    /// [`ErrorCode::NameTaken`].
+    pub fn register_robot_text_or_get(
+        &mut self,
+        name: &str,
+        urdf: &str,
+        srdf: Option<&str>,
+        mesh_base: Option<&Path>,
+        packages: &PackagePath,
+        base: &Isometry3<f64>,
+    ) -> Result<RobotHandle, ClientError> {
+        match self.open_robot(name, urdf) {
+            Err(ClientError::Rejected(ErrorCode::UnknownName)) => {}
+            other => return other,
+        }
+        match self.register_robot_text(name, urdf, srdf, mesh_base, packages, base) {
+            Err(ClientError::Rejected(ErrorCode::NameTaken)) => {
+                self.attach_robot(name, urdf, srdf, base)
+            }
+            other => other,
+        }
+    }
+
+    /// Removes the robot named `name` as a whole: its kinematics and every
+    /// link object, in one step on the server (all or nothing). Removing
+    /// one link with [`Client::remove`] would leave a robot with a hole.
+    ///
+    /// # Errors
+    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`] (no robot
+    /// of that name: never registered, removed, or a server restarted
+    /// since, which keeps the link objects but not the robot: attach it
+    /// again first), [`ErrorCode::NotOwner`] (another client's robot or
+    /// link), [`ErrorCode::ReadOnly`] (a robot of the server's scene file),
+    /// [`ErrorCode::StorageFull`]; [`ClientError::InvalidArgument`] for a
+    /// name over [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the
+    /// connection errors.
+    pub fn remove_robot(&mut self, name: &str) -> Result<(), ClientError> {
+        let mut request = AdminRequest::new(AdminOp::RemoveRobot);
+        if !request.set_name(name) {
+            return Err(ClientError::InvalidArgument(
+                "name longer than MAX_NAME_LEN",
+            ));
+        }
+        self.admin(&request, &[]).map(|_| ())
+    }
+}

@@ -26,6 +26,7 @@
 
 mod args;
 mod connect;
+mod gradient;
 mod handle;
 mod meshes;
 mod objects;
@@ -38,6 +39,7 @@ mod thread;
 mod types;
 
 pub use connect::*;
+pub use gradient::*;
 pub use handle::gjkd_client;
 pub use meshes::*;
 pub use objects::*;

@@ -10,6 +10,7 @@ use gjkd_proto::{ItemKind, Pose, item_flags};
 use rust_client::{Item, ItemResult};
 
 use crate::args::{slice, slice_mut};
+use crate::gradient::gjkd_gradient;
 use crate::handle::{gjkd_client, with_client};
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::{gjkd_id, gjkd_pose, gjkd_precision, gjkd_query_options};
@@ -40,7 +41,9 @@ const ROW_FLAGS: u32 = item_flags::POSE_A
     | item_flags::POSE_B
     | item_flags::MARGIN
     | item_flags::WARM_START
-    | item_flags::SINGLE_PRECISION;
+    | item_flags::SINGLE_PRECISION
+    | item_flags::GRADIENT
+    | item_flags::GRADIENT_BASE;
 
 /// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
 /// server reads (so a batch of rows is copied into it in one piece). Make
@@ -126,6 +129,9 @@ pub struct gjkd_result {
     pub flags: u32,
     /// Pieces of A and B that realise the distance (0 for convex objects).
     pub pieces: [u32; 2],
+    /// The distance's gradient, with `GJKD_PAIR_GRADIENT` in the row's
+    /// flags (`columns` 0 otherwise).
+    pub gradient: gjkd_gradient,
 }
 
 // `gjkd_result` is `ItemResult` under a C name: same size, alignment and
@@ -145,6 +151,7 @@ const _: () = {
     assert!(offset_of!(gjkd_result, iterations) == offset_of!(ItemResult, iterations));
     assert!(offset_of!(gjkd_result, flags) == offset_of!(ItemResult, flags));
     assert!(offset_of!(gjkd_result, pieces) == offset_of!(ItemResult, pieces));
+    assert!(offset_of!(gjkd_result, gradient) == offset_of!(ItemResult, gradient));
 };
 
 /// A row asking the distance of `a` and `b` at their stored poses, with

@@ -260,6 +260,7 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
             iterations: want.iterations,
             flags: want.flags,
             pieces: want.pieces,
+            gradient: Default::default(),
         };
         assert_eq!(bits(got), bits(&want_row), "row {i}");
         assert_eq!(

@@ -102,13 +102,13 @@ fn point_jacobians_of_the_test_arm_match_finite_differences() {
     let kin = Kinematics::from_urdf_str(files::ARM_URDF).unwrap();
     // The mimic finger follows j6 with multiplier -1: its column lands on j6.
     assert_eq!(kin.dof(), 5);
-    check_robot(&kin, 0x5eed_a1);
+    check_robot(&kin, 0x5eeda1);
 }
 
 #[test]
 fn point_jacobians_of_the_panda_and_ur5_match_finite_differences() {
     check_robot(&kinematics(&files::panda_urdf()), 0x9a4da);
-    check_robot(&kinematics(&files::ur5_urdf()), 0x0_05_u64 + 7);
+    check_robot(&kinematics(&files::ur5_urdf()), 0x05u64 + 7);
 }
 
 #[test]

@@ -69,9 +69,23 @@ pub mod item_flags {
     /// round trip is made of. Refused as malformed on any other item and
     /// outside a path.
     pub const END_STEP: u32 = 1 << 6;
+    /// [`super::ItemKind::Distance`]: also the distance's gradient with
+    /// respect to the coordinates that move object A (see
+    /// [`Gradient`](crate::Gradient)).
+    pub const GRADIENT: u32 = 1 << 7;
+    /// With [`GRADIENT`], when A is a robot link: the base pose's twist
+    /// too, in the gradient's last 6 columns.
+    pub const GRADIENT_BASE: u32 = 1 << 8;
     /// Every bit this version knows; others are rejected as malformed.
-    pub const ALL: u32 =
-        POSE_A | POSE_B | MARGIN | WARM_START | SINGLE_PRECISION | CLAMP | END_STEP;
+    pub const ALL: u32 = POSE_A
+        | POSE_B
+        | MARGIN
+        | WARM_START
+        | SINGLE_PRECISION
+        | CLAMP
+        | END_STEP
+        | GRADIENT
+        | GRADIENT_BASE;
 }
 
 /// Per-query options, the client-side view of [`Item`]'s option fields.

@@ -4,7 +4,7 @@
 use iceoryx2::prelude::ZeroCopySend;
 use nalgebra::{Point3, Vector3};
 
-use crate::ErrorCode;
+use crate::{ErrorCode, Gradient};
 
 /// How a query ended; the wire values of [`ItemResult::status`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -90,6 +90,10 @@ pub struct ItemResult {
     pub flags: u32,
     /// Pieces of A and B that realise the distance (0 for convex objects).
     pub pieces: [u32; 2],
+    /// The distance's gradient, when asked
+    /// ([`item_flags::GRADIENT`](crate::item_flags::GRADIENT),
+    /// [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS)).
+    pub gradient: Gradient,
 }
 
 impl ItemResult {
@@ -108,6 +112,7 @@ impl ItemResult {
             iterations: 0,
             flags: 0,
             pieces: [0; 2],
+            gradient: Gradient::NONE,
         }
     }
 
@@ -133,6 +138,7 @@ impl ItemResult {
                 pieces: self.pieces,
                 warm_started: self.flags & result_flags::WARM_STARTED != 0,
                 backup_used: self.flags & result_flags::BACKUP_USED != 0,
+                gradient: self.gradient.is_present().then_some(self.gradient),
             }),
             code => Err(code),
         }
@@ -175,6 +181,8 @@ pub struct Answer {
     pub warm_started: bool,
     /// gjk's Backup Procedure ran.
     pub backup_used: bool,
+    /// The distance's gradient, when asked (see [`Gradient`]).
+    pub gradient: Option<Gradient>,
 }
 
 /// Response header of the query service: whole-request errors. When `error`

@@ -111,8 +111,21 @@ pub mod scene_flags {
     /// Clamp joint positions outside their limits instead of refusing the
     /// request, as [`item_flags::CLAMP`](crate::item_flags::CLAMP).
     pub const CLAMP: u32 = 1 << 5;
+    /// Every row also carries its distance's gradient with respect to the
+    /// coordinates that move its `a` object (see
+    /// [`Gradient`](crate::Gradient)), at the row's step.
+    pub const GRADIENTS: u32 = 1 << 6;
+    /// With [`GRADIENTS`], rows of robot links: the base pose's twist too.
+    pub const GRADIENT_BASE: u32 = 1 << 7;
     /// Every bit this version knows; others are refused as malformed.
-    pub const ALL: u32 = WARM_START | MOTION_BOUNDS | ALL_PAIRS | SINGLE_PRECISION | CUTOFF | CLAMP;
+    pub const ALL: u32 = WARM_START
+        | MOTION_BOUNDS
+        | ALL_PAIRS
+        | SINGLE_PRECISION
+        | CUTOFF
+        | CLAMP
+        | GRADIENTS
+        | GRADIENT_BASE;
 }
 
 /// Bits of [`SceneReply::flags`].

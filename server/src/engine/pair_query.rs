@@ -50,6 +50,7 @@ pub(crate) fn run_pair(
         iterations: answer.iterations,
         flags,
         pieces: answer.pieces,
+        gradient: gjkd_proto::Gradient::NONE,
     };
     Ok((result, answer.warm_start))
 }

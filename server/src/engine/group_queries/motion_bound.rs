@@ -83,6 +83,7 @@ pub(crate) fn bounded_result(bound: &PairBound, w: &Widened, a: &Entry, b: &Entr
         iterations: 0,
         flags: 0,
         pieces: bound.pieces,
+        gradient: gjkd_proto::Gradient::NONE,
     }
 }
 

@@ -31,14 +31,16 @@
 
 #[macro_use]
 mod cpu;
+mod depth;
 mod johnson;
 mod numeric;
 mod overlap;
-mod query;
+pub(crate) mod query;
 mod separation;
 mod shape;
 mod support_map;
 
+pub use depth::{DepthOptions, SignedDistance, signed_distance, signed_distance_after};
 pub use overlap::penetration_bound;
 #[doc(hidden)]
 pub use query::distance_in_baseline;

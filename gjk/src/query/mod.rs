@@ -3,6 +3,7 @@
 
 mod answer;
 mod compound;
+pub(crate) mod core_run;
 mod full_step;
 mod numerical_algorithm;
 mod options;

@@ -47,7 +47,7 @@ pub(super) const COLD_SEED_AFTER: u32 = 2;
 
 /// Whether `iso` is the identity, exactly.
 #[inline(always)]
-pub(super) fn is_identity(iso: &Isometry3<f64>) -> bool {
+pub(crate) fn is_identity(iso: &Isometry3<f64>) -> bool {
     let q = iso.rotation.coords;
     let shift = iso.translation.vector;
     (q.w == 1.0 && q.x == 0.0 && q.y == 0.0 && q.z == 0.0) && shift == Vector3::zeros()

@@ -531,3 +531,69 @@ fn gradients_that_cannot_be_given_are_refused() {
     s.state.handle(1, &[item], &mut out);
     assert_eq!(out[0].error, gjkd_proto::ErrorCode::InvalidOptions as u32);
 }
+
+/// Overlapping pairs: the gradient of the signed distance (minus the
+/// penetration depth) against closed forms: two balls (along the line of
+/// centres), a ball sunk into a box's face (along the face normal, turning
+/// the ball about its centre changes nothing).
+#[test]
+fn overlapping_pairs_have_the_signed_distance_gradient() {
+    let mut state = State::new(Limits::default(), WaitMode::Spin, 11);
+    let mut put = |shape: Shape, pose: Isometry3<f64>| {
+        state
+            .insert(
+                NewObject {
+                    shape,
+                    pose,
+                    name: None,
+                },
+                Owner::Client(1),
+            )
+            .unwrap()
+    };
+    let ball = put(
+        Convex::sphere(0.5).unwrap().into(),
+        Isometry3::translation(0.0, 0.0, 0.0),
+    );
+    let other = put(
+        Convex::sphere(0.5).unwrap().into(),
+        Isometry3::translation(0.6, 0.8, 0.0),
+    );
+    let slab = put(
+        Convex::cuboid(Vector3::new(2.0, 2.0, 0.5), 0.0)
+            .unwrap()
+            .into(),
+        Isometry3::translation(5.0, 0.0, 0.0),
+    );
+    let sunk = put(
+        Convex::sphere(0.3).unwrap().into(),
+        Isometry3::translation(5.1, 0.2, 0.4),
+    );
+    // Radii 0.5 + 0.5, centres moved 0.9 apart: 0.1 deep.
+    let mut item = Item::set_pose(
+        ObjectId::from_raw(other),
+        &Isometry3::translation(0.54, 0.72, 0.0),
+    );
+    item.flags = 0;
+    let mut out = [ItemResult::default()];
+    state.handle(1, &[item], &mut out);
+    let got = pair_with_gradient(&mut state, ball, other, false);
+    assert_eq!(got.distance, 0.0);
+    // Depth 0.1: the certified lower bound on the depth is that close.
+    assert!((got.penetration - 0.1).abs() < 1e-8, "{got:?}");
+    let g = got.gradient;
+    assert_eq!(g.flags & gradient_flags::NO_DIRECTION, 0, "{g:?}");
+    let want = [-0.6, -0.8, 0.0, 0.0, 0.0, 0.0];
+    for (x, y) in g.as_slice().iter().zip(want) {
+        assert!((x - y).abs() < 1e-6, "{g:?}");
+    }
+    // The ball's centre 0.1 under the slab's top face (z = 0.5), radius
+    // 0.3: 0.4 deep; moving the ball up raises the signed distance one for
+    // one.
+    let got = pair_with_gradient(&mut state, sunk, slab, false);
+    assert!((got.penetration - 0.4).abs() < 1e-8, "{got:?}");
+    let want = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    for (x, y) in got.gradient.as_slice().iter().zip(want) {
+        assert!((x - y).abs() < 1e-6, "{:?}", got.gradient);
+    }
+}

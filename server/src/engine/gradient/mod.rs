@@ -14,7 +14,7 @@ use gjkd_proto::{ErrorCode, GRADIENT_COLUMNS, Gradient, ItemResult, gradient_fla
 use nalgebra::{Isometry3, Point3, Vector3};
 
 pub(crate) use poses::{LinkPoses, StepConfigurations};
-pub(crate) use witness::{not_unique, witness};
+pub(crate) use witness::{not_unique, overlap_witness, witness};
 
 use super::robots::Robots;
 
@@ -55,7 +55,7 @@ pub(crate) fn fill(
     cache: &mut LinkPoses,
     stance: Stance<'_>,
 ) -> Result<(), ErrorCode> {
-    let w = witness(result);
+    let w = witness(result).or_else(|| overlap_witness(result, &a, &b));
     let (point_a, point_b) = match &w {
         Some(w) => (w.point_a, w.point_b),
         None => (Point3::from(result.point_a), Point3::from(result.point_b)),
@@ -113,7 +113,7 @@ pub(crate) fn fill(
                 *value = w.normal.dot(column);
                 widest = widest.max(column.norm());
             }
-            gradient.error = normal_error(result.lower, result.upper) * widest;
+            gradient.error = w.normal_error * widest;
             if not_unique(
                 (a.shape, a.pose),
                 (b.shape, b.pose),
@@ -157,17 +157,4 @@ fn add_twist_columns(
     for (column, twist) in out.iter_mut().zip(twist_jacobian(origin, point)) {
         *column += twist * sign;
     }
-}
-
-/// A bound on `|n − n*|` for the reported unit normal `n` and the true one
-/// `n*`: the reported vector is a point of the Minkowski difference no
-/// longer than `upper`, and every point of it lies beyond `d* >= lower`
-/// along `n*`, so `cos θ >= lower / upper`, and `|n − n*| = 2 sin(θ/2) =
-/// sqrt(2 (1 − cos θ))`.
-fn normal_error(lower: f64, upper: f64) -> f64 {
-    if upper.is_nan() || upper <= 0.0 {
-        return 2.0;
-    }
-    let cos = (lower / upper).clamp(0.0, 1.0);
-    (2.0 * (1.0 - cos)).sqrt()
 }

@@ -1,9 +1,11 @@
 //! What a gradient is read from: the pair's witness points and unit
 //! normal, and whether those points are unique.
 
-use gjk::{Convex, Shape, SupportMap};
+use gjk::{Convex, DepthOptions, Shape, SupportMap};
 use gjkd_proto::ItemResult;
 use nalgebra::{Isometry3, Point3, Vector3};
+
+use super::Side;
 
 /// The witness points (world) and unit normal (from `a` towards `b`) of a
 /// pair's distance.
@@ -12,6 +14,9 @@ pub(crate) struct Witness {
     pub point_a: Point3<f64>,
     pub point_b: Point3<f64>,
     pub normal: Vector3<f64>,
+    /// A bound on `|n − n*|`, the reported normal's distance to the true
+    /// one ([`normal_error`]).
+    pub normal_error: f64,
 }
 
 /// The witness of `result`'s distance, `None` when the objects overlap
@@ -25,7 +30,47 @@ pub(crate) fn witness(result: &ItemResult) -> Option<Witness> {
         point_a: Point3::from(result.point_a),
         point_b: Point3::from(result.point_b),
         normal: normal.normalize(),
+        normal_error: normal_error(result.lower, result.upper),
     })
+}
+
+/// The witness of an overlapping (or touching) pair: gjk's signed
+/// distance (the penetration depth by an expanding polytope), whose
+/// certified lower bound on the depth also raises `result.penetration`.
+/// `None` if gjk cannot answer (it answered the distance, so never).
+pub(crate) fn overlap_witness(
+    result: &mut ItemResult,
+    a: &Side<'_>,
+    b: &Side<'_>,
+) -> Option<Witness> {
+    let sd =
+        gjk::signed_distance(a.shape, a.pose, b.shape, b.pose, &DepthOptions::default()).ok()?;
+    if sd.normal.norm_squared() <= 0.25 || !sd.normal.iter().all(|c| c.is_finite()) {
+        return None;
+    }
+    result.penetration = result.penetration.max(-sd.upper);
+    Some(Witness {
+        point_a: sd.point_a,
+        point_b: sd.point_b,
+        normal: sd.normal.normalize(),
+        // The depth's interval, read as the distance's is: a scale of the
+        // normal's error, not a proof of it (the depth's normal is the
+        // minimiser of a support function, not a nearest point).
+        normal_error: normal_error(-sd.upper, -sd.lower),
+    })
+}
+
+/// A bound on `|n − n*|` for the reported unit normal `n` and the true one
+/// `n*`: the reported vector is a point of the Minkowski difference no
+/// longer than `upper`, and every point of it lies beyond `d* >= lower`
+/// along `n*`, so `cos θ >= lower / upper`, and `|n − n*| = 2 sin(θ/2) =
+/// sqrt(2 (1 − cos θ))`.
+pub(crate) fn normal_error(lower: f64, upper: f64) -> f64 {
+    if upper.is_nan() || upper <= 0.0 {
+        return 2.0;
+    }
+    let cos = (lower / upper).clamp(0.0, 1.0);
+    (2.0 * (1.0 - cos)).sqrt()
 }
 
 /// How far, in radians, the direction is tipped to find the supporting

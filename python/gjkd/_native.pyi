@@ -160,6 +160,19 @@ class Answer:
     @property
     def backup_used(self) -> bool:
         """The Backup Procedure ran."""
+    @property
+    def gradient(self) -> Optional[_F64]:
+        """``(columns,)`` the distance's gradient (``None`` when not asked).
+
+        With respect to the coordinates that move ``a``; for overlapping
+        objects, the signed distance's (``distance - penetration``).
+        """
+    @property
+    def gradient_not_unique(self) -> bool:
+        """The nearest points are not unique: a one-sided gradient."""
+    @property
+    def gradient_error(self) -> float:
+        """A bound on each gradient entry's error from the interval."""
 
 @final
 class Distances:
@@ -214,8 +227,20 @@ class Distances:
 class SceneRows:
     """Room for the rows of scene answers, reused from call to call."""
 
-    def __new__(cls, n: int) -> Self:
-        """Zeroed room for ``n`` rows."""
+    def __new__(cls, n: int, gradient_columns: int = 0, gradient_base: bool = False) -> Self:
+        """Zeroed room for ``n`` rows (and ``gradient_columns`` gradient
+        entries per row: a call then asks each row's distance gradient)."""
+    @property
+    def gradient(self) -> _F64:
+        """``(n, gradient_columns)`` each row's gradient with respect to the
+        coordinates that move its ``a`` (a robot's joints, then the base twist
+        with ``gradient_base``; another object's twist)."""
+    @property
+    def gradient_flags(self) -> _U32:
+        """``(n,)`` 1 computed, 2 not unique, 4 base included, 8 no direction."""
+    @property
+    def gradient_error(self) -> _F64:
+        """``(n,)`` a bound on each row's gradient entries' error."""
     def __len__(self) -> int: ...
     @property
     def a(self) -> _U64:
@@ -385,8 +410,17 @@ class _Objects:
         max_iterations: int = 128,
         margin: Optional[float] = None,
         warm_start: bool = True,
+        gradient: bool = False,
+        gradient_base: bool = False,
     ) -> Answer:
-        """The distance between objects ``a`` and ``b``."""
+        """The distance between objects ``a`` and ``b``.
+
+        ``gradient=True`` also asks its gradient with respect to the
+        coordinates that move ``a`` (``Answer.gradient``): a robot link's
+        robot's moving joints (``Robot.joint_names`` order), then with
+        ``gradient_base=True`` the base twist ``[v, ω]``; any other object,
+        its pose's twist (world frame, turning about its origin).
+        """
     def distances(
         self,
         pairs: _ArrayLike,

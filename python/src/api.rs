@@ -152,6 +152,9 @@ pub struct QueryArgs {
     pub margin: Option<f64>,
     /// Start from the pair's last simplex.
     pub warm_start: bool,
+    /// Also the distance's gradient: `None`, or `Some(base)` with the base
+    /// twist's columns when `base`.
+    pub gradient: Option<bool>,
 }
 
 /// One pair query.
@@ -172,6 +175,9 @@ pub fn distance(
         args.warm_start,
     )?;
     let mut item = Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(b), &opts);
+    if let Some(base) = args.gradient {
+        item = item.with_gradient(base);
+    }
     if let Some(p) = pose(pose_a, "pose_a")? {
         set_pose_a(&mut item, p);
     }
@@ -439,12 +445,16 @@ macro_rules! backend_methods {
             /// epsilon), `max_iterations` the iteration cap, `margin`
             /// an early exit (stop once the distance is proved above or at
             /// most it), `warm_start` starts from the pair's last simplex.
+            /// `gradient=True` also asks the distance's gradient with
+            /// respect to the coordinates that move `a` (its robot's
+            /// joints, or its pose's twist; `Answer.gradient`), and
+            /// `gradient_base=True` the robot base's twist too.
             /// Returns an `Answer`; a refused query raises (`NotFound` for
             /// an unknown id, `InvalidInput` for a bad pose).
             #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true),
-                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True)")]
+                margin = None, warm_start = true, gradient = false, gradient_base = false),
+                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, gradient=False, gradient_base=False)")]
             #[allow(clippy::too_many_arguments)]
             fn distance(
                 &mut self,
@@ -457,8 +467,11 @@ macro_rules! backend_methods {
                 max_iterations: u32,
                 margin: Option<f64>,
                 warm_start: bool,
+                gradient: bool,
+                gradient_base: bool,
             ) -> PyResult<crate::batch::Answer> {
-                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                let gradient = gradient.then_some(gradient_base);
+                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start, gradient };
                 crate::api::distance(self, py, a, b, pose_a, pose_b, &args)
             }
 
@@ -488,7 +501,7 @@ macro_rules! backend_methods {
                 warm_start: bool,
                 out: Option<Bound<'_, crate::batch::Distances>>,
             ) -> PyResult<Py<crate::batch::Distances>> {
-                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start };
+                let args = crate::api::QueryArgs { tolerance, max_iterations, margin, warm_start, gradient: None };
                 crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
             }
 

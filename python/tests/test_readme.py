@@ -36,3 +36,8 @@ def test_readme_ompl_example_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     # Its paths are relative to the repository's root, where it says to run it.
     monkeypatch.chdir(ROOT)
     exec(compile(code, str(README), "exec"), {"__name__": "readme_ompl_example"})
+
+
+def test_readme_gradients_example_runs() -> None:
+    code = section_code("Gradients")
+    exec(compile(code, str(README), "exec"), {"__name__": "readme_gradients_example"})

@@ -26,8 +26,11 @@ EXAMPLE = ROOT / "python" / "examples" / "trajopt_panda.py"
 _names = itertools.count()
 
 
-@pytest.fixture()
-def panda(client: gjkd.Client) -> Iterator[tuple[gjkd.Client, Any, list[int]]]:
+@pytest.fixture(scope="module")
+def panda(server: gjkd.Server) -> Iterator[tuple[gjkd.Client, Any, list[int]]]:
+    """One Panda among obstacles for the module (a second robot at the same
+    base would overlap the first everywhere)."""
+    client = gjkd.Client(server.service, timeout=30.0)
     robot = client.register_robot(f"panda{next(_names)}", PANDA, package_path=[DATA])
     rng = np.random.default_rng(5)
     obstacles = []
@@ -38,8 +41,7 @@ def panda(client: gjkd.Client) -> Iterator[tuple[gjkd.Client, Any, list[int]]]:
         else:
             obstacles.append(client.register_box([0.04, 0.03, 0.05], pose=pose))
     yield client, robot, obstacles
-    for o in obstacles:
-        client.remove(o)
+    client.close()
 
 
 def random_positions(robot: Any, rng: np.random.Generator) -> np.ndarray:
@@ -114,9 +116,9 @@ def test_scene_rows_carry_the_pair_gradients(
     client, robot, obstacles = panda
     client.set_joints(robot, np.zeros(robot.dof).clip(robot.lower, robot.upper))
     rows = gjkd.SceneRows(64, gradient_columns=robot.dof + 6, gradient_base=True)
-    summary = client.within(robot, 10.0, out=rows)
+    summary = client.within(robot, 0.5, out=rows)
     n = summary.written
-    assert n > 10
+    assert n > 3
     assert rows.gradient.shape == (64, robot.dof + 6)
     for i in range(n):
         answer = client.distance(int(rows.a[i]), int(rows.b[i]), gradient=True, gradient_base=True)
@@ -125,7 +127,7 @@ def test_scene_rows_carry_the_pair_gradients(
         assert rows.gradient_error[i] >= 0.0
     # Without room for gradients, none are asked.
     plain = gjkd.SceneRows(64)
-    client.within(robot, 10.0, out=plain)
+    client.within(robot, 0.5, out=plain)
     assert plain.gradient.shape == (64, 0)
     with pytest.raises(gjkd.InvalidInput):
         gjkd.SceneRows(4, gradient_columns=17)

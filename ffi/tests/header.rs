@@ -180,6 +180,7 @@ fn c_sees_the_wire_layouts_rust_sends() {
     );
     check("gjkd_result", "flags", offset_of!(ItemResult, flags));
     check("gjkd_result", "pieces", offset_of!(ItemResult, pieces));
+    check("gjkd_result", "gradient", offset_of!(ItemResult, gradient));
 
     let dir = std::env::temp_dir().join(format!("gjkd-layout-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");

@@ -109,6 +109,9 @@ fn text_round_trips_through_vertices() {
 fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<Pose>(), 56);
     assert_eq!(std::mem::size_of::<Item>(), 160);
-    assert_eq!(std::mem::size_of::<ItemResult>(), 128);
+    // 128 bytes of answer and 144 of gradient (16 columns, count, flags,
+    // error bound).
+    assert_eq!(std::mem::size_of::<crate::Gradient>(), 144);
+    assert_eq!(std::mem::size_of::<ItemResult>(), 272);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
 }

@@ -31,7 +31,8 @@ pub const GRADIENT_COLUMNS: usize = 16;
 
 /// Bits of [`Gradient::flags`].
 pub mod gradient_flags {
-    /// The gradient was computed: [`Gradient::columns`] entries hold it.
+    /// The gradient was computed: [`Gradient::columns`](super::Gradient::columns)
+    /// entries hold it.
     pub const PRESENT: u32 = 1;
     /// The nearest points are not unique (parallel faces or edges, a face
     /// and an edge along it): the distance may have no gradient here, and
@@ -45,7 +46,12 @@ pub mod gradient_flags {
     pub const NO_DIRECTION: u32 = 1 << 3;
 }
 
-/// A pair distance's gradient (see the [module](self)).
+/// A pair distance's gradient with respect to the coordinates that move its
+/// first object: a robot link's joints (then its base twist when asked), or
+/// another object's pose twist `[v, ω]` (world frame, about its origin); entry
+/// `k` is `n · (J_b(p_b) − J_a(p_a))_k`. Asked with
+/// [`item_flags::GRADIENT`](crate::item_flags::GRADIENT) or
+/// [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS).
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v2.Gradient")]

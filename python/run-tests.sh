@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's tests: makes (or reuses) a virtual environment, installs
-# maturin, numpy, pytest, mypy, ruff and OMPL's bindings (pip `ompl`, a
-# 5 MB wheel: gjkd.ompl's planning tests), checks the Python sources' format and
+# maturin, numpy, pytest, mypy, ruff, OMPL's bindings (pip `ompl`, a
+# 5 MB wheel: gjkd.ompl's planning tests) and scipy, pin and coal (the
+# gradient tests and their example), checks the Python sources' format and
 # lints, builds the package into it, then runs pytest. Extra arguments go to
 # pytest.
 #
@@ -31,6 +32,12 @@ echo "== installing maturin, numpy, pytest, mypy, ruff and ompl"
 # planning tests skip, saying so.
 "$venv/bin/python" -m pip install --quiet "ompl>=2,<3" \
   || echo "ompl could not be installed: gjkd.ompl's planning tests will skip"
+# The gradient tests check against pinocchio's frame Jacobians and run the
+# trajectory optimisation example (scipy) beside its pinocchio + coal
+# baseline: wheels of about 40 MB together. Without them those tests skip,
+# saying so.
+"$venv/bin/python" -m pip install --quiet scipy pin coal \
+  || echo "scipy, pin or coal could not be installed: the gradient tests that need them will skip"
 echo "== ruff format --check, ruff check"
 "$venv/bin/ruff" format --quiet --check "$here"
 "$venv/bin/ruff" check --quiet "$here"

@@ -31,7 +31,7 @@ use gjkd_server::engine::state::State;
 // a field's) and accepting any bit pattern (every field is an integer or a
 // float), which the wire format already promises for shared memory.
 const _: () = assert!(std::mem::size_of::<Item>() == 160);
-const _: () = assert!(std::mem::size_of::<ItemResult>() == 152);
+const _: () = assert!(std::mem::size_of::<ItemResult>() == 296);
 const _: () = assert!(std::mem::size_of::<ReplyHeader>() == 8);
 
 fn items_bytes(items: &[Item]) -> &[u8] {

@@ -124,6 +124,7 @@
 mod builder;
 mod connection;
 mod error;
+mod gradient;
 mod objects;
 mod open_failure;
 mod pairs;
@@ -135,6 +136,7 @@ mod scene;
 pub use builder::{ClientBuilder, DEFAULT_TIMEOUT};
 pub use connection::Client;
 pub use error::ClientError;
+pub use gradient::{gradient_matrix, row_gradient};
 pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
     RobotHandle, RobotModel,
@@ -149,10 +151,11 @@ pub use scene::{Group, ScenePair, SceneQuery, SceneSummary, Steps};
 pub use gjkd_rt as rt;
 
 pub use gjkd_proto::{
-    Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode, Geometry, Item,
-    ItemKind, ItemResult, MAX_NAME_LEN, MAX_PIECES, ObjectId, PROTOCOL_VERSION, Piece, Pose,
-    Precision, QueryOptions, SceneReply, SceneRequest, SceneRow, ServerInfo, ServerStats,
-    ShapeError, Status, WaitMode, item_flags, result_flags, scene_flags, scene_reply_flags,
+    Answer, DEFAULT_MAX_ITERATIONS, DEFAULT_SERVICE, DEFAULT_TOLERANCE, ErrorCode,
+    GRADIENT_COLUMNS, Geometry, Gradient, Item, ItemKind, ItemResult, MAX_NAME_LEN, MAX_PIECES,
+    ObjectId, PROTOCOL_VERSION, Piece, Pose, Precision, QueryOptions, SceneReply, SceneRequest,
+    SceneRow, ServerInfo, ServerStats, ShapeError, Status, WaitMode, gradient_flags, item_flags,
+    result_flags, scene_flags, scene_reply_flags,
 };
 
 /// The signed distance of a pair query asked with

@@ -370,6 +370,16 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
         self.flag(scene_flags::CUTOFF, true)
     }
 
+    /// Every row also carries its distance's gradient
+    /// ([`SceneRow`]'s `result.gradient`, [`Answer::gradient`]) with respect
+    /// to the coordinates that move its `a` (see [`crate::gradient_matrix`]);
+    /// `base` adds a robot base's twist. Rows the server would answer
+    /// from a motion bound or an early exit are asked to convergence.
+    pub fn gradients(self, base: bool) -> Self {
+        self.flag(scene_flags::GRADIENTS, true)
+            .flag(scene_flags::GRADIENT_BASE, base)
+    }
+
     /// [`Client::within`]: every pair of the scene, not only the group
     /// against the rest.
     pub fn all_pairs(self) -> Self {

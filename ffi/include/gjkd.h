@@ -53,6 +53,31 @@
 // accepts.
 #define GJKD_MAX_TRANSLATION 2.6787715179656683e300
 
+// Most columns of a `gjkd_gradient`.
+#define GJKD_GRADIENT_COLUMNS 16
+
+// `gjkd_pair_query::flags` bit (OR it in): also the distance's gradient,
+// into the result's `gradient`.
+#define GJKD_PAIR_GRADIENT (1 << 8)
+
+// `gjkd_pair_query::flags` bit, with `GJKD_PAIR_GRADIENT`: when `a` is a
+// robot link, the base pose's twist in the last 6 columns too.
+#define GJKD_PAIR_GRADIENT_BASE (1 << 9)
+
+// `gjkd_gradient::flags` bit: the gradient was computed.
+#define GJKD_GRADIENT_PRESENT 1
+
+// `gjkd_gradient::flags` bit: the nearest points are not unique
+// (parallel faces or edges): the values are a one-sided (sub)gradient.
+#define GJKD_GRADIENT_NOT_UNIQUE 2
+
+// `gjkd_gradient::flags` bit: the last 6 columns are the base's twist.
+#define GJKD_GRADIENT_BASE 4
+
+// `gjkd_gradient::flags` bit: the objects overlap and no separating
+// direction is known; the values are zero.
+#define GJKD_GRADIENT_NO_DIRECTION 8
+
 // `gjkd_pair_query::flags` bit: this row's `pose_a` replaces the stored
 // pose of `a`, for this query only.
 #define GJKD_POSE_A 1
@@ -566,6 +591,25 @@ typedef struct gjkd_pair_query {
   uint32_t reserved;
 } gjkd_pair_query;
 
+// The gradient of a pair's distance `d` with respect to the coordinates
+// that move its object `a`: `values[k] = ∂d/∂x_k` for `k < columns`. When
+// `a` is a robot link, the coordinates are the robot's moving joints (in
+// `gjkd_robot_joint_name()` order; a self-collision pair's other link
+// moves too), then, with the base asked, the base twist `[v, ω]` (world
+// frame, turning about the base origin); for any other object, its
+// pose's twist. `error` bounds each entry's error from the distance's
+// certified interval.
+typedef struct gjkd_gradient {
+  // `∂d/∂x_k`, zero beyond `columns`.
+  double values[GJKD_GRADIENT_COLUMNS];
+  // Entries in use; 0 when not asked.
+  uint32_t columns;
+  // `GJKD_GRADIENT_*` bits.
+  uint32_t flags;
+  // A bound on each entry's error from the distance's interval.
+  double error;
+} gjkd_gradient;
+
 // The answer row of one pair of a `gjkd_query_pairs()` batch, laid out
 // as the server writes it (so a batch's answers are copied into the
 // caller's array in one piece). Distances are after radii; points in world
@@ -607,6 +651,9 @@ typedef struct gjkd_result {
   double signed_lower;
   // Certified upper bound on the signed distance (when flagged).
   double signed_upper;
+  // The distance's gradient, with `GJKD_PAIR_GRADIENT` in the row's
+  // flags (`columns` 0 otherwise).
+  struct gjkd_gradient gradient;
 } gjkd_result;
 
 // Options of a scene query; start from `gjkd_scene_options_default()`.
@@ -645,6 +692,11 @@ typedef struct gjkd_scene_options {
   // `GJKD_QUERY_BOUNDED` or `GJKD_QUERY_CLOSER` (motion bounds and early
   // exits still rule out pairs not reported).
   bool exact;
+  // Every row also carries its distance's gradient (`gjkd_scene_row`'s
+  // `gradient`), with respect to the coordinates that move its `a`.
+  bool gradients;
+  // With `gradients`, rows of robot links: the base twist too.
+  bool gradient_base;
 } gjkd_scene_options;
 
 // The objects a scene question is about: `id` (a robot, whose links are
@@ -684,6 +736,9 @@ typedef struct gjkd_scene_row {
   // estimate inside `[lower, upper]`, which may be wide. Set
   // `gjkd_scene_options.exact` for exact distances on every row.
   struct gjkd_answer answer;
+  // The distance's gradient, with `gjkd_scene_options::gradients`
+  // (`columns` 0 otherwise).
+  struct gjkd_gradient gradient;
 } gjkd_scene_row;
 
 // What a scene answer held besides its rows.

@@ -26,6 +26,7 @@
 
 mod args;
 mod connect;
+mod gradient;
 mod handle;
 mod lifetime;
 mod meshes;
@@ -39,6 +40,7 @@ mod thread;
 mod types;
 
 pub use connect::*;
+pub use gradient::*;
 pub use handle::gjkd_client;
 pub use lifetime::*;
 pub use meshes::*;

@@ -10,6 +10,7 @@ use gjkd_proto::{ItemKind, Pose, item_flags};
 use rust_client::{Item, ItemResult};
 
 use crate::args::{slice, slice_mut};
+use crate::gradient::gjkd_gradient;
 use crate::handle::{gjkd_client, with_client};
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::{gjkd_id, gjkd_pose, gjkd_precision, gjkd_query_options};
@@ -45,7 +46,9 @@ const ROW_FLAGS: u32 = item_flags::POSE_A
     | item_flags::MARGIN
     | item_flags::WARM_START
     | item_flags::SINGLE_PRECISION
-    | item_flags::SIGNED_DISTANCE;
+    | item_flags::SIGNED_DISTANCE
+    | item_flags::GRADIENT
+    | item_flags::GRADIENT_BASE;
 
 /// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
 /// server reads (so a batch of rows is copied into it in one piece). Make
@@ -141,6 +144,9 @@ pub struct gjkd_result {
     pub signed_lower: f64,
     /// Certified upper bound on the signed distance (when flagged).
     pub signed_upper: f64,
+    /// The distance's gradient, with `GJKD_PAIR_GRADIENT` in the row's
+    /// flags (`columns` 0 otherwise).
+    pub gradient: gjkd_gradient,
 }
 
 // `gjkd_result` is `ItemResult` under a C name: same size, alignment and
@@ -163,6 +169,7 @@ const _: () = {
     assert!(offset_of!(gjkd_result, signed_distance) == offset_of!(ItemResult, signed_distance));
     assert!(offset_of!(gjkd_result, signed_lower) == offset_of!(ItemResult, signed_lower));
     assert!(offset_of!(gjkd_result, signed_upper) == offset_of!(ItemResult, signed_upper));
+    assert!(offset_of!(gjkd_result, gradient) == offset_of!(ItemResult, gradient));
 };
 
 /// A row asking the distance of `a` and `b` at their stored poses, with

@@ -8,6 +8,7 @@ use gjkd_proto::{PathMode, SceneKind, SceneRequest, SceneRow, scene_flags};
 use rust_client::{Item, ObjectId, SceneSummary, Steps};
 
 use crate::args::{checked_pose, out, slice, slice_mut};
+use crate::gradient::gjkd_gradient;
 use crate::handle::{gjkd_client, with_client};
 use crate::robots::{gjkd_robot, path_steps};
 use crate::status::{Failure, gjkd_status, guard};
@@ -71,6 +72,11 @@ pub struct gjkd_scene_options {
     /// `GJKD_QUERY_BOUNDED` or `GJKD_QUERY_CLOSER` (motion bounds and early
     /// exits still rule out pairs not reported).
     pub exact: bool,
+    /// Every row also carries its distance's gradient (`gjkd_scene_row`'s
+    /// `gradient`), with respect to the coordinates that move its `a`.
+    pub gradients: bool,
+    /// With `gradients`, rows of robot links: the base twist too.
+    pub gradient_base: bool,
 }
 
 impl Default for gjkd_scene_options {
@@ -89,6 +95,8 @@ impl Default for gjkd_scene_options {
             self_pairs: false,
             clamp: false,
             exact: false,
+            gradients: false,
+            gradient_base: false,
         }
     }
 }
@@ -121,6 +129,9 @@ pub struct gjkd_scene_row {
     /// estimate inside `[lower, upper]`, which may be wide. Set
     /// `gjkd_scene_options.exact` for exact distances on every row.
     pub answer: gjkd_answer,
+    /// The distance's gradient, with `gjkd_scene_options::gradients`
+    /// (`columns` 0 otherwise).
+    pub gradient: gjkd_gradient,
 }
 
 /// What a scene answer held besides its rows.
@@ -228,6 +239,11 @@ impl<'a> Call<'a> {
             (options.precision == 1, scene_flags::SINGLE_PRECISION),
             (options.use_cutoff, scene_flags::CUTOFF),
             (options.clamp, scene_flags::CLAMP),
+            (options.gradients, scene_flags::GRADIENTS),
+            (
+                options.gradients && options.gradient_base,
+                scene_flags::GRADIENT_BASE,
+            ),
         ];
         request.flags = bits.iter().filter(|b| b.0).fold(0, |f, b| f | b.1);
         if options.use_cutoff {
@@ -328,6 +344,7 @@ fn scene_row(row: &SceneRow) -> gjkd_scene_row {
         step: row.step,
         error: row.result.error,
         answer: gjkd_answer::from(&row.result),
+        gradient: gjkd_gradient::from(&row.result.gradient),
     }
 }
 

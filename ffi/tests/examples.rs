@@ -83,3 +83,20 @@ fn examples_fail_when_no_server_runs() {
         "{stderr}"
     );
 }
+
+#[test]
+fn gradient_example_answers_match_the_analytic_gradient() {
+    let exe = common::compile(&["examples/gradient.c"], "gradient", false);
+    let server = Server::start("ffi-gradient", &["--no-persist"]);
+    let stdout = common::run_ok(&exe, &[&server.service]);
+    for line in [
+        "rod-ball distance      0.350000000000",
+        "d distance / d j       -0.800000000000",
+        "row d distance / d j   -0.800000000000",
+        "pair columns           1",
+        "rows                   1",
+    ] {
+        assert!(stdout.contains(line), "missing `{line}` in:\n{stdout}");
+    }
+    assert_eq!(stdout.lines().last(), Some("ok"), "{stdout}");
+}

@@ -263,6 +263,7 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
             signed_distance: want.signed_distance,
             signed_lower: want.signed_lower,
             signed_upper: want.signed_upper,
+            gradient: Default::default(),
         };
         assert_eq!(bits(got), bits(&want_row), "row {i}");
         assert_eq!(

@@ -130,6 +130,8 @@ pub struct Kinematics {
     joints: Vec<JointInfo>,
     /// Joints, parents before children.
     order: Vec<usize>,
+    /// Per link, the joint whose child it is (`None` for the root).
+    parent_joint: Vec<Option<usize>>,
     root: usize,
     /// The moving joints, in position-array order (indices into `joints`).
     moving: Vec<usize>,
@@ -181,12 +183,13 @@ impl Kinematics {
             joints.push(info);
         }
         resolve_mimics(robot, &joint_index, &mut joints, &moving)?;
-        let (root, order) = tree_order(&links, &joints)?;
+        let (root, order, parent_joint) = tree_order(&links, &joints)?;
         Ok(Kinematics {
             name: robot.name.clone(),
             links,
             joints,
             order,
+            parent_joint,
             root,
             moving,
             warnings,
@@ -214,6 +217,13 @@ impl Kinematics {
     /// The root link's index.
     pub fn root(&self) -> usize {
         self.root
+    }
+
+    /// The joint whose child `link` is (an index into
+    /// [`Kinematics::joints`]); `None` for the root or an index out of
+    /// range.
+    pub fn parent_joint(&self, link: usize) -> Option<usize> {
+        self.parent_joint.get(link).copied().flatten()
     }
 
     /// All joints, in URDF order.
@@ -554,11 +564,12 @@ fn resolve_mimics(
     Ok(())
 }
 
-/// The root link and the joints in parents-first order.
-fn tree_order(
-    links: &[String],
-    joints: &[JointInfo],
-) -> Result<(usize, Vec<usize>), KinematicsError> {
+/// What [`tree_order`] finds.
+type TreeOrder = (usize, Vec<usize>, Vec<Option<usize>>);
+
+/// The root link, the joints in parents-first order and each link's
+/// parent joint.
+fn tree_order(links: &[String], joints: &[JointInfo]) -> Result<TreeOrder, KinematicsError> {
     let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
     for (j, joint) in joints.iter().enumerate() {
@@ -597,5 +608,5 @@ fn tree_order(
             "some links are not reached from the root (a cycle)".into(),
         ));
     }
-    Ok((root, order))
+    Ok((root, order, parent_joint))
 }

@@ -12,6 +12,9 @@
 //!   make a compound), mesh paths resolved through a [`PackagePath`].
 //! - [`kinematics`]: forward kinematics (fixed, revolute, continuous and
 //!   prismatic joints, limits checked or clamped, mimic joints followed).
+//! - [`jacobian`]: point Jacobians of links (joint columns in the order
+//!   of a position array, mimic joints folded into their leader) and of a
+//!   pose's twist.
 //! - [`srdf`]: an SRDF's `disable_collisions` pairs.
 //!
 //! Pure Rust, no IPC: the server and the client both use it, so that the
@@ -37,6 +40,7 @@
 //! ```
 
 mod collada;
+pub mod jacobian;
 pub mod kinematics;
 mod kinematics_error;
 pub mod mesh;
@@ -46,6 +50,7 @@ pub mod srdf;
 mod urdf;
 mod xml_prefixes;
 
+pub use jacobian::{add_twist_derivative, twist_jacobian};
 pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
 pub use mesh::{Decomposition, Mesh, MeshError};
 pub use paths::{PACKAGE_PATH_ENV, PackagePath};

@@ -76,6 +76,13 @@ pub mod item_flags {
     /// and the two fields after it. Costs nothing for a pair the distance
     /// query proves apart.
     pub const SIGNED_DISTANCE: u32 = 1 << 7;
+    /// [`super::ItemKind::Distance`]: also the distance's gradient with
+    /// respect to the coordinates that move object A (see
+    /// [`Gradient`](crate::Gradient)).
+    pub const GRADIENT: u32 = 1 << 8;
+    /// With [`GRADIENT`], when A is a robot link: the base pose's twist
+    /// too, in the gradient's last 6 columns.
+    pub const GRADIENT_BASE: u32 = 1 << 9;
     /// Every bit this version knows; others are rejected as malformed.
     pub const ALL: u32 = POSE_A
         | POSE_B
@@ -84,7 +91,9 @@ pub mod item_flags {
         | SINGLE_PRECISION
         | CLAMP
         | END_STEP
-        | SIGNED_DISTANCE;
+        | SIGNED_DISTANCE
+        | GRADIENT
+        | GRADIENT_BASE;
 }
 
 /// Per-query options, the client-side view of [`Item`]'s option fields.

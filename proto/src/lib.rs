@@ -46,6 +46,7 @@ use std::fmt;
 mod admin;
 mod error;
 mod geometry;
+mod gradient;
 mod item;
 mod pose;
 mod result;
@@ -60,6 +61,7 @@ pub use error::ErrorCode;
 pub use geometry::{
     Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape, hull,
 };
+pub use gradient::{GRADIENT_COLUMNS, Gradient, gradient_flags};
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
 pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};

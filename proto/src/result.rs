@@ -4,7 +4,7 @@
 use iceoryx2::prelude::ZeroCopySend;
 use nalgebra::{Point3, Vector3};
 
-use crate::ErrorCode;
+use crate::{ErrorCode, Gradient};
 
 /// How a query ended; the wire values of [`ItemResult::status`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -104,6 +104,10 @@ pub struct ItemResult {
     pub signed_lower: f64,
     /// Certified upper bound on the signed distance (when flagged).
     pub signed_upper: f64,
+    /// The distance's gradient, when asked
+    /// ([`item_flags::GRADIENT`](crate::item_flags::GRADIENT),
+    /// [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS)).
+    pub gradient: Gradient,
 }
 
 impl ItemResult {
@@ -125,6 +129,7 @@ impl ItemResult {
             signed_distance: 0.0,
             signed_lower: 0.0,
             signed_upper: 0.0,
+            gradient: Gradient::NONE,
         }
     }
 
@@ -157,6 +162,7 @@ impl ItemResult {
                         upper: self.signed_upper,
                     },
                 ),
+                gradient: self.gradient.is_present().then_some(self.gradient),
             }),
             code => Err(code),
         }
@@ -204,6 +210,8 @@ pub struct Answer {
     /// `point_a`, `point_b` and `normal` are then its witnesses and
     /// direction, also when the shapes overlap.
     pub signed: Option<SignedDistance>,
+    /// The distance's gradient, when asked (see [`Gradient`]).
+    pub gradient: Option<Gradient>,
 }
 
 /// A signed distance with its certified interval: the distance apart,

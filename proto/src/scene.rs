@@ -124,6 +124,12 @@ pub mod scene_flags {
     /// links); a clearance row's nearest object may then be another member.
     /// Refused with nearest.
     pub const SELF_PAIRS: u32 = 1 << 10;
+    /// Every row also carries its distance's gradient with respect to the
+    /// coordinates that move its `a` object (see
+    /// [`Gradient`](crate::Gradient)), at the row's step.
+    pub const GRADIENTS: u32 = 1 << 7;
+    /// With [`GRADIENTS`], rows of robot links: the base pose's twist too.
+    pub const GRADIENT_BASE: u32 = 1 << 8;
     /// Every bit this version knows; others are refused as malformed.
     pub const ALL: u32 = WARM_START
         | MOTION_BOUNDS
@@ -132,7 +138,9 @@ pub mod scene_flags {
         | CUTOFF
         | CLAMP
         | EXACT
-        | SELF_PAIRS;
+        | SELF_PAIRS
+        | GRADIENTS
+        | GRADIENT_BASE;
 }
 
 /// Bits of [`SceneReply::flags`].

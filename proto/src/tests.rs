@@ -119,7 +119,10 @@ fn text_round_trips_through_vertices() {
 fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<Pose>(), 56);
     assert_eq!(std::mem::size_of::<Item>(), 160);
-    assert_eq!(std::mem::size_of::<ItemResult>(), 152);
+    // 152 bytes of answer (the signed distance's three included) and 144 of gradient (16 columns, count, flags,
+    // error bound).
+    assert_eq!(std::mem::size_of::<crate::Gradient>(), 144);
+    assert_eq!(std::mem::size_of::<ItemResult>(), 296);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
 }
 

@@ -172,6 +172,19 @@ class Answer:
     @property
     def signed_interval(self) -> Optional[Tuple[float, float]]:
         """The certified ``(lower, upper)`` bounds of the signed distance, when asked."""
+    @property
+    def gradient(self) -> Optional[_F64]:
+        """``(columns,)`` the distance's gradient (``None`` when not asked).
+
+        With respect to the coordinates that move ``a``; for overlapping
+        objects, the signed distance's (``distance - penetration``).
+        """
+    @property
+    def gradient_not_unique(self) -> bool:
+        """The nearest points are not unique: a one-sided gradient."""
+    @property
+    def gradient_error(self) -> float:
+        """A bound on each gradient entry's error from the interval."""
 
 @final
 class Distances:
@@ -236,8 +249,20 @@ class SceneRows:
     ``exact=True`` to a scene call for exact distances on every reported
     row."""
 
-    def __new__(cls, n: int) -> Self:
-        """Zeroed room for ``n`` rows."""
+    def __new__(cls, n: int, gradient_columns: int = 0, gradient_base: bool = False) -> Self:
+        """Zeroed room for ``n`` rows (and ``gradient_columns`` gradient
+        entries per row: a call then asks each row's distance gradient)."""
+    @property
+    def gradient(self) -> _F64:
+        """``(n, gradient_columns)`` each row's gradient with respect to the
+        coordinates that move its ``a`` (a robot's joints, then the base twist
+        with ``gradient_base``; another object's twist)."""
+    @property
+    def gradient_flags(self) -> _U32:
+        """``(n,)`` 1 computed, 2 not unique, 4 base included, 8 no direction."""
+    @property
+    def gradient_error(self) -> _F64:
+        """``(n,)`` a bound on each row's gradient entries' error."""
     def __len__(self) -> int: ...
     @property
     def a(self) -> _U64:
@@ -408,11 +433,18 @@ class _Objects:
         margin: Optional[float] = None,
         warm_start: bool = True,
         signed_distance: bool = False,
+        gradient: bool = False,
+        gradient_base: bool = False,
     ) -> Answer:
         """The distance between objects ``a`` and ``b``.
 
         ``signed_distance=True`` also answers the signed distance (negative
         inside) with its certified interval; free for a pair proved apart.
+        ``gradient=True`` also asks its gradient with respect to the
+        coordinates that move ``a`` (``Answer.gradient``): a robot link's
+        robot's moving joints (``Robot.joint_names`` order), then with
+        ``gradient_base=True`` the base twist ``[v, ω]``; any other object,
+        its pose's twist (world frame, turning about its origin).
         """
     def distances(
         self,

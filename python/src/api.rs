@@ -154,6 +154,9 @@ pub struct QueryArgs {
     pub warm_start: bool,
     /// Also answer the signed distance (`distance` only).
     pub signed_distance: bool,
+    /// Also the distance's gradient: `None`, or `Some(base)` with the base
+    /// twist's columns when `base`.
+    pub gradient: Option<bool>,
 }
 
 /// One pair query.
@@ -175,6 +178,9 @@ pub fn distance(
         args.signed_distance,
     )?;
     let mut item = Item::distance(ObjectId::from_raw(a), ObjectId::from_raw(b), &opts);
+    if let Some(base) = args.gradient {
+        item = item.with_gradient(base);
+    }
     if let Some(p) = pose(pose_a, "pose_a")? {
         set_pose_a(&mut item, p);
     }
@@ -448,12 +454,16 @@ macro_rules! backend_methods {
             /// interval, in `Answer.signed_distance` and
             /// `Answer.signed_interval`; it costs nothing for a pair proved
             /// apart.
+            /// `gradient=True` also asks the distance's gradient with
+            /// respect to the coordinates that move `a` (its robot's
+            /// joints, or its pose's twist; `Answer.gradient`), and
+            /// `gradient_base=True` the robot base's twist too.
             /// Returns an `Answer`; a refused query raises (`NotFound` for
             /// an unknown id, `InvalidInput` for a bad pose).
             #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true, signed_distance = false),
-                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, signed_distance=False)")]
+                margin = None, warm_start = true, signed_distance = false, gradient = false, gradient_base = false),
+                text_signature = "($self, a, b, pose_a=None, pose_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, signed_distance=False, gradient=False, gradient_base=False)")]
             #[allow(clippy::too_many_arguments)]
             fn distance(
                 &mut self,
@@ -467,9 +477,12 @@ macro_rules! backend_methods {
                 margin: Option<f64>,
                 warm_start: bool,
                 signed_distance: bool,
+                gradient: bool,
+                gradient_base: bool,
             ) -> PyResult<crate::batch::Answer> {
+                let gradient = gradient.then_some(gradient_base);
                 let args = crate::api::QueryArgs {
-                    tolerance, max_iterations, margin, warm_start, signed_distance,
+                    tolerance, max_iterations, margin, warm_start, signed_distance, gradient,
                 };
                 crate::api::distance(self, py, a, b, pose_a, pose_b, &args)
             }
@@ -501,7 +514,7 @@ macro_rules! backend_methods {
                 out: Option<Bound<'_, crate::batch::Distances>>,
             ) -> PyResult<Py<crate::batch::Distances>> {
                 let args = crate::api::QueryArgs {
-                    tolerance, max_iterations, margin, warm_start, signed_distance: false,
+                    tolerance, max_iterations, margin, warm_start, signed_distance: false, gradient: None,
                 };
                 crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
             }

@@ -584,6 +584,29 @@ impl Answer {
     fn backup_used(&self) -> bool {
         self.r.flags & result_flags::BACKUP_USED != 0
     }
+    /// With `gradient=True`: `(columns,)` float64, the distance's gradient
+    /// with respect to the coordinates that move `a` (its robot's moving
+    /// joints in `Robot.joint_names` order, then with `gradient_base` the
+    /// base twist `[v, ω]`; any other object, its pose's twist); `None`
+    /// when not asked. For overlapping objects, the signed distance's.
+    #[getter]
+    fn gradient<'py>(&self, py: Python<'py>) -> Option<Bound<'py, numpy::PyArray1<f64>>> {
+        let g = &self.r.gradient;
+        g.is_present()
+            .then(|| numpy::PyArray1::from_slice(py, g.as_slice()))
+    }
+    /// The nearest points are not unique (parallel faces or edges): the
+    /// gradient is a one-sided one.
+    #[getter]
+    fn gradient_not_unique(&self) -> bool {
+        self.r.gradient.is_not_unique()
+    }
+    /// A bound on each gradient entry's error from the distance's
+    /// certified interval.
+    #[getter]
+    fn gradient_error(&self) -> f64 {
+        self.r.gradient.error
+    }
 
     fn __repr__(&self) -> String {
         format!(

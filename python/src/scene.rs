@@ -2,12 +2,12 @@
 //! scene in one round trip (`clearance`, `within`, `nearest`, `path`), the
 //! rows written into a caller-owned `gjkd.SceneRows`.
 
-use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyAnyMethods;
 
 use gjkd_client::{ClientError, Item, ObjectId, SceneRow, Steps};
-use gjkd_proto::{PathMode, SceneKind, SceneRequest, scene_flags};
+use gjkd_proto::{GRADIENT_COLUMNS, PathMode, SceneKind, SceneRequest, scene_flags};
 
 use crate::arrays::{IdArray, Ids, PoseArray, Poses, f64_array, id_array, pose_array, slice};
 use crate::batch::Distances;
@@ -42,27 +42,86 @@ use crate::robots::{Robot, path_steps};
 /// bounds, without GJK): `distance` and the points are an estimate inside
 /// `[lower, upper]`, which may be wide. Pass `exact=True` for exact
 /// distances on every reported row.
+///
+/// `SceneRows(n, gradient_columns=c)` with `c > 0` also asks every call
+/// for each row's distance gradient (with `gradient_base=True`, a robot's
+/// base twist too), written into:
+///
+/// - `gradient` `(n, c)` float64: row `i` holds `∂d/∂x` with respect to
+///   the coordinates that move its `a` (a robot link: the robot's moving
+///   joints in `Robot.joint_names` order, then the base twist `[v, ω]`
+///   when asked; any other object: its pose's twist), zero beyond the
+///   columns in use; for overlapping pairs, the signed distance's
+///   (`distance - answers.penetration`);
+/// - `gradient_flags` `(n,)` uint32: `1` computed, `2` nearest points not
+///   unique (a one-sided gradient), `4` base twist included, `8` no
+///   direction (zeros);
+/// - `gradient_error` `(n,)` float64: a bound on each entry's error from
+///   the distance's certified interval.
 #[pyclass(module = "gjkd", name = "SceneRows")]
 pub struct SceneRows {
     a: Py<PyArray1<u64>>,
     b: Py<PyArray1<u64>>,
     step: Py<PyArray1<u32>>,
     answers: Py<Distances>,
+    gradient: Py<PyArray2<f64>>,
+    gradient_flags: Py<PyArray1<u32>>,
+    gradient_error: Py<PyArray1<f64>>,
+    gradient_base: bool,
     busy: std::sync::atomic::AtomicBool,
 }
 
 #[pymethods]
 impl SceneRows {
-    /// Zeroed room for `n` rows.
+    /// Zeroed room for `n` rows, and for `gradient_columns` gradient
+    /// entries per row (0: no gradients asked).
     #[new]
-    fn new(py: Python<'_>, n: usize) -> PyResult<Self> {
+    #[pyo3(signature = (n, gradient_columns = 0, gradient_base = false))]
+    fn new(
+        py: Python<'_>,
+        n: usize,
+        gradient_columns: usize,
+        gradient_base: bool,
+    ) -> PyResult<Self> {
+        if gradient_columns > GRADIENT_COLUMNS {
+            return Err(invalid(
+                py,
+                "gradient_columns",
+                None,
+                format!(
+                    "a row carries at most {GRADIENT_COLUMNS} gradient entries, not {gradient_columns}"
+                ),
+            ));
+        }
         Ok(SceneRows {
             a: PyArray1::zeros(py, n, false).unbind(),
             b: PyArray1::zeros(py, n, false).unbind(),
             step: PyArray1::zeros(py, n, false).unbind(),
             answers: Py::new(py, Distances::new(py, n))?,
+            gradient: PyArray2::zeros(py, [n, gradient_columns], false).unbind(),
+            gradient_flags: PyArray1::zeros(py, n, false).unbind(),
+            gradient_error: PyArray1::zeros(py, n, false).unbind(),
+            gradient_base,
             busy: std::sync::atomic::AtomicBool::new(false),
         })
+    }
+
+    /// `(n, gradient_columns)` float64: each row's distance gradient.
+    #[getter]
+    fn gradient<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.gradient.bind(py).clone()
+    }
+
+    /// `(n,)` uint32: each row's gradient flags.
+    #[getter]
+    fn gradient_flags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.gradient_flags.bind(py).clone()
+    }
+
+    /// `(n,)` float64: a bound on each row's gradient entries' error.
+    #[getter]
+    fn gradient_error<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.gradient_error.bind(py).clone()
     }
 
     fn __len__(&self, py: Python<'_>) -> usize {
@@ -345,6 +404,20 @@ impl Inputs<'_> {
 }
 
 impl SceneRows {
+    /// Gradient entries per row (0: none asked).
+    fn gradient_columns(&self, py: Python<'_>) -> usize {
+        self.gradient.bind(py).shape()[1]
+    }
+
+    /// The request flags this room asks for.
+    fn gradient_request_flags(&self, py: Python<'_>) -> u32 {
+        match (self.gradient_columns(py), self.gradient_base) {
+            (0, _) => 0,
+            (_, false) => scene_flags::GRADIENTS,
+            (_, true) => scene_flags::GRADIENTS | scene_flags::GRADIENT_BASE,
+        }
+    }
+
     /// Number of rows (the answers' arrays are as long as the others).
     fn rows(&self, py: Python<'_>) -> usize {
         self.answers.bind(py).borrow().len()
@@ -366,6 +439,12 @@ impl SceneRows {
             ));
         }
         let (a, b, step) = (self.a.bind(py), self.b.bind(py), self.step.bind(py));
+        let (gradient, flags, error) = (
+            self.gradient.bind(py),
+            self.gradient_flags.bind(py),
+            self.gradient_error.bind(py),
+        );
+        let columns = self.gradient_columns(py);
         let answers = self.answers.bind(py).borrow();
         let result = (|| {
             // SAFETY: created contiguous by `SceneRows::new`, owned by their
@@ -373,6 +452,14 @@ impl SceneRows {
             // `Distances` does with its own.
             let (a, b, step) =
                 unsafe { (a.as_slice_mut()?, b.as_slice_mut()?, step.as_slice_mut()?) };
+            // SAFETY: as above.
+            let (gradient, flags, error) = unsafe {
+                (
+                    gradient.as_slice_mut()?,
+                    flags.as_slice_mut()?,
+                    error.as_slice_mut()?,
+                )
+            };
             answers.with_writer(py, |mut writer| {
                 let mut write = |rows: &[SceneRow]| {
                     for (i, row) in rows.iter().enumerate() {
@@ -380,6 +467,16 @@ impl SceneRows {
                         b[i] = row.b;
                         step[i] = row.step;
                         writer.write(i, std::slice::from_ref(&row.result));
+                        if columns > 0 {
+                            let g = &row.result.gradient;
+                            let out = &mut gradient[i * columns..(i + 1) * columns];
+                            out.fill(0.0);
+                            let got = g.as_slice();
+                            let n = got.len().min(columns);
+                            out[..n].copy_from_slice(&got[..n]);
+                            flags[i] = g.flags;
+                            error[i] = g.error;
+                        }
                     }
                 };
                 call(&mut write)
@@ -400,6 +497,7 @@ fn run(
 ) -> PyResult<Summary> {
     let rows = out.borrow();
     request.max_rows = u32::try_from(rows.rows(py)).unwrap_or(u32::MAX);
+    request.flags |= rows.gradient_request_flags(py);
     let count = inputs.len();
     let outcome = rows.with_rows(py, |write| {
         client.call(py, move |c: &mut gjkd_client::Client| {

@@ -41,3 +41,8 @@ def test_readme_ompl_example_runs(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_readme_signed_distance_example_runs() -> None:
     code = section_code("Signed distance")
     exec(compile(code, str(README), "exec"), {"__name__": "readme_signed_example"})
+
+
+def test_readme_gradients_example_runs() -> None:
+    code = section_code("Gradients")
+    exec(compile(code, str(README), "exec"), {"__name__": "readme_gradients_example"})

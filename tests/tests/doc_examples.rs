@@ -188,3 +188,46 @@ fn readme_scene_example_runs() -> Result<(), gjkd_client::ClientError> {
     assert_eq!(s.first_hit, Some(4));
     Ok(())
 }
+
+#[test]
+fn readme_gradients_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-gradients", &["--no-persist"]);
+    let service = server.service.as_str();
+    // --- from README.md, "Gradients" ---
+    use gjkd_client::{Client, PackagePath, QueryOptions, SceneRow, gradient_matrix};
+    use nalgebra::Isometry3;
+
+    let mut client = Client::connect(service)?;
+    // A 1 m rod turning about z, and a ball beside it.
+    let urdf = r#"<robot name="arm"><link name="base"/>
+  <link name="rod"><collision><origin xyz="0.5 0 0"/>
+    <geometry><box size="1 0.1 0.1"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="rod"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"#;
+    let identity = Isometry3::identity();
+    let arm =
+        client.register_robot_text("arm", urdf, None, None, &PackagePath::default(), &identity)?;
+    let rod = arm.link("rod").expect("the rod has geometry");
+    let ball = client.register_sphere(0.1)?;
+    client.set_pose(ball, &Isometry3::translation(0.8, 0.5, 0.0))?;
+
+    // One pair: 0.35 apart; turning the joint towards the ball closes the gap
+    // at 0.8 m per radian.
+    let answer = client.distance_gradient(rod, ball, &QueryOptions::default(), false)?;
+    let gradient = answer.gradient.expect("asked");
+    assert!((answer.distance - 0.35).abs() < 1e-9);
+    assert!((gradient.as_slice()[0] + 0.8).abs() < 1e-9 && !gradient.is_not_unique());
+
+    // Every pair within 1 m, each row with its gradient, copied into one
+    // (rows, dof) array.
+    let mut rows = [SceneRow::default(); 8];
+    let s = client
+        .within(&arm, 1.0)
+        .gradients(false)
+        .into_rows(&mut rows)?;
+    let mut matrix = [0.0; 8];
+    gradient_matrix(&rows[..s.written], 1, &mut matrix);
+    assert!((matrix[0] + 0.8).abs() < 1e-9);
+    Ok(())
+}

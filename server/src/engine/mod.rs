@@ -7,12 +7,14 @@
 //! queries' engine ([`group_queries`]), and its request handlers
 //! ([`handlers`]) are the entry points the serving loop calls. Below them,
 //! [`checks`] holds what every shape and pose is held to and
-//! [`pair_query`] the one pair query both services run. Persistence is
+//! [`pair_query`] the one pair query both services run, and `gradient`
+//! the distance gradients both services answer with. Persistence is
 //! plugged in through the [`durability::Durability`] trait, which the
 //! persistence layer ([`crate::persist`]) implements.
 
 pub mod checks;
 pub mod durability;
+pub(crate) mod gradient;
 pub mod group_queries;
 pub mod handlers;
 pub mod objects;

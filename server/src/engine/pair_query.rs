@@ -53,6 +53,7 @@ pub(crate) fn run_pair(
         signed_distance: 0.0,
         signed_lower: 0.0,
         signed_upper: 0.0,
+        gradient: gjkd_proto::Gradient::NONE,
     };
     Ok((result, answer.warm_start))
 }

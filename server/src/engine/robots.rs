@@ -63,6 +63,14 @@ impl Robots {
         self.by_id.get(&id)
     }
 
+    /// The robot and link index whose object `object` is, if any.
+    pub fn link_of(&self, object: u64) -> Option<(u64, usize)> {
+        self.by_id.iter().find_map(|(&id, robot)| {
+            let link = robot.links.iter().position(|l| *l == Some(object))?;
+            Some((id, link))
+        })
+    }
+
     /// The id of the robot with this name.
     pub fn lookup(&self, name: &str) -> Option<u64> {
         self.names.get(name).copied()

@@ -9,6 +9,7 @@ use gjkd_proto::{ErrorCode, MAX_PIECES, ServerInfo, ServerStats, WaitMode};
 use nalgebra::Isometry3;
 
 use super::durability::{CommitError, Durability};
+use super::gradient::LinkPoses;
 use super::group_queries::GroupQueries;
 pub use super::objects::{BULK_REMOVAL, NewObject, Object, ObjectStore, Owner};
 use super::records::Snapshot;
@@ -74,6 +75,9 @@ pub struct State {
     /// The scene service's broadphase and buffers (see
     /// [`crate::engine::group_queries`]).
     pub(crate) groups: GroupQueries,
+    /// Link poses of the query service's gradients (see
+    /// [`crate::engine::gradient`]).
+    pub(crate) gradient_poses: LinkPoses,
 }
 
 impl State {
@@ -95,6 +99,7 @@ impl State {
             workspace: gjk::Workspace::new(),
             robots: Robots::default(),
             groups: GroupQueries::default(),
+            gradient_poses: LinkPoses::default(),
         }
     }
 

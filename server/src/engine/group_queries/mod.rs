@@ -35,6 +35,7 @@ mod advance;
 mod broadphase;
 mod clearance;
 mod entry;
+mod gradients;
 mod groups;
 mod motion_bound;
 mod nearest;
@@ -53,6 +54,7 @@ use gjkd_proto::{
 use nalgebra::Isometry3;
 use std::collections::HashMap;
 
+use crate::engine::gradient::{LinkPoses, StepConfigurations};
 use crate::engine::warm_cache::FxBuild;
 
 use advance::Lookahead;
@@ -92,6 +94,10 @@ pub(crate) struct Question {
     /// The accepted relative width of a motion bound.
     pub accept_relative: f64,
     k: usize,
+    /// [`scene_flags::GRADIENTS`].
+    gradients: bool,
+    /// [`scene_flags::GRADIENT_BASE`].
+    gradient_base: bool,
 }
 
 /// What a request cost, for the reply.
@@ -127,6 +133,10 @@ pub struct GroupQueries {
     /// Each (client, member)'s nearest object at its last clearance, tried
     /// first the next time.
     nearest: HashMap<(u128, u64), u64, FxBuild>,
+    /// Robot link poses of the rows' gradients.
+    link_poses: LinkPoses,
+    /// Where a path's robots stand at each step, for the rows' gradients.
+    step_configurations: StepConfigurations,
 }
 
 /// Most remembered nearest objects; beyond, the memory starts over.
@@ -198,6 +208,8 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         accept_absolute: r.accept_absolute,
         accept_relative: r.accept_relative,
         k: usize::try_from(r.k).unwrap_or(usize::MAX),
+        gradients: has(scene_flags::GRADIENTS),
+        gradient_base: has(scene_flags::GRADIENT_BASE),
     })
 }
 
@@ -288,10 +300,12 @@ impl State {
         let mut rows = Rows::new(rows);
         let mut counters = Counters::default();
         let mut reply = SceneReply::error(ErrorCode::Ok);
+        self.groups.link_poses.reset();
         if q.mode == PathMode::Single {
             self.apply_poses(&q, inputs)?;
             self.groups.broadphase.sync(&mut self.store);
             self.answer_step(client, &q, 0, &mut rows, &mut counters);
+            self.row_gradients(&q, rows.written_since(0), false);
             reply.steps = 1;
         } else {
             (reply.steps, reply.first_hit) =
@@ -335,6 +349,7 @@ impl State {
         engine.overlay.reset();
         engine.plan.clear();
         engine.plan_ends.clear();
+        engine.step_configurations.clear();
         // Consecutive pose items mostly move the same object: its checks
         // and slot are looked up once.
         let mut last: Option<(u64, Option<u32>)> = None;
@@ -374,6 +389,10 @@ impl State {
             }
             // `check_layout` let the flag through on pose items only.
             if item.kind == ItemKind::Step as u32 || item.flags & item_flags::END_STEP != 0 {
+                if q.gradients {
+                    let step = u32::try_from(engine.plan_ends.len()).unwrap_or(u32::MAX);
+                    engine.overlay.record(step, &mut engine.step_configurations);
+                }
                 engine.plan_ends.push(engine.plan.len());
             }
         }
@@ -445,12 +464,14 @@ impl State {
                 self.answer_step(client, q, step, rows, counters)
             };
             step += 1;
-            if q.mode == PathMode::FirstHit {
-                if hits > 0 {
-                    first_hit = step - 1;
-                    break;
-                }
+            if q.mode == PathMode::FirstHit && hits == 0 {
                 rows.truncate(written, total);
+                continue;
+            }
+            self.row_gradients(q, rows.written_since(written), true);
+            if q.mode == PathMode::FirstHit {
+                first_hit = step - 1;
+                break;
             }
         }
         debug_assert!(step <= steps);

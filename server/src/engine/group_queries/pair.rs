@@ -53,6 +53,9 @@ pub(crate) enum Ask {
 
 /// How a pair was settled.
 #[derive(Clone, Copy, Debug)]
+// The answer travels by value into a row: boxing it would allocate per
+// pair, for a variant that is most of what a scene request returns.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum Outcome {
     /// Its motion bound answers the question: not within the margin, or
     /// not nearer than the current best.
@@ -279,9 +282,11 @@ impl Ctx<'_> {
         };
         let q = self.q;
         let mut options = q.options;
+        // A row's gradient needs its nearest points, which an early exit
+        // at the margin does not find.
         options.margin = match ask {
-            Ask::Within(m) => Some(m),
-            Ask::Below(_) | Ask::BelowExactly(_) => None,
+            Ask::Within(m) if !q.gradients => Some(m),
+            Ask::Within(_) | Ask::Below(_) | Ask::BelowExactly(_) => None,
         };
         // A kept overlap settles the pair within the margin for as long as
         // the motion since stays below its depth: a deeper bound is worth a

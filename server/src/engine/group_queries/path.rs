@@ -8,6 +8,7 @@ use gjkd_proto::{ErrorCode, Item, ItemKind, item_flags};
 use nalgebra::Isometry3;
 
 use crate::engine::checks::check_pose;
+use crate::engine::gradient::StepConfigurations;
 use crate::engine::objects::ObjectStore;
 use crate::engine::robots::{Robots, joint_code};
 
@@ -33,6 +34,14 @@ impl RobotOverlay {
     /// Starts from the stored positions of every robot.
     pub(crate) fn reset(&mut self) {
         self.used = 0;
+    }
+
+    /// Records where every robot the request has moved so far stands at
+    /// path step `step`, for the step's gradients.
+    pub(crate) fn record(&self, step: u32, out: &mut StepConfigurations) {
+        for robot in &self.robots[..self.used] {
+            out.record(step, robot.id, &robot.base, &robot.positions);
+        }
     }
 
     /// The overlay index of robot `id`, started from its stored state.

@@ -31,6 +31,11 @@ impl<'a> Rows<'a> {
         self.total += 1;
     }
 
+    /// The rows written from `from` on.
+    pub(crate) fn written_since(&mut self, from: usize) -> &mut [SceneRow] {
+        &mut self.buffer[from.min(self.written)..self.written]
+    }
+
     /// Forgets the rows from `written` on (a step that is not reported).
     pub(crate) fn truncate(&mut self, written: usize, total: u64) {
         self.written = written;

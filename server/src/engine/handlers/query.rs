@@ -4,6 +4,7 @@
 use gjkd_proto::{ErrorCode, Item, ItemKind, ItemResult, item_flags};
 
 use crate::engine::checks::check_pose;
+use crate::engine::gradient::{self, Side, Stance};
 use crate::engine::pair_query::run_pair;
 use crate::engine::signed_pair::add_signed_distance;
 use crate::engine::state::State;
@@ -110,6 +111,16 @@ impl State {
             b: item.b,
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
+        let wants_gradient = item.flags & item_flags::GRADIENT != 0;
+        // A link's gradient is taken at its robot's configuration: a pose
+        // of this query only would not be where its joints put it.
+        let overridden =
+            |flag: u32, id: u64| item.flags & flag != 0 && self.robots.link_of(id).is_some();
+        if wants_gradient
+            && (overridden(item_flags::POSE_A, item.a) || overridden(item_flags::POSE_B, item.b))
+        {
+            return Err(ErrorCode::InvalidOptions);
+        }
         let (mut result, next) = run_pair(
             &mut self.workspace,
             (&a.shape, &pose_a),
@@ -117,6 +128,29 @@ impl State {
             &options,
             warm.as_ref(),
         )?;
+        if wants_gradient {
+            self.gradient_poses.reset();
+            gradient::fill(
+                &mut result,
+                Side {
+                    id: item.a,
+                    shape: &a.shape,
+                    pose: &pose_a,
+                },
+                Side {
+                    id: item.b,
+                    shape: &b.shape,
+                    pose: &pose_b,
+                },
+                &self.robots,
+                &mut self.gradient_poses,
+                Stance {
+                    steps: None,
+                    step: 0,
+                    base: item.flags & item_flags::GRADIENT_BASE != 0,
+                },
+            )?;
+        }
         if warm_on {
             self.cache.put(key, next);
         }

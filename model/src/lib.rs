@@ -46,7 +46,9 @@ pub mod srdf;
 mod urdf;
 mod xml_prefixes;
 
-pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
+pub use kinematics::{
+    JointError, JointInfo, JointKind, JointSource, Kinematics, KinematicsError, LimitMode,
+};
 pub use mesh::{Decomposition, Mesh, MeshError};
 pub use paths::{PACKAGE_PATH_ENV, PackagePath};
 pub use robot::{CylinderError, LinkModel, RobotError, RobotModel, cylinder};

@@ -225,7 +225,13 @@ class SceneRows:
         """``(n,)`` the other objects, 0 for none."""
     @property
     def step(self) -> _U32:
-        """``(n,)`` the path steps."""
+        """``(n,)`` the path steps (a continuous path's segments)."""
+    @property
+    def s_lo(self) -> _F64:
+        """``(n,)`` a continuous path's first contact: every pose before this ``s`` is certified clear."""
+    @property
+    def s_hi(self) -> _F64:
+        """``(n,)`` a continuous path's first contact: the pose at this ``s`` is within the margin."""
     @property
     def answers(self) -> Distances:
         """The pairs' answers."""
@@ -502,6 +508,8 @@ class Client(_Objects):
         out: SceneRows,
         question: str = "clearance",
         margin: float = 0.0,
+        bracket: float = 1e-6,
+        linear_quaternions: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,
         tolerance: float = ...,
@@ -511,7 +519,7 @@ class Client(_Objects):
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
     ) -> SceneSummary:
-        """A question at every step of a candidate motion."""
+        """A question at every step of a candidate motion; ``question="continuous"``: every pose between the steps, certified."""
     def path_joints(
         self,
         group: Union[int, Robot, _ArrayLike],
@@ -521,6 +529,7 @@ class Client(_Objects):
         out: SceneRows,
         question: str = "clearance",
         margin: float = 0.0,
+        bracket: float = 1e-6,
         clamp: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,

@@ -44,6 +44,20 @@ impl From<&SceneRow> for Contact {
     }
 }
 
+impl Default for Contact {
+    /// A placeholder for a buffer of contacts: segment 0, ids 0, no answer.
+    fn default() -> Self {
+        Contact {
+            segment: 0,
+            a: ObjectId::from_raw(0),
+            b: ObjectId::from_raw(0),
+            s_lo: 0.0,
+            s_hi: 0.0,
+            answer: Err(ErrorCode::Malformed),
+        }
+    }
+}
+
 impl<'a> SceneQuery<'_, 'a> {
     /// [`Client::within`] along the whole motion between consecutive steps
     /// of `steps` (joint positions linear between them; a rigid object's
@@ -132,14 +146,7 @@ impl Client {
             ));
         }
         let both: Vec<f64> = from.iter().chain(to).copied().collect();
-        let mut contact = [Contact {
-            segment: 0,
-            a: ObjectId::from_raw(0),
-            b: ObjectId::from_raw(0),
-            s_lo: 0.0,
-            s_hi: 0.0,
-            answer: Err(ErrorCode::Ok),
-        }];
+        let mut contact = [Contact::default()];
         let summary = self
             .within(robot, margin)
             .continuous(Steps::joints(robot, &both), bracket)

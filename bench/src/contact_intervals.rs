@@ -4,9 +4,10 @@
 //! ([`PathMode::Continuous`], the paper's configuration variables linear
 //! in `s`), beside the sampled sweep at T = 1 000.
 //!
-//! Each obstacle is asked alone (the others allowed): the path from `s = 0`
-//! to 1 gives the first contact's bracket, the same path backwards (the
-//! same poses, `s` run from 1 to 0) the last contact's. Everything before
+//! Each obstacle is asked alone (the others allowed), in one request of
+//! two segments: the path from `s = 0` to 1 gives the first contact's
+//! bracket, the same path backwards (the same poses, `s` run from 1 to 0)
+//! the last contact's. Everything before
 //! the first bracket and after the last is certified clear; an obstacle
 //! with no contact is certified clear all along.
 
@@ -31,16 +32,14 @@ pub struct Located {
     pub last: Option<(f64, f64)>,
 }
 
-/// The first contact of `scene.moving` with obstacle `i` along the motion,
-/// or along it backwards, margin 0: its bracket in this request's `s`.
-fn first_contact(
+/// Obstacle `i`'s first and last contact with `scene.moving`, margin 0,
+/// in one request: the motion forth (segment 0) and back (segment 1).
+fn contacts(
     client: &mut Client,
     motion: &Motion,
     scene: &Registered,
     i: usize,
-    backwards: bool,
-) -> Result<Option<(f64, f64)>, DemoError> {
-    let (from, to) = if backwards { (1.0, 0.0) } else { (0.0, 1.0) };
+) -> Result<Located, DemoError> {
     let mut items: Vec<Item> = scene
         .obstacles
         .iter()
@@ -48,27 +47,32 @@ fn first_contact(
         .filter(|&(j, _)| j != i)
         .map(|(_, &o)| Item::allow(scene.moving, o))
         .collect();
-    items.push(Item::set_pose(scene.moving, &motion.pose(from)).ending_step());
-    items.push(Item::set_pose(scene.moving, &motion.pose(to)).ending_step());
+    for s in [0.0, 1.0, 0.0] {
+        items.push(Item::set_pose(scene.moving, &motion.pose(s)).ending_step());
+    }
     let mut request = SceneRequest::new(SceneKind::Within, scene.moving.raw());
     request.path = PathMode::Continuous as u32;
     request.flags |= scene_flags::LINEAR_QUATERNION;
     request.bracket = BRACKET;
-    let mut rows = [SceneRow::default(); 1];
-    request.max_rows = 1;
+    let mut rows = [SceneRow::default(); 2];
+    request.max_rows = 2;
     let reply = crate::scene_call::query(client, &request, &items, &mut rows)
         .map_err(|e| DemoError::Check(format!("continuous path: {e}")))?;
-    if reply.total == 0 {
-        return Ok(None);
+    let mut located = Located::default();
+    for row in &rows[..reply.total.min(2) as usize] {
+        if row.b != scene.obstacles[i].raw() || row.result.lower > 0.0 {
+            return Err(DemoError::Check(format!(
+                "obstacle {}: unexpected contact row {row:?}",
+                i + 1
+            )));
+        }
+        match row.step {
+            0 => located.first = Some((row.s_lo, row.s_hi)),
+            // Backwards, `s` runs from 1 to 0.
+            _ => located.last = Some((1.0 - row.s_hi, 1.0 - row.s_lo)),
+        }
     }
-    let row = rows[0];
-    if row.b != scene.obstacles[i].raw() || row.result.lower > 0.0 {
-        return Err(DemoError::Check(format!(
-            "obstacle {}: unexpected contact row {row:?}",
-            i + 1
-        )));
-    }
-    Ok(Some((row.s_lo, row.s_hi)))
+    Ok(located)
 }
 
 /// Every obstacle's contact interval; returns them and the time taken.
@@ -83,11 +87,7 @@ pub(crate) fn locate(
     let start = Instant::now();
     let mut out = [Located::default(); OBSTACLES];
     for (i, located) in out.iter_mut().enumerate() {
-        located.first = first_contact(client, motion, scene, i, false)?;
-        if located.first.is_some() {
-            located.last =
-                first_contact(client, motion, scene, i, true)?.map(|(lo, hi)| (1.0 - hi, 1.0 - lo));
-        }
+        *located = contacts(client, motion, scene, i)?;
     }
     Ok((out, start.elapsed()))
 }
@@ -104,21 +104,33 @@ pub(crate) fn print(
     scene: &Registered,
     t: usize,
 ) -> Result<(), DemoError> {
-    let (located, exact_time) = locate(client, motion, scene)?;
+    // The sampled sweep first: the first scene request of a connection
+    // also opens its scene port, which is no part of either answer. Then
+    // each is timed again, alternately, and the faster of three kept.
     let mut buf = PathBuffers::new(t);
-    let sampled = path_sweep(client, motion, scene, t, PathMode::EveryStep, &mut buf)
+    let mut sampled = path_sweep(client, motion, scene, t, PathMode::EveryStep, &mut buf)
         .map_err(|e| DemoError::Check(format!("path request: {e}")))?;
+    let (mut located, mut exact_time) = locate(client, motion, scene)?;
+    for _ in 0..2 {
+        let again = path_sweep(client, motion, scene, t, PathMode::EveryStep, &mut buf)
+            .map_err(|e| DemoError::Check(format!("path request: {e}")))?;
+        if again.elapsed < sampled.elapsed {
+            sampled = again;
+        }
+        let (l, e) = locate(client, motion, scene)?;
+        if e < exact_time {
+            (located, exact_time) = (l, e);
+        }
+    }
     let _ = writeln!(
         out,
         "Contact intervals, margin 0: the sampled sweep at T = {t} (one path request, {:.3} ms)\n\
          against continuous path requests, certified, brackets at most {BRACKET:e} wide\n\
-         ({} requests, {:.3} ms in all). Certified clear before the entry bracket and after\n\
-         the exit bracket; Canny's exact method took 11.6 s for the paper's example, no distances.\n",
+         ({} requests, {:.3} ms in all; each the fastest of three). Certified clear before\n\
+         the entry bracket and after the exit bracket; Canny's exact method took 11.6 s\n\
+         for the paper's example, and gives no distances.\n",
         sampled.elapsed.as_secs_f64() * 1e3,
-        located
-            .iter()
-            .map(|l| 1 + usize::from(l.first.is_some()))
-            .sum::<usize>(),
+        OBSTACLES,
         exact_time.as_secs_f64() * 1e3,
     );
     let _ = writeln!(

@@ -182,10 +182,10 @@ impl State {
         for (i, m) in movers.iter().enumerate() {
             // Pairs of two movers, once, if either moves.
             for other in &movers[i + 1..] {
-                if m.rate > 0.0 || other.rate > 0.0 {
-                    if let Some(ab) = asks(m.slot, other.slot) {
-                        pairs.push(make(ab));
-                    }
+                if (m.rate > 0.0 || other.rate > 0.0)
+                    && let Some(ab) = asks(m.slot, other.slot)
+                {
+                    pairs.push(make(ab));
                 }
             }
             if m.rate == 0.0 {

@@ -228,10 +228,10 @@ class SceneRows:
         """``(n,)`` the path steps (a continuous path's segments)."""
     @property
     def s_lo(self) -> _F64:
-        """``(n,)`` a continuous path's first contact: every pose before this ``s`` is certified clear."""
+        """``(n,)`` continuous paths: every pose before this ``s`` is certified clear."""
     @property
     def s_hi(self) -> _F64:
-        """``(n,)`` a continuous path's first contact: the pose at this ``s`` is within the margin."""
+        """``(n,)`` continuous paths: the pose at this ``s`` is within the margin."""
     @property
     def answers(self) -> Distances:
         """The pairs' answers."""
@@ -508,7 +508,7 @@ class Client(_Objects):
         out: SceneRows,
         question: str = "clearance",
         margin: float = 0.0,
-        bracket: float = 1e-6,
+        bracket: float = ...,
         linear_quaternions: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,
@@ -519,7 +519,7 @@ class Client(_Objects):
         accept_absolute: float = 0.0,
         accept_relative: float = 0.0,
     ) -> SceneSummary:
-        """A question at every step of a candidate motion; ``question="continuous"``: every pose between the steps, certified."""
+        """A question at every step of a candidate motion (``"continuous"``: every pose between)."""
     def path_joints(
         self,
         group: Union[int, Robot, _ArrayLike],
@@ -529,7 +529,7 @@ class Client(_Objects):
         out: SceneRows,
         question: str = "clearance",
         margin: float = 0.0,
-        bracket: float = 1e-6,
+        bracket: float = ...,
         clamp: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,

@@ -75,11 +75,16 @@ fn check_segment(
             assert!(at_hi <= margin + tol, "s_hi {} is {at_hi} away", r.s_hi);
             if let Some(f) = first {
                 assert!(f >= r.s_lo - 1e-12, "contact at {f} before s_lo {}", r.s_lo);
-                assert!(
-                    f <= r.s_hi + 1.0 / DENSE as f64,
-                    "{f} long after {}",
-                    r.s_hi
-                );
+                // A contact at `s_hi` beyond doubt bounds the first from
+                // above (one sampling step allowed); one within `tol` of
+                // the margin may be a grazing pass the server kept.
+                if at_hi <= margin - tol {
+                    assert!(
+                        f <= r.s_hi + 1.0 / DENSE as f64,
+                        "{f} long after {}",
+                        r.s_hi
+                    );
+                }
             }
         }
     }
@@ -191,8 +196,8 @@ fn random_rigid_motions_never_miss_a_contact() {
     }
     // Both answers are exercised.
     assert!(
-        (8..48).contains(&touching),
-        "{touching} of 48 segments touch"
+        (6..36).contains(&touching),
+        "{touching} of 36 segments touch"
     );
 }
 

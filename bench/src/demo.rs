@@ -203,6 +203,8 @@ fn run_with_server(service: &str, steps: &[usize], repeats: usize) -> Result<(),
         );
         collision_row(&mut out, &mut client, &motion, &scene, t, repeats, c)?;
     }
+    let _ = writeln!(out);
+    crate::contact_intervals::print(&mut out, &mut client, &motion, &scene, 1000)?;
     let stats = client.stats()?;
     let _ = writeln!(
         out,

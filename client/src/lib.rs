@@ -141,7 +141,7 @@ pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
     RobotHandle, RobotModel,
 };
-pub use scene::{Group, ScenePair, SceneQuery, SceneSummary, Steps};
+pub use scene::{Contact, Group, ScenePair, SceneQuery, SceneSummary, Steps};
 
 /// Where and how urgently the calling thread runs: pin the thread that
 /// sends queries to a CPU of its own (`rt::pin_current_thread`) and, where

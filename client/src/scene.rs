@@ -9,7 +9,10 @@
 //! - [`Client::nearest`]: the `k` objects nearest to one object;
 //! - [`Client::path`], or [`SceneQuery::along`] and
 //!   [`SceneQuery::until_hit`]: the same questions at every step of a
-//!   candidate motion, without moving anything.
+//!   candidate motion, without moving anything;
+//! - [`SceneQuery::continuous`] and [`Client::edge_contact`]: every pose
+//!   of the motion between the steps, certified clear or its first contact
+//!   bracketed.
 //!
 //! Each call returns a [`SceneQuery`] to refine (warm starts, motion
 //! bounds, an accepted accuracy, a cut-off, allowed pairs) and then run into
@@ -56,6 +59,9 @@ use iceoryx2::service::port_factory::request_response;
 use nalgebra::Isometry3;
 
 use crate::{Answer, Client, ClientError, RobotHandle, Waited, ipc_err};
+
+mod continuous;
+pub use continuous::Contact;
 
 type ScenePort = IoxClient<ipc::Service, [Item], SceneRequest, [SceneRow], SceneReply>;
 type SceneService =
@@ -821,6 +827,8 @@ mod tests {
             step: 4,
             reserved: 0,
             result: ItemResult::default(),
+            s_lo: 0.0,
+            s_hi: 0.0,
         };
         let pair = ScenePair::from(&row);
         assert_eq!(pair.a, ObjectId::from_raw(3));

@@ -318,6 +318,14 @@ enum gjkd_path_question
   // Only the first step with a pair within the margin: its pairs, and
   // its index in `gjkd_scene_summary::first_hit`.
   GJKD_PATH_FIRST_HIT = 2,
+  // Every pose of the motion between consecutive steps, not samples
+  // (joints linear between steps; translations linear and rotations
+  // along the shortest arc): a row per segment that comes within the
+  // margin, its first contact bracketed in `[s_lo, s_hi]`
+  // (`options->bracket` wide at most, everything before `s_lo`
+  // certified clear), `step` the segment; no row for a segment
+  // certified clear. `first_hit` is the first segment that touches.
+  GJKD_PATH_CONTINUOUS = 3,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -697,6 +705,13 @@ typedef struct gjkd_scene_options {
   bool gradients;
   // With `gradients`, rows of robot links: the base twist too.
   bool gradient_base;
+  // `GJKD_PATH_CONTINUOUS`: rigid objects turn with their quaternions'
+  // components linear between steps (the GJK paper's Section 8), not
+  // along the shortest arc.
+  bool linear_quaternions;
+  // `GJKD_PATH_CONTINUOUS`: the widest bracket of a first contact, in
+  // the segment's `s`, `> 0` (default 1e-6).
+  double bracket;
 } gjkd_scene_options;
 
 // The objects a scene question is about: `id` (a robot, whose links are
@@ -739,6 +754,12 @@ typedef struct gjkd_scene_row {
   // The distance's gradient, with `gjkd_scene_options::gradients`
   // (`columns` 0 otherwise).
   struct gjkd_gradient gradient;
+  // `GJKD_PATH_CONTINUOUS`: every pose of the segment (`step`) before
+  // this `s` is certified clear (0 otherwise).
+  double s_lo;
+  // `GJKD_PATH_CONTINUOUS`: the `s` of the pose `answer` is at, within
+  // the margin: the first contact's bracket is `[s_lo, s_hi]`.
+  double s_hi;
 } gjkd_scene_row;
 
 // What a scene answer held besides its rows.

@@ -77,6 +77,13 @@ pub struct gjkd_scene_options {
     pub gradients: bool,
     /// With `gradients`, rows of robot links: the base twist too.
     pub gradient_base: bool,
+    /// `GJKD_PATH_CONTINUOUS`: rigid objects turn with their quaternions'
+    /// components linear between steps (the GJK paper's Section 8), not
+    /// along the shortest arc.
+    pub linear_quaternions: bool,
+    /// `GJKD_PATH_CONTINUOUS`: the widest bracket of a first contact, in
+    /// the segment's `s`, `> 0` (default 1e-6).
+    pub bracket: f64,
 }
 
 impl Default for gjkd_scene_options {
@@ -97,6 +104,8 @@ impl Default for gjkd_scene_options {
             exact: false,
             gradients: false,
             gradient_base: false,
+            linear_quaternions: false,
+            bracket: gjkd_proto::DEFAULT_BRACKET,
         }
     }
 }
@@ -132,6 +141,12 @@ pub struct gjkd_scene_row {
     /// The distance's gradient, with `gjkd_scene_options::gradients`
     /// (`columns` 0 otherwise).
     pub gradient: gjkd_gradient,
+    /// `GJKD_PATH_CONTINUOUS`: every pose of the segment (`step`) before
+    /// this `s` is certified clear (0 otherwise).
+    pub s_lo: f64,
+    /// `GJKD_PATH_CONTINUOUS`: the `s` of the pose `answer` is at, within
+    /// the margin: the first contact's bracket is `[s_lo, s_hi]`.
+    pub s_hi: f64,
 }
 
 /// What a scene answer held besides its rows.
@@ -184,6 +199,14 @@ pub enum gjkd_path_question {
     /// Only the first step with a pair within the margin: its pairs, and
     /// its index in `gjkd_scene_summary::first_hit`.
     GJKD_PATH_FIRST_HIT = 2,
+    /// Every pose of the motion between consecutive steps, not samples
+    /// (joints linear between steps; translations linear and rotations
+    /// along the shortest arc): a row per segment that comes within the
+    /// margin, its first contact bracketed in `[s_lo, s_hi]`
+    /// (`options->bracket` wide at most, everything before `s_lo`
+    /// certified clear), `step` the segment; no row for a segment
+    /// certified clear. `first_hit` is the first segment that touches.
+    GJKD_PATH_CONTINUOUS = 3,
 }
 
 /// The caller's arguments of a scene call, checked.
@@ -244,11 +267,13 @@ impl<'a> Call<'a> {
                 options.gradients && options.gradient_base,
                 scene_flags::GRADIENT_BASE,
             ),
+            (options.linear_quaternions, scene_flags::LINEAR_QUATERNION),
         ];
         request.flags = bits.iter().filter(|b| b.0).fold(0, |f, b| f | b.1);
         if options.use_cutoff {
             request.margin = options.cutoff;
         }
+        request.bracket = options.bracket;
         Ok(Call {
             request,
             members: if group.id == 0 { members } else { &[] },
@@ -345,6 +370,8 @@ fn scene_row(row: &SceneRow) -> gjkd_scene_row {
         error: row.result.error,
         answer: gjkd_answer::from(&row.result),
         gradient: gjkd_gradient::from(&row.result.gradient),
+        s_lo: row.s_lo,
+        s_hi: row.s_hi,
     }
 }
 
@@ -583,6 +610,7 @@ fn path_question(question: u32) -> Result<(SceneKind, PathMode), Failure> {
         0 => Ok((SceneKind::Clearance, PathMode::EveryStep)),
         1 => Ok((SceneKind::Within, PathMode::EveryStep)),
         2 => Ok((SceneKind::Within, PathMode::FirstHit)),
+        3 => Ok((SceneKind::Within, PathMode::Continuous)),
         _ => Err(Failure::invalid("question is no gjkd_path_question")),
     }
 }

@@ -51,7 +51,9 @@ mod urdf;
 mod xml_prefixes;
 
 pub use jacobian::{add_twist_derivative, twist_jacobian};
-pub use kinematics::{JointError, JointInfo, JointKind, Kinematics, KinematicsError, LimitMode};
+pub use kinematics::{
+    JointError, JointInfo, JointKind, JointSource, Kinematics, KinematicsError, LimitMode,
+};
 pub use mesh::{Decomposition, Mesh, MeshError};
 pub use paths::{PACKAGE_PATH_ENV, PackagePath};
 pub use robot::{CylinderError, LinkModel, RobotError, RobotModel, cylinder};

@@ -66,7 +66,8 @@ pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
 pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
-    PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags, scene_reply_flags,
+    DEFAULT_BRACKET, PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags,
+    scene_reply_flags,
 };
 pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
 pub use text::{pack_text, unpack_text};

@@ -72,6 +72,31 @@ pub enum PathMode {
     /// ([`SceneKind::Within`] only), reporting that step's pairs and its
     /// index in [`SceneReply::first_hit`].
     FirstHit = 2,
+    /// A continuous path ([`SceneKind::Within`] only): the poses after each
+    /// step are waypoints, and the motion between two consecutive
+    /// waypoints is one segment, `s` running from 0 (the first waypoint)
+    /// to 1 (the next). Along a segment, joint positions move linearly in
+    /// `s`; a rigid object's translation moves linearly and its rotation
+    /// along the shortest arc at a constant rate (slerp), or, with
+    /// [`scene_flags::LINEAR_QUATERNION`], its quaternion's components
+    /// linearly, renormalised (the configuration variables of the GJK
+    /// paper's Section 8). Every pose of the segment is asked, not samples
+    /// of it: a segment with no row is certified clear (no pair of the
+    /// question within the margin at any `s`); a segment with a row has
+    /// its first contact in the row's bracket
+    /// [[`SceneRow::s_lo`], [`SceneRow::s_hi`]], at most
+    /// [`SceneRequest::bracket`] wide: every pose before `s_lo` is
+    /// certified clear, and the row is the pair's answer at `s_hi`, within
+    /// the margin (its upper bound at most the margin, but for a contact
+    /// too grazing for the pair query's accuracy to decide: its interval
+    /// then reaches below the margin). The row's `step` is the segment's
+    /// index (segment `k` runs from waypoint `k` to `k + 1`);
+    /// [`SceneReply::first_hit`] is the first segment with a contact,
+    /// [`SceneReply::steps`] the segments answered. Pairs neither of
+    /// whose objects the path moves are not asked. A path with fewer than
+    /// two waypoints, a segment along which nothing moves, or an object
+    /// both posed and moved as a robot's link is malformed.
+    Continuous = 3,
 }
 
 impl PathMode {
@@ -81,6 +106,7 @@ impl PathMode {
             0 => Some(PathMode::Single),
             1 => Some(PathMode::EveryStep),
             2 => Some(PathMode::FirstHit),
+            3 => Some(PathMode::Continuous),
             _ => None,
         }
     }
@@ -130,6 +156,12 @@ pub mod scene_flags {
     pub const GRADIENTS: u32 = 1 << 7;
     /// With [`GRADIENTS`], rows of robot links: the base pose's twist too.
     pub const GRADIENT_BASE: u32 = 1 << 8;
+    /// [`PathMode::Continuous`](super::PathMode::Continuous): rigid objects
+    /// turn with their quaternion's components linear in `s`, renormalised
+    /// (the paper's configuration variables), not along the shortest arc;
+    /// the quaternions are taken with the signs given. Malformed in any
+    /// other mode.
+    pub const LINEAR_QUATERNION: u32 = 1 << 9;
     /// Every bit this version knows; others are refused as malformed.
     pub const ALL: u32 = WARM_START
         | MOTION_BOUNDS
@@ -140,7 +172,8 @@ pub mod scene_flags {
         | EXACT
         | SELF_PAIRS
         | GRADIENTS
-        | GRADIENT_BASE;
+        | GRADIENT_BASE
+        | LINEAR_QUATERNION;
 }
 
 /// Bits of [`SceneReply::flags`].
@@ -185,7 +218,15 @@ pub struct SceneRequest {
     pub max_rows: u32,
     /// [`scene_flags`] bits.
     pub flags: u32,
+    /// [`PathMode::Continuous`]: the widest bracket `[s_lo, s_hi]` of a
+    /// segment's first contact, in `s` (a finite number `> 0`; default
+    /// [`DEFAULT_BRACKET`]).
+    pub bracket: f64,
 }
+
+/// [`SceneRequest::bracket`]'s default: contacts located to a millionth
+/// of their segment.
+pub const DEFAULT_BRACKET: f64 = 1e-6;
 
 impl Default for SceneRequest {
     /// A request with kind 0, which no server accepts: iceoryx2 needs a
@@ -215,6 +256,7 @@ impl SceneRequest {
             k: 0,
             max_rows: 0,
             flags: scene_flags::WARM_START | scene_flags::MOTION_BOUNDS,
+            bracket: DEFAULT_BRACKET,
         }
     }
 
@@ -251,6 +293,12 @@ pub struct SceneRow {
     /// (a margin's early exit) and [`Status::Bounded`](crate::Status::Bounded)
     /// (motion bounds); [`scene_flags::EXACT`] asks for exact rows only.
     pub result: ItemResult,
+    /// [`PathMode::Continuous`]: every pose of the segment before this `s`
+    /// is certified clear (0 otherwise).
+    pub s_lo: f64,
+    /// [`PathMode::Continuous`]: the `s` of the pose `result` answers, the
+    /// end of the first contact's bracket (0 otherwise).
+    pub s_hi: f64,
 }
 
 /// Response header of the scene service.
@@ -267,7 +315,8 @@ pub struct SceneReply {
     pub total: u64,
     /// Steps answered (1 when not a path).
     pub steps: u32,
-    /// [`PathMode::FirstHit`]: the first step with a pair within the margin,
+    /// [`PathMode::FirstHit`]: the first step with a pair within the margin;
+    /// [`PathMode::Continuous`]: the first segment with a contact;
     /// `u32::MAX` when none.
     pub first_hit: u32,
     /// Pair queries that ran GJK.

@@ -272,7 +272,13 @@ class SceneRows:
         """``(n,)`` the other objects, 0 for none."""
     @property
     def step(self) -> _U32:
-        """``(n,)`` the path steps."""
+        """``(n,)`` the path steps (a continuous path's segments)."""
+    @property
+    def s_lo(self) -> _F64:
+        """``(n,)`` continuous paths: every pose before this ``s`` is certified clear."""
+    @property
+    def s_hi(self) -> _F64:
+        """``(n,)`` continuous paths: the pose at this ``s`` is within the margin."""
     @property
     def answers(self) -> Distances:
         """The pairs' answers."""
@@ -574,6 +580,8 @@ class Client(_Objects):
         question: str = "clearance",
         margin: float = 0.0,
         self_pairs: bool = False,
+        bracket: float = ...,
+        linear_quaternions: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,
         tolerance: float = ...,
@@ -584,7 +592,7 @@ class Client(_Objects):
         accept_relative: float = 0.0,
         exact: bool = False,
     ) -> SceneSummary:
-        """A question at every step of a candidate motion."""
+        """A question at every step of a candidate motion (``"continuous"``: every pose between)."""
     def path_joints(
         self,
         group: Union[int, Robot, _ArrayLike],
@@ -595,6 +603,7 @@ class Client(_Objects):
         question: str = "clearance",
         margin: float = 0.0,
         self_pairs: bool = False,
+        bracket: float = ...,
         clamp: bool = False,
         allow: Optional[_ArrayLike] = None,
         cutoff: Optional[float] = None,

@@ -27,7 +27,10 @@ use crate::robots::{Robot, path_steps};
 /// - `a` `(n,)` uint64: the group's object (the object asked about, for
 ///   `nearest`);
 /// - `b` `(n,)` uint64: the other object, 0 when none qualifies;
-/// - `step` `(n,)` uint32: the path step (0 when not a path);
+/// - `step` `(n,)` uint32: the path step (0 when not a path; the segment
+///   of a continuous path);
+/// - `s_lo`, `s_hi` `(n,)` float64: a continuous path's first-contact
+///   bracket in the segment's `s` (0 otherwise);
 /// - `answers`: a `gjkd.Distances` of `n` rows with each pair's
 ///   `distance`, `lower`, `upper`, `point_a` (on `a`), `point_b`,
 ///   `normal`, `status` (`gjkd.Status`, `BOUNDED` for rows answered from
@@ -63,6 +66,8 @@ pub struct SceneRows {
     a: Py<PyArray1<u64>>,
     b: Py<PyArray1<u64>>,
     step: Py<PyArray1<u32>>,
+    s_lo: Py<PyArray1<f64>>,
+    s_hi: Py<PyArray1<f64>>,
     answers: Py<Distances>,
     gradient: Py<PyArray2<f64>>,
     gradient_flags: Py<PyArray1<u32>>,
@@ -97,6 +102,8 @@ impl SceneRows {
             a: PyArray1::zeros(py, n, false).unbind(),
             b: PyArray1::zeros(py, n, false).unbind(),
             step: PyArray1::zeros(py, n, false).unbind(),
+            s_lo: PyArray1::zeros(py, n, false).unbind(),
+            s_hi: PyArray1::zeros(py, n, false).unbind(),
             answers: Py::new(py, Distances::new(py, n))?,
             gradient: PyArray2::zeros(py, [n, gradient_columns], false).unbind(),
             gradient_flags: PyArray1::zeros(py, n, false).unbind(),
@@ -144,6 +151,20 @@ impl SceneRows {
     #[getter]
     fn step<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
         self.step.bind(py).clone()
+    }
+
+    /// `(n,)` float64: a continuous path's first contact: every pose of
+    /// the segment before this `s` is certified clear.
+    #[getter]
+    fn s_lo<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.s_lo.bind(py).clone()
+    }
+
+    /// `(n,)` float64: a continuous path's first contact: the pose at this
+    /// `s` is within the margin (the row's answer is there).
+    #[getter]
+    fn s_hi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.s_hi.bind(py).clone()
     }
 
     /// The pairs' answers, a `gjkd.Distances` of `n` rows.
@@ -445,6 +466,7 @@ impl SceneRows {
             self.gradient_error.bind(py),
         );
         let columns = self.gradient_columns(py);
+        let (s_lo, s_hi) = (self.s_lo.bind(py), self.s_hi.bind(py));
         let answers = self.answers.bind(py).borrow();
         let result = (|| {
             // SAFETY: created contiguous by `SceneRows::new`, owned by their
@@ -460,12 +482,16 @@ impl SceneRows {
                     error.as_slice_mut()?,
                 )
             };
+            // SAFETY: as above.
+            let (s_lo, s_hi) = unsafe { (s_lo.as_slice_mut()?, s_hi.as_slice_mut()?) };
             answers.with_writer(py, |mut writer| {
                 let mut write = |rows: &[SceneRow]| {
                     for (i, row) in rows.iter().enumerate() {
                         a[i] = row.a;
                         b[i] = row.b;
                         step[i] = row.step;
+                        s_lo[i] = row.s_lo;
+                        s_hi[i] = row.s_hi;
                         writer.write(i, std::slice::from_ref(&row.result));
                         if columns > 0 {
                             let g = &row.result.gradient;
@@ -515,11 +541,14 @@ fn path_question(py: Python<'_>, question: &str) -> PyResult<(SceneKind, PathMod
         "clearance" => Ok((SceneKind::Clearance, PathMode::EveryStep)),
         "within" => Ok((SceneKind::Within, PathMode::EveryStep)),
         "first_hit" => Ok((SceneKind::Within, PathMode::FirstHit)),
+        "continuous" => Ok((SceneKind::Within, PathMode::Continuous)),
         other => Err(invalid(
             py,
             "question",
             None,
-            format!("question must be 'clearance', 'within' or 'first_hit', not {other:?}"),
+            format!(
+                "question must be 'clearance', 'within', 'first_hit' or 'continuous', not {other:?}"
+            ),
         )),
     }
 }
@@ -759,11 +788,17 @@ impl Client {
     /// `objects[i]` at step `s`. `question` is `"clearance"` (each member's
     /// clearance at every step), `"within"` (the pairs within `margin` at
     /// every step) or `"first_hit"` (only the first step with a pair within
-    /// `margin`, its index in the summary's `first_hit`). Rows carry their
-    /// step in `out.step`. `self_pairs` as `within` (a clearance row's
-    /// nearest object may then be another member). Other arguments as
-    /// `clearance`.
-    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
+    /// `margin`, its index in the summary's `first_hit`) or `"continuous"`
+    /// (every pose of the motion between consecutive steps, not samples:
+    /// translations linear, rotations along the shortest arc, or with
+    /// `linear_quaternions` the quaternions' components linear as the GJK
+    /// paper's Section 8; a row per segment that comes within `margin`, its
+    /// first contact bracketed in `[out.s_lo, out.s_hi]` at most `bracket`
+    /// wide, everything before `s_lo` certified clear; no row for a segment
+    /// certified clear; `out.step` is the segment). Rows carry their step in
+    /// `out.step`. `self_pairs` as `within` (a clearance row's nearest
+    /// object may then be another member). Other arguments as `clearance`.
+    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, bracket=gjkd_proto::DEFAULT_BRACKET, linear_quaternions=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn path<'py>(
         &mut self,
@@ -775,6 +810,8 @@ impl Client {
         question: &str,
         margin: f64,
         self_pairs: bool,
+        bracket: f64,
+        linear_quaternions: bool,
         allow: Option<&Bound<'py, PyAny>>,
         cutoff: Option<f64>,
         tolerance: f64,
@@ -814,6 +851,10 @@ impl Client {
             if self_pairs {
                 r.flags |= scene_flags::SELF_PAIRS;
             }
+            r.bracket = bracket;
+            if linear_quaternions {
+                r.flags |= scene_flags::LINEAR_QUATERNION;
+            }
         };
         let path = PathArg::Poses(mode, moving, poses);
         ask(py, self, kind, group, allow, path, &options, edit, out)
@@ -828,8 +869,11 @@ impl Client {
     /// (`OUT_OF_LIMITS`, `index` its step) unless `clamp`, which moves it
     /// to the nearest limit; a NaN raises (`NON_FINITE_POSE`). `group` is
     /// usually the robot (`robot.id`, or the `Robot` itself, so that its
-    /// allowed pairs apply). Other arguments as `path`.
-    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
+    /// allowed pairs apply). `question="continuous"` checks every pose of
+    /// the motion between consecutive steps, joints linear between them: a
+    /// planner's edge check is two rows of `positions`. Other arguments as
+    /// `path`.
+    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, bracket=gjkd_proto::DEFAULT_BRACKET, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
     #[allow(clippy::too_many_arguments)]
     fn path_joints<'py>(
         &mut self,
@@ -841,6 +885,7 @@ impl Client {
         question: &str,
         margin: f64,
         self_pairs: bool,
+        bracket: f64,
         clamp: bool,
         allow: Option<&Bound<'py, PyAny>>,
         cutoff: Option<f64>,
@@ -887,6 +932,7 @@ impl Client {
             if self_pairs {
                 r.flags |= scene_flags::SELF_PAIRS;
             }
+            r.bracket = bracket;
         };
         let path = PathArg::Joints(mode, steps);
         ask(py, self, kind, group, allow, path, &options, edit, out)

@@ -173,6 +173,8 @@ pub(crate) fn within_along(
                 step,
                 reserved: 0,
                 result,
+                s_lo: 0.0,
+                s_hi: 0.0,
             });
         } else if let Some(bound) = &candidate.bound {
             candidate.quiet_from = candidate.travel;

@@ -169,5 +169,7 @@ pub(crate) fn clearance_of(
         step,
         reserved: 0,
         result,
+        s_lo: 0.0,
+        s_hi: 0.0,
     }
 }

@@ -34,6 +34,7 @@
 mod advance;
 mod broadphase;
 mod clearance;
+mod continuous;
 mod entry;
 mod gradients;
 mod groups;
@@ -87,6 +88,10 @@ pub(crate) struct Question {
     /// [`scene_flags::WARM_START`].
     pub warm: bool,
     clamp: bool,
+    /// [`scene_flags::LINEAR_QUATERNION`].
+    linear_quaternion: bool,
+    /// [`SceneRequest::bracket`].
+    bracket: f64,
     /// Every pair query's options (the margin set per question).
     pub options: gjk::Options,
     /// The accepted absolute width of a motion bound.
@@ -159,18 +164,26 @@ impl GroupQueries {
 ///
 /// # Errors
 /// [`ErrorCode::Malformed`] for an unknown kind, path mode or flag, a
-/// first-hit path of another kind than within, the group's own pairs
-/// asked of nearest; [`ErrorCode::InvalidOptions`]
+/// first-hit or continuous path of another kind than within, linear
+/// quaternions outside a continuous path, the group's own pairs asked of
+/// nearest; [`ErrorCode::InvalidOptions`]
 /// for a margin, tolerance or accuracy that is not a finite number `>= 0`,
-/// no iterations, or `k = 0` for nearest.
+/// no iterations, `k = 0` for nearest, or a continuous path's bracket that
+/// is not a finite number `> 0`.
 fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
     let kind = r.scene_kind().ok_or(ErrorCode::Malformed)?;
     let mode = r.path_mode().ok_or(ErrorCode::Malformed)?;
+    let within_only = matches!(mode, PathMode::FirstHit | PathMode::Continuous);
+    let linear_quaternion = r.flags & scene_flags::LINEAR_QUATERNION != 0;
     if r.flags & !scene_flags::ALL != 0
-        || (mode == PathMode::FirstHit && kind != SceneKind::Within)
+        || (within_only && kind != SceneKind::Within)
+        || (linear_quaternion && mode != PathMode::Continuous)
         || (r.flags & scene_flags::SELF_PAIRS != 0 && kind == SceneKind::Nearest)
     {
         return Err(ErrorCode::Malformed);
+    }
+    if mode == PathMode::Continuous && !(r.bracket > 0.0 && r.bracket <= f64::MAX) {
+        return Err(ErrorCode::InvalidOptions);
     }
     let number = |x: f64| (0.0..=f64::MAX).contains(&x);
     if ![r.margin, r.tolerance, r.accept_absolute, r.accept_relative]
@@ -193,6 +206,8 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         exact: has(scene_flags::EXACT),
         warm: has(scene_flags::WARM_START),
         clamp: has(scene_flags::CLAMP),
+        linear_quaternion,
+        bracket: r.bracket,
         options: gjk::Options {
             tolerance: r.tolerance,
             max_iterations: r.max_iterations,
@@ -292,10 +307,11 @@ impl State {
         if q.kind == SceneKind::Nearest && self.groups.group.members.len() != 1 {
             return Err(ErrorCode::Malformed);
         }
-        if q.mode == PathMode::Single {
-            self.check_poses(&q, inputs)?;
-        } else {
-            self.plan_path(&q, inputs)?;
+        let mut waypoints = None;
+        match q.mode {
+            PathMode::Single => self.check_poses(&q, inputs)?,
+            PathMode::Continuous => waypoints = Some(self.plan_continuous(&q, inputs)?),
+            PathMode::EveryStep | PathMode::FirstHit => self.plan_path(&q, inputs)?,
         }
         let mut rows = Rows::new(rows);
         let mut counters = Counters::default();
@@ -307,6 +323,9 @@ impl State {
             self.answer_step(client, &q, 0, &mut rows, &mut counters);
             self.row_gradients(&q, rows.written_since(0), false);
             reply.steps = 1;
+        } else if let Some(waypoints) = &waypoints {
+            (reply.steps, reply.first_hit) =
+                self.answer_continuous(&q, waypoints, &mut rows, &mut counters)?;
         } else {
             (reply.steps, reply.first_hit) =
                 self.answer_path(client, &q, steps, &mut rows, &mut counters);

@@ -44,6 +44,15 @@ impl RobotOverlay {
         }
     }
 
+    /// Robot `id`'s joint positions and base as the items so far leave
+    /// them, if an item moved it.
+    pub(crate) fn state(&self, id: u64) -> Option<(&[f64], &Isometry3<f64>)> {
+        self.robots[..self.used]
+            .iter()
+            .find(|r| r.id == id)
+            .map(|r| (r.positions.as_slice(), &r.base))
+    }
+
     /// The overlay index of robot `id`, started from its stored state.
     fn index_of(&mut self, robots: &Robots, id: u64) -> Result<usize, ErrorCode> {
         if let Some(i) = self.robots[..self.used].iter().position(|r| r.id == id) {

@@ -60,6 +60,8 @@ pub(crate) fn within_of(
                 step,
                 reserved: 0,
                 result,
+                s_lo: 0.0,
+                s_hi: 0.0,
             });
         }
     }

@@ -511,5 +511,6 @@ fn first_hit_stops_at_the_first_step_within_the_margin() {
     assert_eq!((reply.first_hit, reply.steps, rows.len()), (u32::MAX, 9, 0));
 }
 
+mod continuous;
 mod paths;
 mod robots_and_refusals;

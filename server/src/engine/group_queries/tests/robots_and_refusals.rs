@@ -13,7 +13,7 @@ const ARM: &str = r#"<robot name="arm">
     <origin xyz="1 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
 </robot>"#;
 
-fn arm_state() -> (State, u64, Vec<u64>, u64) {
+pub(super) fn arm_state() -> (State, u64, Vec<u64>, u64) {
     let mut s = State::new(Limits::default(), WaitMode::Spin, 3);
     let model = gjkd_model::RobotModel::from_urdf_str(ARM, None, &Default::default()).unwrap();
     let mut links = Vec::new();

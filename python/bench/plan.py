@@ -13,9 +13,10 @@ planning, and every returned path re-checked densely by an exact check
 independent of gjkd (pinocchio + coal on the URDF's own meshes, margin 0,
 at a tenth of OMPL's resolution): the paths that touch an obstacle or
 collide with themselves. The problems alternate checkers, one problem at a
-time, so that both see the same machine load. gjkd's edge check is still
-the sampled path at OMPL's resolution (until the certified continuous check
-lands). Needs ``pip install ompl pin coal`` besides the gjkd package.
+time, so that both see the same machine load. gjkd's edge check is the
+certified continuous check (one request an edge; ``--motion sampled`` for
+the sampled path at OMPL's resolution), the baseline's OMPL's discrete
+validator at its default resolution. Needs ``pip install ompl pin coal`` besides the gjkd package.
 """
 
 from __future__ import annotations
@@ -182,6 +183,12 @@ def main() -> None:
     )
     parser.add_argument("--planner", default="RRTConnect", help="OMPL's og.<planner>")
     parser.add_argument(
+        "--motion",
+        choices=["continuous", "sampled"],
+        default="continuous",
+        help="gjkd's edge check: certified continuous, or sampled at OMPL's resolution",
+    )
+    parser.add_argument(
         "--objective",
         choices=["length", "clearance"],
         default="length",
@@ -212,6 +219,7 @@ def main() -> None:
             margin=args.margin,
             joints=robot["joints"],
             fixed=robot["fixed"],
+            motion=args.motion,
         )
         ss = gjkd.ompl.simple_setup(checker, planner=args.planner)
         if args.planner in OPTIMISING and args.objective == "clearance":

@@ -134,9 +134,52 @@ def test_motion_checks_the_sampled_segment(checker: gjkd.ompl.RobotChecker) -> N
     assert checker.edge_checks == 2
 
 
+def test_continuous_edges_agree_with_dense_exact_checks(
+    checker: gjkd.ompl.RobotChecker,
+) -> None:
+    """Random edges: certified clear exactly when no pose of the edge comes
+    within the margin (10 000 poses an edge, by hand), and an edge that
+    slips between the sampled validator's states is still refused."""
+    assert checker.motion == "continuous"
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 1.0, 10_001)[:, None]
+    seen = {True: 0, False: 0}
+    for _ in range(60):
+        a = rng.uniform(checker.lower, checker.upper)
+        b = a + rng.uniform(-0.6, 0.6, size=3)
+        b = np.clip(b, checker.lower, checker.upper)
+        least = min(exact_clearance(q) for q in a + t * (b - a))
+        if abs(least - checker.margin) < 1e-6:
+            continue  # a grazing edge: either answer is right within round-off
+        got = checker.motion_valid(a, b)
+        assert got == (least > checker.margin), (a, b, least)
+        seen[got] += 1
+    assert seen[True] > 5 and seen[False] > 5, seen
+    # Both ends clear, the middle overlapping: the sampled validator at a
+    # coarse step checks the end only and passes it, the continuous one not.
+    a, b = np.array([-1.2, -1.4, 1.2]), np.array([-1.0, -0.6, 1.6])
+    assert min(exact_clearance(q) for q in a + t * (b - a)) < 0.0
+    with gjkd.ompl.RobotChecker(
+        checker.client,
+        unique_service("coarse"),
+        urdf_text=ARM,
+        margin=0.05,
+        resolution=1.0,
+        motion="sampled",
+    ) as coarse:
+        assert coarse.is_valid(a) and coarse.is_valid(b)
+        assert coarse.motion_valid(a, b) is True
+    assert checker.motion_valid(a, b) is False
+
+
 def test_long_edges_take_several_requests(client: gjkd.Client) -> None:
     with gjkd.ompl.RobotChecker(
-        client, unique_service("fine"), urdf_text=ARM, margin=0.05, resolution=2e-5
+        client,
+        unique_service("fine"),
+        urdf_text=ARM,
+        margin=0.05,
+        resolution=2e-5,
+        motion="sampled",
     ) as fine:
         a, b = np.array([-0.5, 0.0, 0.0]), np.array([-0.5, 0.0, 1.0])
         steps = fine.segment(a, b)

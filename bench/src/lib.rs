@@ -45,6 +45,7 @@ pub mod contact_intervals;
 pub mod demo;
 #[cfg(feature = "measure")]
 pub mod depth;
+#[cfg(feature = "measure")]
 pub mod edges;
 #[cfg(feature = "measure")]
 pub mod extremes;

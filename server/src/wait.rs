@@ -306,7 +306,7 @@ mod tests {
             rng ^= rng << 13;
             rng ^= rng >> 7;
             rng ^= rng << 17;
-            if rng % 3 == 0 {
+            if rng.is_multiple_of(3) {
                 now = paced(&mut p, now, 2 * US, 1).0;
             } else {
                 let (end, spun) = co_located(&mut p, now, 2 * US, 1);

@@ -502,7 +502,7 @@ mod tests {
         let mut reserved = Item::distance(a, a, &QueryOptions::default());
         reserved.reserved = 1;
         let mut pose_flags = Item::set_pose(a, &Isometry3::identity());
-        pose_flags.flags = 1 << 9;
+        pose_flags.flags = 1 << 20;
         let mut pose_reserved = Item::set_pose(a, &Isometry3::identity());
         pose_reserved.reserved = 7;
         // A path step's end is a scene request's; here it moves nothing.

@@ -1,5 +1,10 @@
-//! Generates the C header from this crate into `OUT_DIR/gjkd.h`; the test
-//! `tests/header.rs` compares it with the committed `include/gjkd.h`.
+//! Links the C library: its versioned soname and the list of exported
+//! symbols. The C header is not generated here but by the test
+//! `tests/header.rs`, which compares cbindgen's output with the committed
+//! `include/gjkd.h`: as a build dependency, cbindgen turned on features of
+//! the build tools (`syn`'s `fold`) that the Python extension's build does
+//! not, so `maturin develop` rebuilt every procedural macro and every crate
+//! that derives with one instead of reusing what `cargo test` built.
 
 /// The ABI version in the soname: the major version, or for `0.x`
 /// versions `0.x` (Cargo's rule of which versions are compatible).
@@ -34,8 +39,6 @@ fn link_soname_in_build_tree(out: &str, soname: &str) {
 fn main() {
     let dir = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
     let out = std::env::var("OUT_DIR").expect("cargo sets OUT_DIR");
-    println!("cargo::rerun-if-changed=src");
-    println!("cargo::rerun-if-changed=cbindgen.toml");
     println!("cargo::rerun-if-changed=gjkd_c.map");
     if std::env::var("CARGO_CFG_TARGET_OS").is_ok_and(|os| os == "linux") {
         // A versioned soname, so that programs linked with the shared
@@ -50,12 +53,4 @@ fn main() {
         println!("cargo::rustc-cdylib-link-arg=-Wl,--version-script={dir}/gjkd_c.map");
         println!("cargo::rustc-cdylib-link-arg=-Wl,--exclude-libs,ALL");
     }
-    let config =
-        cbindgen::Config::from_file(format!("{dir}/cbindgen.toml")).expect("read cbindgen.toml");
-    cbindgen::Builder::new()
-        .with_crate(&dir)
-        .with_config(config)
-        .generate()
-        .expect("cbindgen generates the header")
-        .write_to_file(format!("{out}/gjkd.h"));
 }

@@ -6,6 +6,8 @@ process (``baseline.py``), the same planner and settings for both.
     python python/bench/plan.py --quick    # 4 problems a scene
     python python/bench/plan.py --planner RRTstar --objective clearance \
         --problems 20 --time 2             # an optimising planner, fixed time
+    python python/bench/plan.py --pybullet --plot docs/img/planning.svg
+                                           # pybullet as a third checker; a plot
 
 Per checker: RRTConnect's planning time (OMPL's own measure; median and
 90th percentile), success rate, state checks and edge checks per second of
@@ -16,7 +18,10 @@ collide with themselves. The problems alternate checkers, one problem at a
 time, so that both see the same machine load. gjkd's edge check is the
 certified continuous check (one request an edge; ``--motion sampled`` for
 the sampled path at OMPL's resolution), the baseline's OMPL's discrete
-validator at its default resolution. Needs ``pip install ompl pin coal`` besides the gjkd package.
+validator at its default resolution. ``--pybullet`` adds pybullet's
+``getClosestPoints`` (``bullet.py``) as a reference point, planned the
+baseline's way. Needs ``pip install ompl pin coal`` besides the gjkd
+package (and ``pybullet``, ``matplotlib`` for those options).
 """
 
 from __future__ import annotations
@@ -38,6 +43,11 @@ from scenes import PACKAGES, PANDA_SRDF, Problem, load_problems, panda_urdf, rea
 
 import gjkd
 import gjkd.ompl
+
+try:
+    from bullet import Bullet
+except ImportError:  # pybullet not installed: --pybullet says so
+    Bullet = None  # type: ignore[assignment,misc]
 
 SCENES = ["box", "cage", "table_pick", "table_under_pick", "bookshelf_small"]
 # Planners that use their whole time improving the path under an objective.
@@ -119,15 +129,23 @@ def run_gjkd(
     }
 
 
-def run_baseline(
-    p: Problem, margin: float, fingers: float, limit: float, planner: str, objective: str
-) -> tuple[Optional[np.ndarray], dict[str, Any], PinCoal]:
-    checker = PinCoal(read_scene(p.scene_file), margin, fingers)
+def run_in_process(
+    checker: Any,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    p: Problem,
+    limit: float,
+    planner: str,
+    objective: str,
+) -> tuple[Optional[np.ndarray], dict[str, Any]]:
+    """OMPL with an in-process ``checker`` (``is_valid(q)``; ``clearance(q)``
+    for the clearance objective) and its discrete motion validator at the
+    default resolution, as its users set it up."""
     space = ob.RealVectorStateSpace(7)
     bounds = ob.RealVectorBounds(7)
     for i in range(7):
-        bounds.setLow(i, float(checker.model.lowerPositionLimit[i]))
-        bounds.setHigh(i, float(checker.model.upperPositionLimit[i]))
+        bounds.setLow(i, float(lower[i]))
+        bounds.setHigh(i, float(upper[i]))
     space.setBounds(bounds)
     ss = og.SimpleSetup(space)
     ss.setStateValidityChecker(lambda s: checker.is_valid(s[0:7]))
@@ -148,7 +166,32 @@ def run_baseline(
         "states": checker.checks,
         "edges": si.getMotionValidator().getCheckedMotionCount(),
     }
-    return path, stats, checker
+    return path, stats
+
+
+def plot(results: dict[str, list[dict[str, Any]]], limit: float, title: str, out: str) -> None:
+    """Each checker's share of problems solved within a planning time (a
+    cumulative curve, log time): the curve to the left plans faster."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    for name, rows in results.items():
+        times = sorted(1e3 * r["time"] for r in rows if r["solved"])
+        share = np.arange(1, len(times) + 1) / max(len(rows), 1)
+        ax.step(times, share, where="post", label=name)
+    ax.set_xscale("log")
+    ax.set_xlabel("planning time, ms (log)")
+    ax.set_ylabel("share of problems solved")
+    ax.set_ylim(0, 1)
+    ax.set_xlim(right=1e3 * limit)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="lower right")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out)
 
 
 def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -194,16 +237,27 @@ def main() -> None:
         default="length",
         help="an optimising planner's objective (OMPL's default: path length)",
     )
+    parser.add_argument(
+        "--pybullet",
+        action="store_true",
+        help="also plan with pybullet's getClosestPoints (a reference point; pip install pybullet)",
+    )
+    parser.add_argument(
+        "--plot", help="write the planning-time curves here (SVG; needs matplotlib)"
+    )
     parser.add_argument("--json", help="write every problem's figures here")
     args = parser.parse_args()
     if args.quick:
         args.problems, args.time = 4, 2.0
+    if args.pybullet and Bullet is None:
+        parser.error("--pybullet needs pybullet: pip install pybullet")
     ou.setLogLevel(ou.LOG_WARN)
     ou.RNG.setSeed(args.seed)
     problems, robot = load_problems(args.scenes, args.problems)
     fingers = float(robot["fixed"]["panda_finger_joint1"])
-    results: dict[str, list[dict[str, Any]]] = {"gjkd": [], "pinocchio+coal": []}
-    invalid: dict[str, list[str]] = {"gjkd": [], "pinocchio+coal": []}
+    names = ["gjkd", "pinocchio+coal"] + (["pybullet"] if args.pybullet else [])
+    results: dict[str, list[dict[str, Any]]] = {name: [] for name in names}
+    invalid: dict[str, list[str]] = {name: [] for name in names}
     skipped: list[str] = []
     service = f"gjkd-plan-{os.getpid()}"
     with (
@@ -238,17 +292,33 @@ def main() -> None:
             path, stats = run_gjkd(ss, checker, p, args.time)
             for i in ids:
                 client.remove(i)
-            bpath, bstats, truth = run_baseline(
-                p, args.margin, fingers, args.time, args.planner, args.objective
-            )
-            for q, what in ((p.start, "start"), (p.goal, "goal")):
-                if not truth.is_valid(q):
-                    why = truth.first_collision(q)
-                    invalid["pinocchio+coal"].append(f"{p.scene}/{p.index} {what} {why}")
+            obstacles = read_scene(p.scene_file)
+            truth = PinCoal(obstacles, args.margin, fingers)
+            runs = [("gjkd", path, stats)]
+            for name in names[1:]:
+                other = (
+                    truth if name == "pinocchio+coal" else Bullet(obstacles, args.margin, fingers)
+                )
+                for q, what in ((p.start, "start"), (p.goal, "goal")):
+                    if not other.is_valid(q):
+                        invalid[name].append(f"{p.scene}/{p.index} {what}")
+                other.checks = 0
+                opath, ostats = run_in_process(
+                    other,
+                    checker.lower,
+                    checker.upper,
+                    p,
+                    args.time,
+                    args.planner,
+                    args.objective,
+                )
+                runs.append((name, opath, ostats))
+                if other is not truth:
+                    other.close()
             if args.margin != 0.0:
-                truth = PinCoal(read_scene(p.scene_file), 0.0, fingers)
+                truth = PinCoal(obstacles, 0.0, fingers)
             step = 0.001 * checker.extent
-            for name, pth, st in (("gjkd", path, stats), ("pinocchio+coal", bpath, bstats)):
+            for name, pth, st in runs:
                 results[name].append(
                     {
                         "scene": p.scene,
@@ -262,13 +332,11 @@ def main() -> None:
                         **st,
                     }
                 )
-            g, b = results["gjkd"][-1], results["pinocchio+coal"][-1]
-            print(
-                f"[{k + 1}/{len(problems)}] {p.scene}/{p.index}: "
-                f"gjkd {g['solved']} {1e3 * g['time']:.1f} ms, "
-                f"pinocchio+coal {b['solved']} {1e3 * b['time']:.1f} ms",
-                file=sys.stderr,
+            done = ", ".join(
+                f"{n} {results[n][-1]['solved']} {1e3 * results[n][-1]['time']:.1f} ms"
+                for n in names
             )
+            print(f"[{k + 1}/{len(problems)}] {p.scene}/{p.index}: {done}", file=sys.stderr)
         checker.close()
     objective = f", objective {args.objective}" if args.planner in OPTIMISING else ""
     print(
@@ -287,8 +355,10 @@ def main() -> None:
                 f"| {s['p90_ms']:.1f} | {s['states_per_s']:.0f} | {s['edges_per_s']:.0f} "
                 f"| {s['touching']} |"
             )
-    g, b = summary(results["gjkd"]), summary(results["pinocchio+coal"])
-    print(f"median planning time, gjkd / pinocchio+coal: {g['median_ms'] / b['median_ms']:.2f}")
+    g = summary(results["gjkd"])
+    for name in names[1:]:
+        b = summary(results[name])
+        print(f"median planning time, gjkd / {name}: {g['median_ms'] / b['median_ms']:.2f}")
     if args.planner in OPTIMISING:
         # A fixed time: what the time bought, the path's length and its least
         # clearance (checked densely by pinocchio + coal), median over the
@@ -328,6 +398,14 @@ def main() -> None:
     print(f"{len(skipped)} problems skipped, start or goal outside the URDF's limits: {skipped}")
     for name, bad in invalid.items():
         print(f"{name}: {len(bad)} invalid starts or goals" + "".join(f"\n  {x}" for x in bad))
+    if args.plot:
+        plot(
+            results,
+            args.time,
+            f"{args.planner}{objective}, {sum(len(r) for r in results.values()) // len(names)} "
+            f"problems, margin {args.margin:g}",
+            args.plot,
+        )
     if args.json:
         with open(args.json, "w") as f:
             json.dump(

@@ -107,6 +107,25 @@ class Bullet:
                 return False
         return True
 
+    def clearance(self, q: Sequence[float], reach: float = 10.0) -> float:
+        """The least distance over every checked pair at ``q`` (negative where
+        shapes overlap; ``reach`` where nothing is nearer), as a clearance
+        objective asks for it."""
+        self.checks += 1
+        c = self.client
+        for j, x in zip(self.arm, np.asarray(q, dtype=float)):
+            pb.resetJointState(self.robot, j, float(x), physicsClientId=c)
+        least = reach
+        for body in self.obstacles:
+            for point in pb.getClosestPoints(self.robot, body, reach, physicsClientId=c):
+                least = min(least, point[8])
+        for a, b in self.self_pairs:
+            for point in pb.getClosestPoints(
+                self.robot, self.robot, reach, a, b, physicsClientId=c
+            ):
+                least = min(least, point[8])
+        return float(least)
+
     def close(self) -> None:
         """Disconnects the pybullet world."""
         pb.disconnect(self.client)

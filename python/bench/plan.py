@@ -121,10 +121,11 @@ def run_gjkd(
     ss: Any, checker: gjkd.ompl.RobotChecker, p: Problem, limit: float
 ) -> tuple[Optional[np.ndarray], dict[str, Any]]:
     checker.state_checks = checker.edge_checks = checker.edge_steps = 0
+    checker.clearance_checks = 0
     path = gjkd.ompl.plan(ss, checker, p.start, p.goal, time=limit)
     return path, {
         "time": ss.getLastPlanComputationTime(),
-        "states": checker.state_checks + checker.edge_steps,
+        "states": checker.state_checks + checker.edge_steps + checker.clearance_checks,
         "edges": checker.edge_checks,
     }
 

@@ -150,8 +150,9 @@ class RobotChecker:
             :meth:`gjkd.Client.register_robot`), a joint name is unknown, or
             the margin or resolution is not a finite number in range.
 
-    Counters: :attr:`state_checks`, :attr:`edge_checks` and
-    :attr:`edge_steps` count the questions answered (for benchmarks).
+    Counters: :attr:`state_checks`, :attr:`edge_checks`,
+    :attr:`edge_steps` and :attr:`clearance_checks` count the questions
+    answered (for benchmarks).
     """
 
     def __init__(
@@ -210,6 +211,7 @@ class RobotChecker:
         self.state_checks = 0
         self.edge_checks = 0
         self.edge_steps = 0
+        self.clearance_checks = 0
         try:
             self._choose_joints(joints, fixed)
         except Error:
@@ -373,6 +375,7 @@ class RobotChecker:
         """The distance from the robot at ``q`` to its nearest other object
         or non-allowed link (one request): 0 where shapes overlap, ``inf``
         when nothing qualifies."""
+        self.clearance_checks += 1
         s = self._ask(self._steps(q), "clearance")
         d = self._rows.distance[: s.written]
         ok = (self._rows.b[: s.written] != 0) & (self._rows.error[: s.written] == 0)

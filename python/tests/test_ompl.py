@@ -99,6 +99,7 @@ def test_states_agree_with_the_exact_answer(checker: gjkd.ompl.RobotChecker) -> 
     for q, d in zip(qs[:40], exact[:40]):
         assert checker.clearance(q) == pytest.approx(max(d, 0.0), abs=1e-9)
     assert checker.state_checks == 2 * len(qs)
+    assert checker.clearance_checks == 40
 
 
 def test_self_collision_is_seen(checker: gjkd.ompl.RobotChecker) -> None:

@@ -19,14 +19,18 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Each package of `cargo tree <args>` ("name vX.Y.Z") with the feature
-/// sets it is built with (a package built for the host and for the target
-/// can appear twice).
-fn feature_sets(args: &[&str]) -> BTreeMap<String, BTreeSet<BTreeSet<String>>> {
+/// Each package of `cargo tree <args>` ("name vX.Y.Z"), with `true` for a
+/// copy built for the host (a procedural macro and what it uses), mapped
+/// to the feature sets it is built with. Cargo builds a host copy and a
+/// target copy of one crate apart, so their features are compared apart.
+/// Build scripts' dependencies are not listed (`-e normal`).
+type Sets = BTreeMap<(String, bool), BTreeSet<BTreeSet<String>>>;
+
+fn feature_sets(args: &[&str]) -> Sets {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = Command::new(cargo)
         .current_dir(root())
-        .args(["tree", "--prefix", "none", "-f", "{p}|{f}"])
+        .args(["tree", "--prefix", "depth", "-f", "{p}|{f}"])
         .args(args)
         .output()
         .expect("run cargo tree");
@@ -35,11 +39,23 @@ fn feature_sets(args: &[&str]) -> BTreeMap<String, BTreeSet<BTreeSet<String>>> {
         "cargo tree {args:?} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let mut sets: BTreeMap<String, BTreeSet<BTreeSet<String>>> = BTreeMap::new();
+    let mut sets = Sets::new();
+    // The depth of the procedural macro the current line is under, if any.
+    let mut host_from: Option<usize> = None;
     for line in String::from_utf8(out.stdout).expect("UTF-8").lines() {
-        let Some((package, features)) = line.split_once('|') else {
+        let digits = line.chars().take_while(char::is_ascii_digit).count();
+        let Ok(depth) = line[..digits].parse::<usize>() else {
             continue;
         };
+        let Some((package, features)) = line[digits..].split_once('|') else {
+            continue;
+        };
+        if host_from.is_some_and(|d| depth <= d) {
+            host_from = None;
+        }
+        if host_from.is_none() && package.contains("(proc-macro)") {
+            host_from = Some(depth);
+        }
         // "name v1.2.3 (/path)" for path packages: the name and version
         // identify it.
         let id: Vec<&str> = package.split_whitespace().take(2).collect();
@@ -51,7 +67,9 @@ fn feature_sets(args: &[&str]) -> BTreeMap<String, BTreeSet<BTreeSet<String>>> {
             .filter(|f| !f.is_empty())
             .map(str::to_owned)
             .collect();
-        sets.entry(id.join(" ")).or_default().insert(features);
+        sets.entry((id.join(" "), host_from.is_some()))
+            .or_default()
+            .insert(features);
     }
     sets
 }
@@ -64,26 +82,36 @@ fn the_python_build_reuses_the_workspace_build() {
         "--features",
         "pyo3/extension-module",
         "-e",
-        "normal,build",
+        "normal",
     ]);
-    let workspace = feature_sets(&["--workspace", "-e", "normal,build,dev"]);
+    let workspace = feature_sets(&["--workspace", "-e", "normal,dev"]);
     assert!(
-        python.keys().any(|p| p.starts_with("parry3d-f64 ")),
+        python
+            .keys()
+            .any(|(p, host)| p.starts_with("parry3d-f64 ") && !host)
+            && python
+                .keys()
+                .any(|(p, host)| p.starts_with("syn ") && *host),
         "the tree was read"
     );
     let mut differ = Vec::new();
-    for (package, sets) in &python {
+    for ((package, host), sets) in &python {
         if package.starts_with("pyo3") || package.starts_with("numpy ") {
             continue;
         }
         if package.starts_with("gjkd-python ") {
             continue;
         }
-        let built = workspace.get(package).cloned().unwrap_or_default();
+        let built = workspace
+            .get(&(package.clone(), *host))
+            .cloned()
+            .unwrap_or_default();
+        let side = if *host { "host" } else { "target" };
         for features in sets {
             if !built.contains(features) {
                 differ.push(format!(
-                    "{package}: the Python build asks {features:?}, the workspace builds {built:?}"
+                    "{package} ({side}): the Python build asks {features:?}, \
+                     the workspace builds {built:?}"
                 ));
             }
         }

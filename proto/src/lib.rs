@@ -12,7 +12,7 @@
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
 //! | [`query_service_name`] `{service}/v2/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
-//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
+//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
 //! | [`scene_service_name`] `{service}/v2/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
 //! | [`wake_service_name`] `{service}/v2/wake` | event | | |
 //!
@@ -44,25 +44,28 @@
 use std::fmt;
 
 mod admin;
+mod admin_payload;
 mod error;
 mod geometry;
 mod gradient;
 mod item;
+mod item_body;
 mod pose;
 mod result;
 mod scene;
 mod shape;
-mod text;
 
 pub use admin::{
     AdminOp, AdminReply, AdminRequest, ServerInfo, ServerStats, WaitMode, lookup_kind,
 };
+pub use admin_payload::{AdminChunk, TEXT_CHUNK_LEN};
 pub use error::ErrorCode;
 pub use geometry::{
     Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape, hull,
 };
 pub use gradient::{GRADIENT_COLUMNS, Gradient, gradient_flags};
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
+pub use item_body::{ItemBody, JointsBody, PairBody};
 pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
@@ -70,7 +73,6 @@ pub use scene::{
     scene_reply_flags,
 };
 pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
-pub use text::{pack_text, unpack_text};
 
 /// Protocol version, part of every service name: a client and a server of
 /// different versions never see each other's services, instead of misreading

@@ -9,8 +9,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, SceneReply,
-    SceneRequest, SceneRow, Vertex, WaitMode, admin_service_name, query_service_name,
+    AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader,
+    SceneReply, SceneRequest, SceneRow, WaitMode, admin_service_name, query_service_name,
     scene_service_name, wake_service_name,
 };
 use iceoryx2::active_request::ActiveRequest;
@@ -23,7 +23,7 @@ use crate::engine::{Limits, State};
 use crate::wait::{Idle, WaitPolicy};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
-type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+type AdminServer = IoxServer<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>;
 type SceneServer = IoxServer<ipc::Service, [Item], SceneRequest, [SceneRow], SceneReply>;
 type SceneService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
@@ -41,7 +41,7 @@ type QueryService = iceoryx2::service::port_factory::request_response::PortFacto
 >;
 type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
-    [Vertex],
+    [AdminChunk],
     AdminRequest,
     AdminReply,
     (),
@@ -185,7 +185,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .map_err(ipc("query service"))?;
     let admin_service = node
         .service_builder(&admin_name)
-        .request_response::<[Vertex], AdminReply>()
+        .request_response::<[AdminChunk], AdminReply>()
         .request_user_header::<AdminRequest>()
         .max_clients(clients)
         .max_servers(1)

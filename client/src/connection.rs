@@ -26,6 +26,8 @@ pub(crate) struct Connection {
     // Ports are declared before their services so they are dropped first.
     /// The scene service, opened at the first scene query.
     pub(crate) scene: Option<scene::ScenePorts>,
+    /// The pose service, opened at the first pose read-back.
+    pub(crate) poses: Option<crate::poses::PosesPorts>,
     pub(crate) query: QueryPort,
     pub(crate) admin: AdminPort,
     pub(crate) wake: Notifier<ipc::Service>,
@@ -283,6 +285,7 @@ impl Client {
             .map_err(ipc_err("wake notifier"))?;
         self.conn = Some(Connection {
             scene: None,
+            poses: None,
             query,
             admin,
             wake,

@@ -51,6 +51,11 @@ impl Store {
         }
     }
 
+    /// The stored pose of each of `ids` (see `State::poses`).
+    pub fn poses(&self, ids: &[u64], out: &mut [gjkd_proto::StoredPose]) {
+        self.state.poses(ids, out);
+    }
+
     /// Answers query items as a server answers one request.
     pub fn handle(&mut self, items: &[Item], results: &mut [ItemResult]) {
         self.state.handle(LOCAL_CLIENT, items, results);

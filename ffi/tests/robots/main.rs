@@ -5,7 +5,7 @@
 //! status, code and message.
 //!
 //! One test binary, one file a concept: the shared arm (`arm.rs`), a robot
-//! moving (`moves.rs`), meshes (`meshes.rs`), their errors
+//! moving (`moves.rs`), poses read back (`poses.rs`), meshes (`meshes.rs`), their errors
 //! (`mesh_errors.rs`, `robot_errors.rs`), cylinders (`cylinders.rs`).
 
 mod arm;
@@ -13,4 +13,5 @@ mod cylinders;
 mod mesh_errors;
 mod meshes;
 mod moves;
+mod poses;
 mod robot_errors;

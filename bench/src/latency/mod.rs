@@ -11,7 +11,7 @@
 //!   the transport;
 //! - `uds`: a Unix-stream-socket server with blocking reads, also a child
 //!   process of its own (`gjkd bench uds-server`, [`super::uds`]);
-//! - `in-process`: [`State::handle`] called directly, the GJK work alone.
+//! - `in-process`: [`State::handle`](gjkd_server::engine::State::handle) called directly, the GJK work alone.
 //!
 //! Each is asked a single pair (`Client::distance`, the pair at its stored
 //! poses) and batches of 1, 8, 64 and 512 distinct box pairs, each item with

@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group};
 use gjkd_client::{Client, Item, ItemResult, ObjectId, QueryOptions};
-use gjkd_proto::WaitMode;
+use gjkd_proto::{AdminChunk, WaitMode};
 use gjkd_server::engine::{Limits, State};
 use gjkd_server::server::{ServeOptions, run};
 use nalgebra::{Isometry3, Vector3};
@@ -217,7 +217,13 @@ fn benches(c: &mut Criterion) {
         .map(|&p| p.into())
         .collect();
     let ids: Vec<ObjectId> = (0..65)
-        .map(|_| ObjectId::from_raw(state.handle_admin(1, &reg, &verts).id))
+        .map(|_| {
+            ObjectId::from_raw(
+                state
+                    .handle_admin(1, &reg, AdminChunk::from_vertices(&verts))
+                    .id,
+            )
+        })
         .collect();
     let items: Vec<Item> = batch
         .iter()
@@ -234,7 +240,7 @@ fn benches(c: &mut Criterion) {
         .into();
     let poses: Vec<Isometry3<f64>> = items
         .iter()
-        .map(|it| it.pose_b.to_isometry_unchecked())
+        .map(|it| it.pair().pose_b.to_isometry_unchecked())
         .collect();
     let opts = gjk::Options::default();
     let mut warm: Vec<Option<gjk::WarmStart>> = vec![None; poses.len()];

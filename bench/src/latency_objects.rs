@@ -6,7 +6,9 @@
 //! everywhere; the iceoryx2 transports register the same boxes through the
 //! client.
 
-use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, ObjectId, Vertex, WaitMode, shape_kind};
+use gjkd_proto::{
+    AdminChunk, AdminOp, AdminRequest, Item, ItemResult, ObjectId, Vertex, WaitMode, shape_kind,
+};
 use gjkd_server::engine::{Limits, State};
 use nalgebra::{Isometry3, Vector3};
 
@@ -45,7 +47,13 @@ pub(crate) fn local_state(max_batch: usize) -> (State, ObjectId, ObjectId, Vec<O
             z: if i & 4 == 0 { -HALF[2] } else { HALF[2] },
         })
         .collect();
-    let mut reg_one = || ObjectId::from_raw(state.handle_admin(1, &reg, &verts).id);
+    let mut reg_one = || {
+        ObjectId::from_raw(
+            state
+                .handle_admin(1, &reg, AdminChunk::from_vertices(&verts))
+                .id,
+        )
+    };
     let a = reg_one();
     let b = reg_one();
     let boxes: Vec<ObjectId> = (0..=max_batch).map(|_| reg_one()).collect();

@@ -278,7 +278,9 @@ impl UdsClient {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use gjkd_proto::{AdminOp, AdminRequest, ObjectId, QueryOptions, Vertex, WaitMode, shape_kind};
+    use gjkd_proto::{
+        AdminChunk, AdminOp, AdminRequest, ObjectId, QueryOptions, Vertex, WaitMode, shape_kind,
+    };
     use gjkd_server::engine::state::Limits;
 
     #[test]
@@ -289,7 +291,9 @@ mod tests {
         reg.piece_count = 1;
         reg.pieces[0].vertex_count = 1;
         reg.pieces[0].rounding = 0.5;
-        let a = state.handle_admin(1, &reg, &[Vertex::default()]).id;
+        let a = state
+            .handle_admin(1, &reg, AdminChunk::from_vertices(&[Vertex::default()]))
+            .id;
         let b = state
             .handle_admin(
                 1,
@@ -298,7 +302,8 @@ mod tests {
                     x: 3.0,
                     y: 0.0,
                     z: 0.0,
-                }],
+                }
+                .into()],
             )
             .id;
         let items = [

@@ -14,25 +14,27 @@ use crate::open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 use crate::path_split::{RequestLimits, SplitScratch};
 use crate::{ClientError, ipc_err, scene};
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, ServerInfo,
-    Vertex, WaitMode, admin_service_name, query_service_name, wake_service_name,
+    AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader,
+    ServerInfo, Vertex, WaitMode, admin_service_name, query_service_name, wake_service_name,
 };
 
 type QueryPort = IoxClient<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
-type AdminPort = IoxClient<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+type AdminPort = IoxClient<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>;
 
 /// Open ports to one server incarnation.
 pub(crate) struct Connection {
     // Ports are declared before their services so they are dropped first.
     /// The scene service, opened at the first scene query.
     pub(crate) scene: Option<scene::ScenePorts>,
+    /// The pose service, opened at the first pose read-back.
+    pub(crate) poses: Option<crate::poses::PosesPorts>,
     pub(crate) query: QueryPort,
     pub(crate) admin: AdminPort,
     pub(crate) wake: Notifier<ipc::Service>,
     pub(crate) query_service:
         request_response::PortFactory<ipc::Service, [Item], (), [ItemResult], ReplyHeader>,
     pub(crate) admin_service:
-        request_response::PortFactory<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>,
+        request_response::PortFactory<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>,
     pub(crate) _wake_service: event::PortFactory<ipc::Service>,
     pub(crate) info: ServerInfo,
     /// The admin server port that answered hello, once it has. A server that
@@ -250,7 +252,7 @@ impl Client {
         let admin_service = self
             .node
             .service_builder(&name(admin_service_name(&self.service))?)
-            .request_response::<[Vertex], AdminReply>()
+            .request_response::<[AdminChunk], AdminReply>()
             .request_user_header::<AdminRequest>()
             .open()
             .map_err(|e| self.open_failed(&admin_service_name(&self.service), e.into()))?;
@@ -283,6 +285,7 @@ impl Client {
             .map_err(ipc_err("wake notifier"))?;
         self.conn = Some(Connection {
             scene: None,
+            poses: None,
             query,
             admin,
             wake,
@@ -396,18 +399,18 @@ impl Client {
     pub(crate) fn admin_call(
         &mut self,
         request: &AdminRequest,
-        vertices: &[Vertex],
+        payload: &[AdminChunk],
         deadline: Instant,
     ) -> Result<(AdminReply, u128), ClientError> {
         let conn = self.conn.as_ref().ok_or_else(|| self.gone())?;
         let outcome = (|| {
             let mut loan = conn
                 .admin
-                .loan_slice_uninit(vertices.len())
+                .loan_slice_uninit(payload.len())
                 .map_err(|e| Waited::Failed(ipc_err("admin loan")(e)))?;
             *loan.user_header_mut() = *request;
             let pending = loan
-                .write_from_slice(vertices)
+                .write_from_slice(payload)
                 .send()
                 .map_err(|e| conn.send_failed(&self.node, "admin send", e))?;
             // Admin requests are rare: always wake the server, whatever its
@@ -433,19 +436,19 @@ impl Client {
     pub(crate) fn admin(
         &mut self,
         request: &AdminRequest,
-        vertices: &[Vertex],
+        payload: &[AdminChunk],
     ) -> Result<AdminReply, ClientError> {
-        self.admin_until(request, vertices, Instant::now() + self.timeout)
+        self.admin_until(request, payload, Instant::now() + self.timeout)
     }
 
     pub(crate) fn admin_until(
         &mut self,
         request: &AdminRequest,
-        vertices: &[Vertex],
+        payload: &[AdminChunk],
         deadline: Instant,
     ) -> Result<AdminReply, ClientError> {
         self.ensure_connected(deadline)?;
-        let (reply, _) = self.admin_call(request, vertices, deadline)?;
+        let (reply, _) = self.admin_call(request, payload, deadline)?;
         match reply.error_code() {
             ErrorCode::Ok => Ok(reply),
             code => Err(ClientError::Rejected(code)),

@@ -129,6 +129,7 @@ mod objects;
 mod open_failure;
 mod pairs;
 mod path_split;
+mod poses;
 mod reuse;
 mod robots;
 mod scene;

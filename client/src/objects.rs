@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use gjkd_proto::{AdminOp, AdminReply, AdminRequest, Vertex};
+use gjkd_proto::{AdminChunk, AdminOp, AdminReply, AdminRequest, Vertex};
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::connection::RETRY_PAUSE;
@@ -108,7 +108,7 @@ impl Client {
     ) -> Result<AdminReply, ClientError> {
         let deadline = Instant::now() + self.timeout;
         loop {
-            match self.admin_until(request, vertices, deadline) {
+            match self.admin_until(request, AdminChunk::from_vertices(vertices), deadline) {
                 Err(ClientError::ServerGone(_)) if Instant::now() + RETRY_PAUSE < deadline => {
                     std::thread::sleep(RETRY_PAUSE);
                 }

@@ -65,8 +65,8 @@ fn same_target(a: &Item, b: &Item) -> bool {
     a.kind == b.kind
         && a.a == b.a
         && (a.kind != ItemKind::SetJoints as u32
-            || (a.b == b.b
-                && a.max_iterations == b.max_iterations
+            || (a.joints().first == b.joints().first
+                && a.joints().count == b.joints().count
                 && (a.flags ^ b.flags) & !item_flags::END_STEP == 0))
 }
 

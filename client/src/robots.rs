@@ -28,8 +28,8 @@ use std::path::Path;
 use gjk::Shape;
 pub use gjkd_model::{JointError, Kinematics, LimitMode, Mesh, MeshError, PackagePath, RobotModel};
 use gjkd_proto::{
-    AdminOp, AdminRequest, ErrorCode, Item, ItemResult, JOINTS_PER_ITEM, ObjectId, Pose,
-    lookup_kind, pack_text,
+    AdminChunk, AdminOp, AdminRequest, ErrorCode, Item, ItemResult, JOINTS_PER_ITEM, ObjectId,
+    Pose, lookup_kind,
 };
 use nalgebra::Isometry3;
 
@@ -326,7 +326,7 @@ impl Client {
         request.text_len = u32::try_from(text.len())
             .map_err(|_| ClientError::InvalidArgument("robot text longer than 4 GiB"))?;
         request.pose = Pose::from_isometry(base);
-        let reply = self.admin(&request, &pack_text(&text))?;
+        let reply = self.admin(&request, &AdminChunk::pack_text(&text))?;
         self.handle(ObjectId::from_raw(reply.id), name, kinematics)
     }
 

@@ -793,9 +793,9 @@ mod tests {
         let first = steps.item(1, 0);
         assert_eq!(first.flags & crate::item_flags::END_STEP, 0);
         let second = steps.item(1, 1);
-        let (values, count) = second.joint_positions().expect("a joint item");
-        assert_eq!(count, 2);
-        assert_eq!(second.b, JOINTS_PER_ITEM as u64);
+        let values = second.joint_positions().expect("a joint item");
+        assert_eq!(values.len(), 2);
+        assert_eq!(second.joints().first, JOINTS_PER_ITEM as u32);
         assert_eq!(values[0], positions[joints + JOINTS_PER_ITEM]);
         assert_ne!(second.flags & crate::item_flags::CLAMP, 0);
         // The last item of a step ends it.

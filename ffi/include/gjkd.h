@@ -1137,6 +1137,32 @@ enum gjkd_status gjkd_remove(struct gjkd_client *client, gjkd_id id);
 // `out_id` NULL or writable.
 enum gjkd_status gjkd_lookup(struct gjkd_client *client, const char *name, gjkd_id *out_id);
 
+// Reads the stored poses of `count` objects in one round trip:
+// `poses[i]` is the pose of `ids[i]` as the server holds it, bit for bit
+// (what `gjkd_set_pose()` or the registration stored; for a robot's link
+// object, the pose its robot's last joint update computed), and
+// `errors[i]` a `gjkd_error_code`: `GJKD_CODE_OK`, or
+// `GJKD_CODE_UNKNOWN_OBJECT` for an id the server does not hold (never
+// registered, removed, another server run's; a robot id from
+// `gjkd_robot_info()` is not an object id), whose pose is then the
+// identity. An unknown id fails its entry alone, as a pair of
+// `gjkd_query_pairs()` does: the call still returns `GJKD_OK`. Batches
+// larger than the server takes are split. A count of 0 does nothing (the
+// arrays may then be NULL).
+//
+// Errors: `GJKD_ERR_NULL_POINTER` (`client`, `ids`, `poses`, `errors`,
+// with a count above 0), `GJKD_ERR_BUSY`, `GJKD_ERR_SERVER_GONE`,
+// `GJKD_ERR_TIMEOUT`. On error the outputs are left alone.
+//
+// # Safety
+// `client` is NULL or a live handle; `ids`, `poses` and `errors` NULL or
+// pointing to `count` elements.
+enum gjkd_status gjkd_get_poses(struct gjkd_client *client,
+                                const gjkd_id *ids,
+                                size_t count,
+                                struct gjkd_pose *poses,
+                                uint32_t *errors);
+
 // Stores a new pose for object `id`, used by every later query (of any
 // client) that does not give its own.
 //

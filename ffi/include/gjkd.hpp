@@ -674,6 +674,28 @@ public:
         same_size(ids.size(), poses.size());
         set_poses(ids.data(), poses.data(), ids.size());
     }
+    /// The stored poses of `count` objects into `poses`, bit for bit as
+    /// the server holds them (a robot link's as its joints put it), and
+    /// each entry's code into `errors`: GJKD_CODE_OK, or
+    /// GJKD_CODE_UNKNOWN_OBJECT for an id the server does not hold (its
+    /// pose the identity; the others are answered all the same).
+    void get_poses(const Id *ids, std::size_t count, Pose *poses, std::uint32_t *errors) {
+        check(gjkd_get_poses(handle_, ids, count, poses, errors));
+    }
+    /// The stored poses of `ids`, in order; throws Error (GJKD_ERR_REJECTED,
+    /// GJKD_CODE_UNKNOWN_OBJECT, the row named) if an id is unknown.
+    std::vector<Pose> get_poses(const std::vector<Id> &ids) {
+        std::vector<Pose> poses(ids.size());
+        std::vector<std::uint32_t> errors(ids.size());
+        get_poses(ids.data(), ids.size(), poses.data(), errors.data());
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+            if (errors[i] != GJKD_CODE_OK) {
+                throw Error(GJKD_ERR_REJECTED, errors[i],
+                            "get_poses: ids[" + std::to_string(i) + "] is no object");
+            }
+        }
+        return poses;
+    }
 
     /// The distance between `a` and `b` at their stored poses, or at
     /// `pose_a` / `pose_b` if not null.

@@ -127,7 +127,7 @@ fn pair_item(
     }
     if let Some(p) = pose_b {
         item.flags |= item_flags::POSE_B;
-        item.pose_b = p.wire();
+        item.pair_mut().pose_b = p.wire();
     }
     item
 }

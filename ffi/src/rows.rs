@@ -92,12 +92,16 @@ const _: () = {
     assert!(offset_of!(gjkd_pair_query, a) == offset_of!(Item, a));
     assert!(offset_of!(gjkd_pair_query, b) == offset_of!(Item, b));
     assert!(offset_of!(gjkd_pair_query, pose_a) == offset_of!(Item, pose_a));
-    assert!(offset_of!(gjkd_pair_query, pose_b) == offset_of!(Item, pose_b));
-    assert!(offset_of!(gjkd_pair_query, tolerance) == offset_of!(Item, tolerance));
-    assert!(offset_of!(gjkd_pair_query, margin) == offset_of!(Item, margin));
-    assert!(offset_of!(gjkd_pair_query, max_iterations) == offset_of!(Item, max_iterations));
-    assert!(offset_of!(gjkd_pair_query, reserved) == offset_of!(Item, reserved));
+    assert!(offset_of!(gjkd_pair_query, pose_b) == offset_of!(Item, body.pair.pose_b));
+    assert!(offset_of!(gjkd_pair_query, tolerance) == offset_of!(Item, body.pair.tolerance));
+    assert!(offset_of!(gjkd_pair_query, margin) == offset_of!(Item, body.pair.margin));
+    assert!(
+        offset_of!(gjkd_pair_query, max_iterations) == offset_of!(Item, body.pair.max_iterations)
+    );
+    assert!(offset_of!(gjkd_pair_query, reserved) == offset_of!(Item, body.pair.reserved));
     assert!(size_of::<gjkd_pose>() == size_of::<Pose>());
+    assert!(align_of::<gjkd_pose>() == align_of::<Pose>());
+    assert!(offset_of!(gjkd_pose, translation) == offset_of!(Pose, translation));
     assert!(offset_of!(gjkd_pose, rotation) == offset_of!(Pose, rotation));
 };
 

@@ -172,15 +172,31 @@ fn c_sees_the_wire_layouts_rust_sends() {
     check("gjkd_pair_query", "a", offset_of!(Item, a));
     check("gjkd_pair_query", "b", offset_of!(Item, b));
     check("gjkd_pair_query", "pose_a", offset_of!(Item, pose_a));
-    check("gjkd_pair_query", "pose_b", offset_of!(Item, pose_b));
-    check("gjkd_pair_query", "tolerance", offset_of!(Item, tolerance));
-    check("gjkd_pair_query", "margin", offset_of!(Item, margin));
+    check(
+        "gjkd_pair_query",
+        "pose_b",
+        offset_of!(Item, body.pair.pose_b),
+    );
+    check(
+        "gjkd_pair_query",
+        "tolerance",
+        offset_of!(Item, body.pair.tolerance),
+    );
+    check(
+        "gjkd_pair_query",
+        "margin",
+        offset_of!(Item, body.pair.margin),
+    );
     check(
         "gjkd_pair_query",
         "max_iterations",
-        offset_of!(Item, max_iterations),
+        offset_of!(Item, body.pair.max_iterations),
     );
-    check("gjkd_pair_query", "reserved", offset_of!(Item, reserved));
+    check(
+        "gjkd_pair_query",
+        "reserved",
+        offset_of!(Item, body.pair.reserved),
+    );
     check("gjkd_result", "size", size_of::<ItemResult>());
     check("gjkd_result", "distance", offset_of!(ItemResult, distance));
     check("gjkd_result", "lower", offset_of!(ItemResult, lower));

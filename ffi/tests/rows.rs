@@ -199,7 +199,7 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
         }
         if poses & GJKD_POSE_B != 0 {
             item.flags |= gjkd_proto::item_flags::POSE_B;
-            item.pose_b = pb.wire();
+            item.pair_mut().pose_b = pb.wire();
         }
         items.push(item);
     }
@@ -224,7 +224,7 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
             assert_eq!(row.pose_a.wire(), item.pose_a);
         }
         if row.flags & GJKD_POSE_B != 0 {
-            assert_eq!(row.pose_b.wire(), item.pose_b);
+            assert_eq!(row.pose_b.wire(), item.pair().pose_b);
         }
         assert_eq!(
             (
@@ -233,9 +233,9 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
                 row.max_iterations
             ),
             (
-                item.tolerance.to_bits(),
-                item.margin.to_bits(),
-                item.max_iterations
+                item.pair().tolerance.to_bits(),
+                item.pair().margin.to_bits(),
+                item.pair().max_iterations
             )
         );
     }

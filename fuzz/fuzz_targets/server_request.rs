@@ -8,7 +8,9 @@
 use std::sync::Mutex;
 
 use gjkd_server::engine::{Limits, State};
-use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, Vertex, WaitMode, shape_kind};
+use gjkd_proto::{
+    AdminChunk, AdminOp, AdminRequest, Item, ItemResult, Vertex, WaitMode, shape_kind,
+};
 use libfuzzer_sys::fuzz_target;
 
 /// Reinterprets bytes as `T`s: every wire type is plain old data whose every
@@ -95,7 +97,7 @@ fuzz_target!(|data: &[u8]| {
         if op % 4 == 0 {
             request.op = AdminOp::Register as u32;
         }
-        let reply = state.handle_admin(client, &request, &vertices);
+        let reply = state.handle_admin(client, &request, AdminChunk::from_vertices(&vertices));
         if reply.error == 0 && request.op == AdminOp::Register as u32 {
             assert!(state.object(reply.id).is_some(), "acknowledged but absent");
         }

@@ -22,7 +22,8 @@ pub enum AdminOp {
     /// Attach a robot's kinematics, named [`AdminRequest::name`], to the
     /// objects already registered as its links (named `<robot>/<link>`; a
     /// link with no such object has no shape and only carries its
-    /// children). The slice payload is text packed by [`pack_text`](crate::pack_text): the
+    /// children). The slice payload is text in [`AdminChunk`](crate::AdminChunk)s
+    /// ([`AdminChunk::pack_text`](crate::AdminChunk::pack_text)): the
     /// URDF, optionally followed by a NUL byte and an SRDF whose
     /// `disable_collisions` pairs (with the adjacent links) the server keeps
     /// as the robot's allowed pairs. [`AdminRequest::text_len`] is the
@@ -64,9 +65,10 @@ pub mod lookup_kind {
     pub const ROBOT: u32 = 1;
 }
 
-/// Request header of the admin service. The slice payload holds the
-/// vertices of a registration, or the text of a robot
-/// ([`AdminOp::AttachRobot`]), and is empty for other operations.
+/// Request header of the admin service. The slice payload
+/// ([`AdminChunk`](crate::AdminChunk)s) holds the vertices of a
+/// registration, or the text of a robot ([`AdminOp::AttachRobot`]), and is
+/// empty for other operations.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v2.AdminRequest")]

@@ -4,7 +4,10 @@
 use iceoryx2::prelude::ZeroCopySend;
 use nalgebra::Isometry3;
 
-use crate::{DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, JOINTS_PER_ITEM, ObjectId, Pose};
+use crate::{
+    DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, ItemBody, JOINTS_PER_ITEM, JointsBody, ObjectId,
+    PairBody, Pose,
+};
 
 /// What an [`Item`] asks for; the wire values of [`Item::kind`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -159,12 +162,17 @@ impl QueryOptions {
     }
 }
 
-/// One item of a query request: a pose update or a pair query. A request is a
-/// slice of items, answered by a slice of [`ItemResult`](crate::ItemResult)s of the same length,
-/// in the same order; items are applied in order, so a pose update affects
-/// the queries after it in the same batch.
+/// One item of a query request: a pose update, a pair query or a joint
+/// update. A request is a slice of items, answered by a slice of
+/// [`ItemResult`](crate::ItemResult)s of the same length, in the same
+/// order; items are applied in order, so a pose update affects the queries
+/// after it in the same batch.
 ///
-/// Build items with [`Item::set_pose`] and [`Item::distance`].
+/// The header (`kind`, `flags`, `a`, `b`, `pose_a`) is common to every
+/// kind; the [`body`](Item::body) is a pair query's pose of B and options
+/// ([`Item::pair`]) or a joint update's positions ([`Item::joints`]), two
+/// views of the same bytes. Build items with [`Item::set_pose`],
+/// [`Item::distance`] and [`Item::set_joints`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v2.Item")]
@@ -173,23 +181,18 @@ pub struct Item {
     pub kind: u32,
     /// [`item_flags`] bits.
     pub flags: u32,
-    /// Object A (the object whose pose is set, for [`ItemKind::SetPose`]).
+    /// Object A: the object whose pose is set ([`ItemKind::SetPose`]), the
+    /// first of a pair, the robot ([`ItemKind::SetJoints`]).
     pub a: u64,
-    /// Object B (unused for [`ItemKind::SetPose`]).
+    /// Object B of a pair; zero for the other kinds.
     pub b: u64,
-    /// Pose of A: the new stored pose for [`ItemKind::SetPose`], this query's
-    /// pose of A with [`item_flags::POSE_A`].
+    /// Pose of A: the new stored pose for [`ItemKind::SetPose`]; this
+    /// query's pose of A with [`item_flags::POSE_A`]; the robot's new base
+    /// pose for [`ItemKind::SetJoints`] with [`item_flags::POSE_A`].
     pub pose_a: Pose,
-    /// This query's pose of B with [`item_flags::POSE_B`].
-    pub pose_b: Pose,
-    /// Relative tolerance.
-    pub tolerance: f64,
-    /// Early-exit margin, with [`item_flags::MARGIN`].
-    pub margin: f64,
-    /// Iteration cap.
-    pub max_iterations: u32,
-    /// Zero.
-    pub reserved: u32,
+    /// The kind's own fields: [`PairBody`] for every kind but
+    /// [`ItemKind::SetJoints`], whose body is a [`JointsBody`].
+    pub body: ItemBody,
 }
 
 impl Item {
@@ -201,11 +204,15 @@ impl Item {
             a: id.raw(),
             b: 0,
             pose_a: Pose::from_isometry(pose),
-            pose_b: Pose::IDENTITY,
-            tolerance: DEFAULT_TOLERANCE,
-            margin: 0.0,
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-            reserved: 0,
+            body: ItemBody {
+                pair: PairBody {
+                    pose_b: Pose::IDENTITY,
+                    tolerance: DEFAULT_TOLERANCE,
+                    margin: 0.0,
+                    max_iterations: DEFAULT_MAX_ITERATIONS,
+                    reserved: 0,
+                },
+            },
         }
     }
 
@@ -230,11 +237,15 @@ impl Item {
             a: a.raw(),
             b: b.raw(),
             pose_a: Pose::IDENTITY,
-            pose_b: Pose::IDENTITY,
-            tolerance: options.tolerance,
-            margin: options.margin.unwrap_or(0.0),
-            max_iterations: options.max_iterations,
-            reserved: 0,
+            body: ItemBody {
+                pair: PairBody {
+                    pose_b: Pose::IDENTITY,
+                    tolerance: options.tolerance,
+                    margin: options.margin.unwrap_or(0.0),
+                    max_iterations: options.max_iterations,
+                    reserved: 0,
+                },
+            },
         }
     }
 
@@ -262,7 +273,7 @@ impl Item {
     /// This query with its own pose for B.
     pub fn with_pose_b(mut self, pose: &Isometry3<f64>) -> Self {
         self.flags |= item_flags::POSE_B;
-        self.pose_b = Pose::from_isometry(pose);
+        self.pair_mut().pose_b = Pose::from_isometry(pose);
         self
     }
 
@@ -273,13 +284,10 @@ impl Item {
     /// With `clamp`, positions outside their limits are clamped, otherwise
     /// the item fails with [`ErrorCode::OutOfLimits`](crate::ErrorCode::OutOfLimits) and changes nothing.
     ///
-    /// Layout: `a` is the robot, `b` the index of the first joint,
-    /// `max_iterations` the number of positions (0 to [`JOINTS_PER_ITEM`]:
-    /// none moves only the base, as a robot without moving joints needs),
-    /// carried in `pose_b.translation`, `pose_b.rotation`, `tolerance` and
-    /// `margin`, in that order; flag [`item_flags::POSE_A`] sends a base pose
-    /// in `pose_a`. A robot with more joints takes several items in one
-    /// request (each computes the poses; only the last one's matter).
+    /// Layout: `a` is the robot, `b` zero, the body a [`JointsBody`];
+    /// flag [`item_flags::POSE_A`] sends a base pose in `pose_a`. A robot
+    /// with more joints takes several items in one request (each computes
+    /// the poses; only the last one's matter).
     ///
     /// # Panics
     /// If `positions` is longer than [`JOINTS_PER_ITEM`].
@@ -296,21 +304,19 @@ impl Item {
         );
         let mut values = [0.0; JOINTS_PER_ITEM];
         values[..positions.len()].copy_from_slice(positions);
-        let [t0, t1, t2, r0, r1, r2, r3, tolerance, margin] = values;
         let mut item = Item {
             kind: ItemKind::SetJoints as u32,
             flags: if clamp { item_flags::CLAMP } else { 0 },
             a: robot.raw(),
-            b: u64::from(first),
+            b: 0,
             pose_a: Pose::IDENTITY,
-            pose_b: Pose {
-                translation: [t0, t1, t2],
-                rotation: [r0, r1, r2, r3],
+            body: ItemBody {
+                joints: JointsBody {
+                    positions: values,
+                    count: positions.len() as u32,
+                    first,
+                },
             },
-            tolerance,
-            margin,
-            max_iterations: positions.len() as u32,
-            reserved: 0,
         };
         if let Some(base) = base {
             item.flags |= item_flags::POSE_A;
@@ -319,20 +325,36 @@ impl Item {
         item
     }
 
-    /// The joint positions of a [`ItemKind::SetJoints`] item (all
-    /// [`JOINTS_PER_ITEM`] slots) and how many are in use, `None` if the
-    /// count is out of range.
-    pub fn joint_positions(&self) -> Option<([f64; JOINTS_PER_ITEM], usize)> {
-        let count = self.max_iterations as usize;
-        if count > JOINTS_PER_ITEM {
-            return None;
-        }
-        let [t0, t1, t2] = self.pose_b.translation;
-        let [r0, r1, r2, r3] = self.pose_b.rotation;
-        Some((
-            [t0, t1, t2, r0, r1, r2, r3, self.tolerance, self.margin],
-            count,
-        ))
+    /// The joint positions in use of a [`ItemKind::SetJoints`] item, `None`
+    /// if its count is out of range.
+    pub fn joint_positions(&self) -> Option<&[f64]> {
+        let joints = self.joints();
+        joints.positions.get(..joints.count as usize)
+    }
+
+    /// The body's pair view: a pair query's pose of B and options (see
+    /// [`ItemBody`] for why reading it from any item is sound).
+    #[inline(always)]
+    pub fn pair(&self) -> &PairBody {
+        self.body.pair()
+    }
+
+    /// The body's pair view, to change.
+    #[inline(always)]
+    pub fn pair_mut(&mut self) -> &mut PairBody {
+        self.body.pair_mut()
+    }
+
+    /// The body's joints view: a joint update's positions.
+    #[inline(always)]
+    pub fn joints(&self) -> &JointsBody {
+        self.body.joints()
+    }
+
+    /// The body's joints view, to change.
+    #[inline(always)]
+    pub fn joints_mut(&mut self) -> &mut JointsBody {
+        self.body.joints_mut()
     }
 
     /// A scene request's group member (see [`ItemKind::Member`]).
@@ -387,10 +409,11 @@ impl Item {
 
     /// The options encoded in this item.
     pub fn options(&self) -> QueryOptions {
+        let pair = self.pair();
         QueryOptions {
-            tolerance: self.tolerance,
-            max_iterations: self.max_iterations,
-            margin: (self.flags & item_flags::MARGIN != 0).then_some(self.margin),
+            tolerance: pair.tolerance,
+            max_iterations: pair.max_iterations,
+            margin: (self.flags & item_flags::MARGIN != 0).then_some(pair.margin),
             warm_start: self.flags & item_flags::WARM_START != 0,
             precision: if self.flags & item_flags::SINGLE_PRECISION != 0 {
                 Precision::Single

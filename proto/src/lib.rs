@@ -6,14 +6,15 @@
 //! module path, so the same struct seen from another crate would not match),
 //! and every service name carries the protocol version.
 //!
-//! Three services make up one gjkd deployment named `service` (default
+//! Five services make up one gjkd deployment named `service` (default
 //! [`DEFAULT_SERVICE`]):
 //!
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
 //! | [`query_service_name`] `{service}/v2/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
-//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`Vertex`]`]` | [`AdminReply`] |
+//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
 //! | [`scene_service_name`] `{service}/v2/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
+//! | [`poses_service_name`] `{service}/v2/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
 //! | [`wake_service_name`] `{service}/v2/wake` | event | | |
 //!
 //! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
@@ -44,33 +45,37 @@
 use std::fmt;
 
 mod admin;
+mod admin_payload;
 mod error;
 mod geometry;
 mod gradient;
 mod item;
+mod item_body;
 mod pose;
+mod poses;
 mod result;
 mod scene;
 mod shape;
-mod text;
 
 pub use admin::{
     AdminOp, AdminReply, AdminRequest, ServerInfo, ServerStats, WaitMode, lookup_kind,
 };
+pub use admin_payload::{AdminChunk, TEXT_CHUNK_LEN};
 pub use error::ErrorCode;
 pub use geometry::{
     Geometry, Piece, ShapeError, cuboid_corners, cylinder, decode_piece, decode_shape, hull,
 };
 pub use gradient::{GRADIENT_COLUMNS, Gradient, gradient_flags};
 pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
+pub use item_body::{ItemBody, JointsBody, PairBody};
 pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
+pub use poses::{PosesReply, StoredPose};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
     DEFAULT_BRACKET, PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags,
     scene_reply_flags,
 };
 pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
-pub use text::{pack_text, unpack_text};
 
 /// Protocol version, part of every service name: a client and a server of
 /// different versions never see each other's services, instead of misreading
@@ -114,6 +119,12 @@ pub fn admin_service_name(service: &str) -> String {
 /// within a margin, nearest objects, paths).
 pub fn scene_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/scene")
+}
+
+/// Name of the pose service (stored poses read back, a batch of ids at a
+/// time).
+pub fn poses_service_name(service: &str) -> String {
+    format!("{service}/v{PROTOCOL_VERSION}/poses")
 }
 
 /// Name of the event service a client notifies after sending, so that a

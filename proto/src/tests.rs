@@ -2,6 +2,7 @@
 
 use crate::*;
 use nalgebra::{Isometry3, Vector3};
+use std::mem::offset_of;
 
 #[test]
 fn names_carry_the_version() {
@@ -81,38 +82,83 @@ fn joint_items_carry_their_positions() {
     let base = Isometry3::translation(1.0, 2.0, 3.0);
     let it = Item::set_joints(robot, 2, &q, Some(&base), true);
     assert_eq!(it.item_kind(), Some(ItemKind::SetJoints));
-    assert_eq!(it.joint_positions(), Some((q, 9)));
-    assert_eq!((it.a, it.b), (9, 2));
+    assert_eq!(it.joint_positions(), Some(&q[..]));
+    assert_eq!(
+        *it.joints(),
+        JointsBody {
+            positions: q,
+            count: 9,
+            first: 2
+        }
+    );
+    assert_eq!((it.a, it.b), (9, 0));
     assert_eq!(it.flags, item_flags::POSE_A | item_flags::CLAMP);
     assert_eq!(it.pose_a, Pose::from_isometry(&base));
     let short = Item::set_joints(robot, 0, &[1.5], None, false);
-    assert_eq!(
-        short.joint_positions().map(|(v, n)| (v[0], n)),
-        Some((1.5, 1))
-    );
+    assert_eq!(short.joint_positions(), Some(&[1.5][..]));
     assert_eq!(short.flags, 0);
     let mut bad = short;
-    bad.max_iterations = 10;
+    bad.joints_mut().count = 10;
     assert_eq!(bad.joint_positions(), None);
     // No position at all: the base of a robot without moving joints.
     let base_only = Item::set_joints(robot, 0, &[], Some(&base), false);
-    assert_eq!(base_only.joint_positions(), Some(([0.0; 9], 0)));
+    assert_eq!(base_only.joint_positions(), Some(&[][..]));
     assert_eq!(base_only.flags, item_flags::POSE_A);
 }
 
+/// The joints view and the pair view share the body's bytes: the layout a
+/// C or Python writer of raw items relies on.
 #[test]
-fn text_round_trips_through_vertices() {
+fn the_two_body_views_share_their_bytes() {
+    let it = Item::set_joints(ObjectId::from_raw(1), 3, &[1.0, 2.0], None, false);
+    let pair = it.pair();
+    assert_eq!(pair.pose_b.translation, [1.0, 2.0, 0.0]);
+    // count 2 and first 3 are the pair view's last two words.
+    assert_eq!((pair.max_iterations, pair.reserved), (2, 3));
+    assert_eq!(offset_of!(Item, body), 80);
+    assert_eq!(
+        offset_of!(JointsBody, count),
+        offset_of!(PairBody, max_iterations)
+    );
+    assert_eq!(
+        offset_of!(JointsBody, first),
+        offset_of!(PairBody, reserved)
+    );
+}
+
+#[test]
+fn text_round_trips_through_chunks() {
     for text in ["", "a", &"<robot name=\"é\"/>".repeat(5), &"x".repeat(48)] {
-        let packed = pack_text(text);
-        assert_eq!(packed.len(), text.len().div_ceil(24));
-        assert_eq!(
-            unpack_text(&packed, text.len() as u64).as_deref(),
-            Some(text)
-        );
+        let packed = AdminChunk::pack_text(text);
+        assert_eq!(packed.len(), text.len().div_ceil(TEXT_CHUNK_LEN));
+        assert_eq!(AdminChunk::text_of(&packed, text.len() as u64), Some(text));
     }
-    let packed = pack_text("hello");
-    assert_eq!(unpack_text(&packed, 4), None, "non-zero padding");
-    assert_eq!(unpack_text(&packed, 30), None, "too few vertices");
+    let packed = AdminChunk::pack_text("hello");
+    assert_eq!(AdminChunk::text_of(&packed, 4), None, "non-zero padding");
+    assert_eq!(AdminChunk::text_of(&packed, 30), None, "too few chunks");
+    assert_eq!(AdminChunk::bytes(&packed)[..6], *b"hello\0");
+    let bad_utf8 = AdminChunk::pack_text("é");
+    assert_eq!(AdminChunk::text_of(&bad_utf8, 1), None, "cut inside a char");
+}
+
+#[test]
+fn vertices_cast_to_chunks_and_back() {
+    let v = [
+        Vertex {
+            x: 1.0,
+            y: -2.0,
+            z: 3.5,
+        },
+        Vertex {
+            x: f64::MAX,
+            y: 0.0,
+            z: -0.0,
+        },
+    ];
+    let chunks = AdminChunk::from_vertices(&v);
+    assert_eq!(chunks.len(), 2);
+    assert_eq!(AdminChunk::vertices(chunks), &v);
+    assert_eq!(AdminChunk::bytes(chunks)[..8], 1.0f64.to_le_bytes());
 }
 
 #[test]
@@ -124,6 +170,8 @@ fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<crate::Gradient>(), 144);
     assert_eq!(std::mem::size_of::<ItemResult>(), 296);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
+    assert_eq!(std::mem::size_of::<AdminChunk>(), 24);
+    assert_eq!(std::mem::size_of::<ItemBody>(), 80);
 }
 
 /// A stored pose is held to 2^998 per translation axis, so that any two

@@ -427,6 +427,11 @@ class _Objects:
         """Stores the pose of object ``id``."""
     def set_poses(self, ids: _ArrayLike, poses: _ArrayLike) -> None:
         """Stores ``(N, 7)`` or ``(N, 4, 4)`` poses of ``(N,)`` ids."""
+    def poses(self, ids: _ArrayLike) -> _F64:
+        """The stored poses of ``(N,)`` ids as an ``(N, 7)`` array
+        ``[x, y, z, qx, qy, qz, qw]``, bit for bit as stored (a robot
+        link's where its joints put it); one round trip. An unknown id
+        raises ``NotFound`` (``UNKNOWN_OBJECT``, ``index`` its row)."""
     def distance(
         self,
         a: int,

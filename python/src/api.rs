@@ -65,6 +65,44 @@ pub fn set_poses(
     store_poses(backend, py, id_arr.slice()?, pose_arr.poses()?, "poses")
 }
 
+/// The stored poses of `ids` as an `(N, 7)` array
+/// `[x, y, z, qx, qy, qz, qw]`, bit for bit as the store holds them; an
+/// unknown id raises `NotFound` (`UNKNOWN_OBJECT`, with its row), as
+/// `set_poses` does.
+pub fn poses<'py>(
+    backend: &mut dyn Backend,
+    py: Python<'py>,
+    ids: &Bound<'_, PyAny>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let id_arr = id_array(ids, "ids")?;
+    if id_arr.shape().len() != 1 {
+        return Err(invalid(
+            py,
+            "ids",
+            None,
+            format!("ids must have shape (N,), got {:?}", id_arr.shape()),
+        ));
+    }
+    let slice = id_arr.slice()?;
+    let ids: Vec<u64> = (0..slice.len()).map(|i| slice.get(i)).collect();
+    let got = if ids.is_empty() {
+        Vec::new()
+    } else {
+        backend.stored_poses(py, &ids)?
+    };
+    let mut rows = Vec::with_capacity(got.len());
+    for (i, entry) in got.iter().enumerate() {
+        let p = entry.map_err(|code| errors::refused(py, code, Some("ids"), Some(i)))?;
+        let [x, y, z] = p.translation;
+        let [qx, qy, qz, qw] = p.rotation;
+        rows.push(vec![x, y, z, qx, qy, qz, qw]);
+    }
+    if rows.is_empty() {
+        return Ok(numpy::PyArray2::zeros(py, [0, 7], false));
+    }
+    numpy::PyArray2::from_vec2(py, &rows).map_err(|e| invalid(py, "ids", None, e.to_string()))
+}
+
 /// Stores one pose.
 pub fn set_pose(
     backend: &mut dyn Backend,
@@ -440,6 +478,22 @@ macro_rules! backend_methods {
                 poses: &Bound<'_, PyAny>,
             ) -> PyResult<()> {
                 crate::api::set_poses(self, py, ids, poses)
+            }
+
+            /// The stored poses of `ids` (`(N,)` integers) as an `(N, 7)`
+            /// float64 array `[x, y, z, qx, qy, qz, qw]`, bit for bit as
+            /// stored: what `set_pose`/`set_poses` or the registration
+            /// stored, and for a robot's link the pose its joints put it
+            /// at. One round trip for any `N` (split when larger than a
+            /// request takes). An unknown id raises `NotFound`
+            /// (`UNKNOWN_OBJECT`, with `index` its row), as `set_poses`
+            /// does; no id gives a `(0, 7)` array.
+            fn poses<'py>(
+                &mut self,
+                py: Python<'py>,
+                ids: &Bound<'_, PyAny>,
+            ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+                crate::api::poses(self, py, ids)
             }
 
             /// The distance between objects `a` and `b`, at their stored

@@ -29,6 +29,13 @@ pub trait Backend {
     fn remove(&mut self, py: Python<'_>, id: u64) -> PyResult<()>;
     /// The id of the object named `name`.
     fn lookup(&mut self, py: Python<'_>, name: &str) -> PyResult<u64>;
+    /// The stored pose of each of `ids`, or its error code
+    /// (`UnknownObject`), in order.
+    fn stored_poses(
+        &mut self,
+        py: Python<'_>,
+        ids: &[u64],
+    ) -> PyResult<Vec<Result<Pose, gjkd_proto::ErrorCode>>>;
 }
 
 /// A pose argument, checked as the server will check it, so that a bad one

@@ -165,7 +165,7 @@ pub fn set_pose_a(item: &mut Item, pose: Pose) {
 /// `item` with its own pose for B, the wire pose as given.
 pub fn set_pose_b(item: &mut Item, pose: Pose) {
     item.flags |= gjkd_proto::item_flags::POSE_B;
-    item.pose_b = pose;
+    item.pair_mut().pose_b = pose;
 }
 
 /// The answers of a batch of `N` pair queries, one numpy array per field;

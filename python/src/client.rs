@@ -199,6 +199,24 @@ impl Backend for Client {
             .map(|id| id.raw())
             .map_err(|e| errors::client(py, e, Some("name")))
     }
+
+    fn stored_poses(
+        &mut self,
+        py: Python<'_>,
+        ids: &[u64],
+    ) -> PyResult<Vec<Result<Pose, gjkd_client::ErrorCode>>> {
+        let ids: Vec<gjkd_client::ObjectId> = ids
+            .iter()
+            .map(|&id| gjkd_client::ObjectId::from_raw(id))
+            .collect();
+        let got = self
+            .call(py, |c| c.poses(&ids))?
+            .map_err(|e| errors::client(py, e, Some("ids")))?;
+        Ok(got
+            .iter()
+            .map(|r| r.as_ref().map(Pose::from_isometry).map_err(|c| *c))
+            .collect())
+    }
 }
 
 backend_methods!(Client, {

@@ -97,6 +97,16 @@ impl Backend for Local {
         }
         self.admin(py, &request, &[], Some("name"))
     }
+
+    fn stored_poses(
+        &mut self,
+        _py: Python<'_>,
+        ids: &[u64],
+    ) -> PyResult<Vec<Result<Pose, gjkd_proto::ErrorCode>>> {
+        let mut out = vec![gjkd_proto::StoredPose::default(); ids.len()];
+        self.store.store.poses(ids, &mut out);
+        Ok(out.iter().map(gjkd_proto::StoredPose::pose).collect())
+    }
 }
 
 backend_methods!(Local, {

@@ -3,7 +3,7 @@
 //! code a server runs, so the answers are the same bit for bit), and the
 //! serving command (`python -m gjkd serve`).
 
-use gjkd_proto::{AdminRequest, ErrorCode, Item, ItemResult, Pose, Vertex, WaitMode};
+use gjkd_proto::{AdminChunk, AdminRequest, ErrorCode, Item, ItemResult, Pose, Vertex, WaitMode};
 use nalgebra::Isometry3;
 
 /// The server's check of a wire pose (finite, unit quaternion within its
@@ -42,11 +42,18 @@ impl Store {
 
     /// Answers a registration, removal or look-up: the id, or the error.
     pub fn admin(&mut self, request: &AdminRequest, vertices: &[Vertex]) -> Result<u64, ErrorCode> {
-        let reply = self.state.handle_admin(LOCAL_CLIENT, request, vertices);
+        let reply =
+            self.state
+                .handle_admin(LOCAL_CLIENT, request, AdminChunk::from_vertices(vertices));
         match reply.error_code() {
             ErrorCode::Ok => Ok(reply.id),
             code => Err(code),
         }
+    }
+
+    /// The stored pose of each of `ids` (see `State::poses`).
+    pub fn poses(&self, ids: &[u64], out: &mut [gjkd_proto::StoredPose]) {
+        self.state.poses(ids, out);
     }
 
     /// Answers query items as a server answers one request.

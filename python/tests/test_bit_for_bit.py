@@ -165,3 +165,29 @@ def quat_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
         ],
         axis=1,
     )
+
+
+def test_poses_come_back_bit_for_bit_from_client_and_local(client: gjkd.Client) -> None:
+    """`poses` reads back exactly what `set_poses` stored, the same bits
+    from a server and from `Local`; an unknown id raises with its row."""
+    rng = np.random.default_rng(5)
+    rows = np.zeros((6, 7))
+    rows[:, :3] = rng.uniform(-3, 3, (6, 3))
+    q = rng.normal(size=(6, 4))
+    rows[:, 3:] = q / np.linalg.norm(q, axis=1)[:, None]
+    answers = []
+    with gjkd.Local() as local:
+        for objects in (client, local):
+            ids = np.array([objects.register_sphere(0.1) for _ in range(6)], dtype=np.uint64)
+            objects.set_poses(ids, rows)
+            got = objects.poses(ids)
+            assert got.shape == (6, 7) and got.dtype == np.float64
+            assert np.array_equal(got.view(np.uint64), rows.view(np.uint64))
+            assert objects.poses(np.array([], dtype=np.uint64)).shape == (0, 7)
+            gone = int(ids[2])
+            objects.remove(gone)
+            with pytest.raises(gjkd.NotFound) as e:
+                objects.poses([int(ids[0]), gone])
+            assert e.value.code == gjkd.ErrorCode.UNKNOWN_OBJECT and e.value.index == 1
+            answers.append(got)
+    assert np.array_equal(answers[0].view(np.uint64), answers[1].view(np.uint64))

@@ -364,3 +364,22 @@ def test_robot_unknown_service_name_is_independent() -> None:
         c.close()
         with pytest.raises(gjkd.Error):
             c.register_robot("x", urdf_text=ARM_URDF)
+
+
+def test_poses_read_links_back_where_the_joints_put_them(
+    client: gjkd.Client, arm: gjkd.Robot
+) -> None:
+    """`poses` of the links after `set_joints` against the hand kinematics."""
+    q = np.array([0.4, -0.7, 0.05])
+    base = [0.3, -0.2, 0.1, 0.0, 0.0, math.sin(0.35), math.cos(0.35)]
+    client.set_joints(arm, q, base=base)
+    names = [n for n, i in zip(arm.link_names, arm.link_ids) if i != 0]
+    got = client.poses([arm.link(n) for n in names])
+    assert got.shape == (len(names), 7) and got.dtype == np.float64
+    expected = hand_fk(q, trans(0.3, -0.2, 0.1) @ rot_z(0.7))
+    for row, name in zip(got, names):
+        assert np.max(np.abs(matrix(row) - expected[name])) < 1e-12, name
+    # The same rows as the client computes from the same joints.
+    local_rows = arm.link_poses(q, base)
+    for row, name in zip(got, names):
+        assert np.max(np.abs(row - local_rows[arm.link_names.index(name)])) < 1e-12, name

@@ -34,8 +34,8 @@
 //! reg.piece_count = 1;
 //! reg.pieces[0].vertex_count = 1;
 //! reg.pieces[0].rounding = 0.5;
-//! let ball = state.handle_admin(1, &reg, &[Vertex::default()]).id;
-//! let other = state.handle_admin(1, &reg, &[Vertex { x: 3.0, y: 0.0, z: 0.0 }]).id;
+//! let ball = state.handle_admin(1, &reg, &[Vertex::default().into()]).id;
+//! let other = state.handle_admin(1, &reg, &[Vertex { x: 3.0, y: 0.0, z: 0.0 }.into()]).id;
 //!
 //! let items = [Item::distance(ObjectId::from_raw(ball), ObjectId::from_raw(other), &QueryOptions::default())];
 //! let mut results = [ItemResult::default()];

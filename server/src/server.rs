@@ -9,9 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use gjkd_proto::{
-    AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader, SceneReply,
-    SceneRequest, SceneRow, Vertex, WaitMode, admin_service_name, query_service_name,
-    scene_service_name, wake_service_name,
+    AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, PosesReply,
+    ReplyHeader, SceneReply, SceneRequest, SceneRow, StoredPose, WaitMode, admin_service_name,
+    poses_service_name, query_service_name, scene_service_name, wake_service_name,
 };
 use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::listener::Listener;
@@ -23,7 +23,15 @@ use crate::engine::{Limits, State};
 use crate::wait::{Idle, WaitPolicy};
 
 type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
-type AdminServer = IoxServer<ipc::Service, [Vertex], AdminRequest, AdminReply, ()>;
+type AdminServer = IoxServer<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>;
+type PosesServer = IoxServer<ipc::Service, [u64], (), [StoredPose], PosesReply>;
+type PosesService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [u64],
+    (),
+    [StoredPose],
+    PosesReply,
+>;
 type SceneServer = IoxServer<ipc::Service, [Item], SceneRequest, [SceneRow], SceneReply>;
 type SceneService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
@@ -41,7 +49,7 @@ type QueryService = iceoryx2::service::port_factory::request_response::PortFacto
 >;
 type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
-    [Vertex],
+    [AdminChunk],
     AdminRequest,
     AdminReply,
     (),
@@ -132,11 +140,13 @@ pub struct ServeOptions {
 struct Endpoints {
     query: QueryServer,
     scene: SceneServer,
+    poses: PosesServer,
     admin: AdminServer,
     listener: Listener<ipc::Service>,
     _wake_service: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     admin_service: AdminService,
     scene_service: SceneService,
+    poses_service: PosesService,
     query_service: QueryService,
     node: Node<ipc::Service>,
 }
@@ -151,6 +161,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     let admin_name = name(admin_service_name(&options.service))?;
     let scene_name = name(scene_service_name(&options.service))?;
     let wake_name = name(wake_service_name(&options.service))?;
+    let poses_name = name(poses_service_name(&options.service))?;
 
     let node = NodeBuilder::new()
         .name(&NodeName::new("gjkd").map_err(ipc("node name"))?)
@@ -185,7 +196,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .map_err(ipc("query service"))?;
     let admin_service = node
         .service_builder(&admin_name)
-        .request_response::<[Vertex], AdminReply>()
+        .request_response::<[AdminChunk], AdminReply>()
         .request_user_header::<AdminRequest>()
         .max_clients(clients)
         .max_servers(1)
@@ -210,6 +221,19 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .enable_fire_and_forget_requests(false)
         .open_or_create()
         .map_err(ipc("scene service"))?;
+    let poses_service = node
+        .service_builder(&poses_name)
+        .request_response::<[u64], [StoredPose]>()
+        .response_user_header::<PosesReply>()
+        .max_clients(clients)
+        .max_servers(1)
+        .max_nodes(limits.max_nodes)
+        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(2)
+        .max_borrowed_responses_per_pending_response(1)
+        .enable_fire_and_forget_requests(false)
+        .open_or_create()
+        .map_err(ipc("poses service"))?;
     let wake_service = node
         .service_builder(&wake_name)
         .event()
@@ -235,6 +259,14 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         .override_response_preallocation(move |_| response_chunks(clients))
         .create()
         .map_err(server_port_error(&options.service, "scene server"))?;
+    // Sized as the query server, for `max_batch` poses a reply.
+    let poses: PosesServer = poses_service
+        .server_builder()
+        .initial_max_slice_len(limits.max_batch)
+        .allocation_strategy(AllocationStrategy::Static)
+        .override_response_preallocation(move |_| response_chunks(clients))
+        .create()
+        .map_err(server_port_error(&options.service, "poses server"))?;
     // The query server port comes last: clients take it as the sign that
     // the server is ready, and a request sent to a service before its server
     // port exists is never answered.
@@ -255,11 +287,13 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     Ok(Endpoints {
         query,
         scene,
+        poses,
         admin,
         listener,
         _wake_service: wake_service,
         admin_service,
         scene_service,
+        poses_service,
         query_service,
         node,
     })
@@ -343,6 +377,10 @@ fn serve_until(
         // scene question should not pay on every turn.
         if endpoints.scene_service.dynamic_config().number_of_clients() > 0 {
             served += serve_scenes(&endpoints.scene, state, &mut scene_rows);
+        }
+        // Likewise: poses are read back rarely, and only by some clients.
+        if endpoints.poses_service.dynamic_config().number_of_clients() > 0 {
+            served += serve_poses(&endpoints.poses, state);
         }
         // Counted over all turns, busy or not, so that a stream of queries
         // cannot starve registrations.
@@ -484,6 +522,7 @@ fn block(waitset: &WaitSet<ipc::Service>, endpoints: &Endpoints) {
     let _ = listener.try_wait(|_| {});
     let pending = endpoints.query.has_requests().unwrap_or(false)
         || endpoints.scene.has_requests().unwrap_or(false)
+        || endpoints.poses.has_requests().unwrap_or(false)
         || endpoints.admin.has_requests().unwrap_or(false);
     if pending {
         return;
@@ -667,6 +706,54 @@ fn serve_scenes(scene: &SceneServer, state: &mut State, scratch: &mut Vec<SceneR
                 }
                 Err(e) => warn!(error = ?e, written, "cannot loan scene reply"),
             }
+        },
+    )
+}
+
+/// Answers every pose request waiting; returns how many.
+fn serve_poses(poses: &PosesServer, state: &mut State) -> usize {
+    serve_waiting(
+        "poses",
+        || poses.receive(),
+        |request| {
+            let ids = request.payload();
+            if let Err(code) = state.check_batch(ids.len()) {
+                debug!(len = ids.len(), ?code, "pose request refused");
+                let header = PosesReply {
+                    error: code as u32,
+                    count: 0,
+                };
+                refuse("poses", &request, header);
+                return;
+            }
+            let reply = match request.loan_slice_uninit(ids.len()) {
+                Ok(r) => r,
+                Err(e) => {
+                    warn!(error = ?e, len = ids.len(), "cannot loan pose reply");
+                    return;
+                }
+            };
+            let mut reply = reply.write_from_fn(|_| StoredPose::default());
+            *reply.user_header_mut() = PosesReply {
+                error: ErrorCode::Ok as u32,
+                count: ids.len() as u32,
+            };
+            let out = reply.payload_mut();
+            let answered = guarded(
+                "poses",
+                || {
+                    state.poses(ids, out);
+                    true
+                },
+                || false,
+            );
+            if !answered {
+                *reply.user_header_mut() = PosesReply {
+                    error: ErrorCode::Internal as u32,
+                    count: 0,
+                };
+            }
+            delivered("poses", reply.send());
         },
     )
 }

@@ -687,8 +687,8 @@ mod tests {
     use crate::engine::state::test_support::*;
     use crate::engine::state::{Limits, State};
     use gjkd_proto::{
-        AdminOp, AdminRequest, ErrorCode, Item, ObjectId, QueryOptions, Vertex, WaitMode,
-        shape_kind,
+        AdminChunk, AdminOp, AdminRequest, ErrorCode, Item, ObjectId, QueryOptions, Vertex,
+        WaitMode, shape_kind,
     };
     use nalgebra::{Isometry3, Vector3};
 
@@ -707,11 +707,16 @@ mod tests {
         req.pieces[0].vertex_count = 1;
         let v = [Vertex::default()];
         assert_eq!(
-            s.handle_admin(1, &req, &v).error_code(),
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::TooManyObjects
         );
         s.remove(a, 1).expect("owner");
-        assert_eq!(s.handle_admin(1, &req, &v).error_code(), ErrorCode::Ok);
+        assert_eq!(
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
+            ErrorCode::Ok
+        );
     }
 
     #[test]

@@ -205,10 +205,15 @@ impl Robots {
     /// robot's joints, [`ErrorCode::NonFinitePose`] for a NaN position or base,
     /// [`ErrorCode::BadQuaternion`], [`ErrorCode::OutOfLimits`].
     pub fn set_joints(&mut self, store: &mut ObjectStore, item: &Item) -> Result<(), ErrorCode> {
-        let (values, count) = item.joint_positions().ok_or(ErrorCode::Malformed)?;
+        let values = item.joint_positions().ok_or(ErrorCode::Malformed)?;
+        // `b` is no field of a joint update: refused, not ignored.
+        if item.b != 0 {
+            return Err(ErrorCode::Malformed);
+        }
         let robots = &mut *self;
         let robot = robots.by_id.get(&item.a).ok_or(ErrorCode::UnknownObject)?;
-        let first = usize::try_from(item.b).map_err(|_| ErrorCode::Malformed)?;
+        let count = values.len();
+        let first = item.joints().first as usize;
         let end = first.checked_add(count).ok_or(ErrorCode::Malformed)?;
         if end > robot.positions.len() {
             return Err(ErrorCode::Malformed);
@@ -226,7 +231,7 @@ impl Robots {
         let mut positions = std::mem::take(&mut robots.positions);
         positions.clear();
         positions.extend_from_slice(&robot.positions);
-        positions[first..end].copy_from_slice(&values[..count]);
+        positions[first..end].copy_from_slice(values);
         let mut poses = std::mem::take(&mut robots.poses);
         let computed = robot
             .kinematics
@@ -282,7 +287,7 @@ mod tests {
     use gjk::{Convex, Shape};
     use gjkd_proto::AdminRequest;
     use gjkd_proto::{
-        AdminOp, ItemResult, ObjectId, QueryOptions, WaitMode, pack_text, result_flags,
+        AdminChunk, AdminOp, ItemResult, ObjectId, QueryOptions, WaitMode, result_flags,
     };
     use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
@@ -340,7 +345,7 @@ mod tests {
         let mut req = AdminRequest::new(AdminOp::AttachRobot);
         req.set_name("two");
         req.text_len = text.len() as u32;
-        let reply = s.handle_admin(who, &req, &pack_text(text));
+        let reply = s.handle_admin(who, &req, &AdminChunk::pack_text(text));
         match reply.error_code() {
             ErrorCode::Ok => Ok(reply.id),
             e => Err(e),
@@ -475,8 +480,12 @@ mod tests {
         bad_base.pose_a.rotation = [0.0, 0.0, 0.0, 2.0];
         check(&mut s, bad_base, ErrorCode::BadQuaternion);
         let mut over = Item::set_joints(robot, 0, &[0.1], None, false);
-        over.max_iterations = 10;
+        over.joints_mut().count = 10;
         check(&mut s, over, ErrorCode::Malformed);
+        // `b` is no field of a joint update: a non-zero one is refused.
+        let mut with_b = Item::set_joints(robot, 0, &[0.1], None, false);
+        with_b.b = 1;
+        check(&mut s, with_b, ErrorCode::Malformed);
         // No position: the base alone moves (here to where it is), the
         // joints stay.
         let before = s.robots.get(robot.raw()).unwrap().positions.clone();
@@ -522,7 +531,8 @@ mod tests {
         req.set_name("two");
         req.text_len = 5;
         assert_eq!(
-            s.handle_admin(CLIENT, &req, &pack_text(URDF)).error_code(),
+            s.handle_admin(CLIENT, &req, &AdminChunk::pack_text(URDF))
+                .error_code(),
             ErrorCode::Malformed
         );
         // A valid robot with an SRDF keeps its allowed pairs; another client

@@ -342,7 +342,7 @@ pub(crate) mod test_support {
     use crate::persist::attach;
     use crate::persist::database::Database;
     use gjk::Convex;
-    use gjkd_proto::{AdminOp, AdminRequest, Item, ItemResult, Vertex, shape_kind};
+    use gjkd_proto::{AdminChunk, AdminOp, AdminRequest, Item, ItemResult, Vertex, shape_kind};
     use nalgebra::{Isometry3, Vector3};
 
     pub(crate) fn state() -> State {
@@ -360,7 +360,7 @@ pub(crate) mod test_support {
             .iter()
             .map(|&p| p.into())
             .collect();
-        let reply = s.handle_admin(owner, &req, &verts);
+        let reply = s.handle_admin(owner, &req, AdminChunk::from_vertices(&verts));
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         reply.id
     }
@@ -391,7 +391,7 @@ pub(crate) mod test_support {
         req.pieces[0].vertex_count = 1;
         req.pieces[0].rounding = 0.5;
         assert!(req.set_name(name));
-        let reply = s.handle_admin(owner, &req, &[Vertex::default()]);
+        let reply = s.handle_admin(owner, &req, AdminChunk::from_vertices(&[Vertex::default()]));
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         reply.id
     }

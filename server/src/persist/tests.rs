@@ -7,7 +7,8 @@ use super::journal;
 use crate::engine::state::test_support::*;
 use crate::engine::state::{BULK_REMOVAL, Limits, State};
 use gjkd_proto::{
-    AdminOp, AdminRequest, ErrorCode, Item, ObjectId, QueryOptions, Vertex, WaitMode, shape_kind,
+    AdminChunk, AdminOp, AdminRequest, ErrorCode, Item, ObjectId, QueryOptions, Vertex, WaitMode,
+    shape_kind,
 };
 use nalgebra::Isometry3;
 
@@ -115,7 +116,7 @@ fn a_full_disk_refuses_changes_until_there_is_room_again() {
     req.piece_count = 1;
     req.pieces[0].vertex_count = 1;
     assert!(req.set_name("ghost"));
-    let reply = s.handle_admin(1, &req, &[Vertex::default()]);
+    let reply = s.handle_admin(1, &req, AdminChunk::from_vertices(&[Vertex::default()]));
     assert_eq!(reply.error_code(), ErrorCode::StorageFull);
     assert_eq!(s.len(), 2, "the unwritten object is not kept");
     assert_eq!(s.lookup("ghost"), None);
@@ -134,7 +135,8 @@ fn a_full_disk_refuses_changes_until_there_is_room_again() {
     // Another failure of the storage is the server's own.
     faults.fail_writes(libc::EIO);
     assert_eq!(
-        s.handle_admin(1, &req, &[Vertex::default()]).error_code(),
+        s.handle_admin(1, &req, AdminChunk::from_vertices(&[Vertex::default()]))
+            .error_code(),
         ErrorCode::Internal
     );
     faults.fail_writes(0);
@@ -218,32 +220,40 @@ fn a_retried_registration_gets_the_stored_object_across_a_restart() {
     req.pieces[0].rounding = 0.5;
     req.token = 0xfeed;
     let v = [Vertex::default()];
-    let first = s.handle_admin(1, &req, &v);
+    let first = s.handle_admin(1, &req, AdminChunk::from_vertices(&v));
     assert_eq!(first.error_code(), ErrorCode::Ok);
-    assert_eq!(s.handle_admin(1, &req, &v).id, first.id, "same token");
+    assert_eq!(
+        s.handle_admin(1, &req, AdminChunk::from_vertices(&v)).id,
+        first.id,
+        "same token"
+    );
     assert_eq!(s.len(), 1);
     drop(s);
     // As a server killed after the commit finds it.
     let (db, opened) = Database::open(&path, 9).expect("reopen");
     let mut r = State::restore(Limits::default(), WaitMode::Spin, &opened.snapshot).expect("valid");
     attach(&mut r, db).expect("journal");
-    let again = r.handle_admin(1, &req, &v);
+    let again = r.handle_admin(1, &req, AdminChunk::from_vertices(&v));
     assert_eq!((again.error_code(), again.id), (ErrorCode::Ok, first.id));
     assert_eq!(r.len(), 1, "one object, not two");
     // Another owner's token is its own.
-    let other = r.handle_admin(2, &req, &v);
+    let other = r.handle_admin(2, &req, AdminChunk::from_vertices(&v));
     assert_ne!(other.id, first.id);
     // The same token for another shape is a client bug.
     let mut changed = req;
     changed.pieces[0].rounding = 0.75;
     assert_eq!(
-        r.handle_admin(1, &changed, &v).error_code(),
+        r.handle_admin(1, &changed, AdminChunk::from_vertices(&v))
+            .error_code(),
         ErrorCode::Malformed
     );
     // Token 0 is no token: two objects.
     let mut plain = req;
     plain.token = 0;
-    let (p1, p2) = (r.handle_admin(1, &plain, &v), r.handle_admin(1, &plain, &v));
+    let (p1, p2) = (
+        r.handle_admin(1, &plain, AdminChunk::from_vertices(&v)),
+        r.handle_admin(1, &plain, AdminChunk::from_vertices(&v)),
+    );
     assert_ne!(p1.id, p2.id);
     // Removed: the token is forgotten with the object, on disk too.
     r.remove(first.id, 1).expect("owner");

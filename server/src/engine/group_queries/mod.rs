@@ -9,7 +9,7 @@
 //!
 //! ```
 //! use gjkd_server::engine::{Limits, State};
-//! use gjkd_proto::{AdminOp, AdminRequest, SceneKind, SceneRequest, SceneRow, Vertex, WaitMode,
+//! use gjkd_proto::{AdminChunk, AdminOp, AdminRequest, SceneKind, SceneRequest, SceneRow, Vertex, WaitMode,
 //!     shape_kind};
 //!
 //! let mut state = State::new(Limits::default(), WaitMode::Spin, 1);
@@ -18,9 +18,9 @@
 //! reg.piece_count = 1;
 //! reg.pieces[0].vertex_count = 1;
 //! reg.pieces[0].rounding = 0.5;
-//! let ball = state.handle_admin(1, &reg, &[Vertex::default()]).id;
+//! let ball = state.handle_admin(1, &reg, AdminChunk::from_vertices(&[Vertex::default()])).id;
 //! for x in [3.0, 5.0] {
-//!     state.handle_admin(1, &reg, &[Vertex { x, y: 0.0, z: 0.0 }]);
+//!     state.handle_admin(1, &reg, AdminChunk::from_vertices(&[Vertex { x, y: 0.0, z: 0.0 }]));
 //! }
 //! // The object nearest to the ball, with its certified interval.
 //! let request = SceneRequest::new(SceneKind::Clearance, ball);
@@ -239,7 +239,12 @@ fn check_layout(q: &Question, items: &[Item]) -> Result<u32, ErrorCode> {
     let mut steps: u32 = 0;
     let mut pending = false;
     for item in items {
-        if item.flags & !item_flags::ALL != 0 || item.reserved != 0 {
+        // A joint item's body has no reserved word; its `b` is zero instead.
+        let unused = match ItemKind::from_raw(item.kind) {
+            Some(ItemKind::SetJoints) => item.b,
+            _ => u64::from(item.pair().reserved),
+        };
+        if item.flags & !item_flags::ALL != 0 || unused != 0 {
             return Err(ErrorCode::Malformed);
         }
         let ends = item.flags & item_flags::END_STEP != 0;

@@ -110,11 +110,16 @@ fn joint_poses(
     clamp: bool,
     out: &mut Vec<(u64, Isometry3<f64>)>,
 ) -> Result<(), ErrorCode> {
-    let (values, count) = item.joint_positions().ok_or(ErrorCode::Malformed)?;
+    let values = item.joint_positions().ok_or(ErrorCode::Malformed)?;
+    // `b` is no field of a joint update: refused, not ignored.
+    if item.b != 0 {
+        return Err(ErrorCode::Malformed);
+    }
     let index = overlay.index_of(robots, item.a)?;
     let robot = robots.get(item.a).ok_or(ErrorCode::UnknownObject)?;
     let state = &mut overlay.robots[index];
-    let first = usize::try_from(item.b).map_err(|_| ErrorCode::Malformed)?;
+    let count = values.len();
+    let first = item.joints().first as usize;
     let end = first.checked_add(count).ok_or(ErrorCode::Malformed)?;
     if end > state.positions.len() {
         return Err(ErrorCode::Malformed);
@@ -132,7 +137,7 @@ fn joint_poses(
     let positions = &mut overlay.positions;
     positions.clear();
     positions.extend_from_slice(&state.positions);
-    positions[first..end].copy_from_slice(&values[..count]);
+    positions[first..end].copy_from_slice(values);
     robot
         .kinematics
         .link_poses_into(&base, positions, mode, &mut overlay.poses)

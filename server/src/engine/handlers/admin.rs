@@ -1,7 +1,7 @@
 //! The admin service's handler: hello, statistics, registrations,
 //! removals, look-ups and robots.
 
-use gjkd_proto::{AdminOp, AdminReply, AdminRequest, ErrorCode, Vertex};
+use gjkd_proto::{AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode};
 
 use super::decode::decode_registration;
 use crate::engine::checks::check_pose;
@@ -12,7 +12,7 @@ use crate::engine::state::State;
 impl State {
     /// Answers one admin request from client `requester` (the id of its
     /// iceoryx2 node, see [`Owner`]), with the request's slice payload
-    /// `vertices`. With persistence on, a registration or removal is
+    /// `payload` (a registration's vertices or a robot's text). With persistence on, a registration or removal is
     /// committed to the database ([`crate::persist::database`]) before this returns;
     /// if the commit fails the change is undone and the reply is
     /// [`ErrorCode::Internal`], so an acknowledged change is always on disk.
@@ -20,7 +20,7 @@ impl State {
         &mut self,
         requester: u128,
         request: &AdminRequest,
-        vertices: &[Vertex],
+        payload: &[AdminChunk],
     ) -> AdminReply {
         let op = request.op;
         let mut reply = AdminReply {
@@ -28,10 +28,9 @@ impl State {
             ..AdminReply::default()
         };
         let op_kind = AdminOp::from_raw(op);
-        // Only a registration carries vertices: any other request with a
+        // Only a registration (vertices) and a robot (text) carry a slice: any other request with a
         // slice is malformed (and would otherwise be silently ignored).
-        if !vertices.is_empty()
-            && !matches!(op_kind, Some(AdminOp::Register | AdminOp::AttachRobot))
+        if !payload.is_empty() && !matches!(op_kind, Some(AdminOp::Register | AdminOp::AttachRobot))
         {
             reply.error = ErrorCode::Malformed as u32;
             return reply;
@@ -45,12 +44,15 @@ impl State {
                 reply.stats = self.stats();
                 Ok(0)
             }
-            Some(AdminOp::Register) => decode_registration(&self.limits, request, vertices)
-                .and_then(|new| {
-                    let max = self.limits.max_objects;
-                    self.store
-                        .register(new, Owner::Client(requester), max, request.token)
-                }),
+            Some(AdminOp::Register) => {
+                decode_registration(&self.limits, request, AdminChunk::vertices(payload)).and_then(
+                    |new| {
+                        let max = self.limits.max_objects;
+                        self.store
+                            .register(new, Owner::Client(requester), max, request.token)
+                    },
+                )
+            }
             Some(AdminOp::Remove) => self
                 .remove(request.object, requester)
                 .map(|()| request.object),
@@ -63,7 +65,7 @@ impl State {
                 }
                 _ => Err(ErrorCode::Malformed),
             },
-            Some(AdminOp::AttachRobot) => self.attach_request(requester, request, vertices),
+            Some(AdminOp::AttachRobot) => self.attach_request(requester, request, payload),
             Some(AdminOp::RemoveRobot) => match request.name() {
                 Some(name) => self.remove_robot(name, requester),
                 None => Err(ErrorCode::Malformed),
@@ -87,18 +89,18 @@ impl State {
         &mut self,
         requester: u128,
         request: &AdminRequest,
-        text: &[Vertex],
+        text: &[AdminChunk],
     ) -> Result<u64, ErrorCode> {
         let name = request
             .name()
             .filter(|n| !n.is_empty())
             .ok_or(ErrorCode::Malformed)?
             .to_owned();
-        let text = gjkd_proto::unpack_text(text, u64::from(request.text_len))
-            .ok_or(ErrorCode::Malformed)?;
+        let text =
+            AdminChunk::text_of(text, u64::from(request.text_len)).ok_or(ErrorCode::Malformed)?;
         let (urdf, srdf) = match text.split_once('\0') {
             Some((urdf, srdf)) => (urdf, Some(srdf)),
-            None => (text.as_str(), None),
+            None => (text, None),
         };
         let base = check_pose(&request.pose)?;
         self.attach_robot(NewRobot {

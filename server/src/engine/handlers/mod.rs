@@ -9,4 +9,5 @@
 
 pub mod admin;
 pub mod decode;
+pub mod poses;
 pub mod query;

@@ -41,12 +41,17 @@ impl State {
         // Unknown flag bits and a non-zero reserved word are refused rather
         // than ignored, so that a later protocol version can give them a
         // meaning without old servers silently answering something else.
-        // A path step's end means something only in a scene request.
+        // A path step's end means something only in a scene request. The
+        // pair body's reserved word is checked by the kinds that have one,
+        // so a joint item's body is never read as a pair's.
         let known = item_flags::ALL & !item_flags::END_STEP;
-        if item.flags & !known != 0 || item.reserved != 0 {
+        if item.flags & !known != 0 {
             return ItemResult::error(ErrorCode::Malformed);
         }
         match ItemKind::from_raw(item.kind) {
+            Some(ItemKind::SetPose | ItemKind::Distance) if item.pair().reserved != 0 => {
+                ItemResult::error(ErrorCode::Malformed)
+            }
             Some(ItemKind::SetPose) => match self.set_pose(item) {
                 Ok(()) => ItemResult::default(),
                 Err(e) => ItemResult::error(e),
@@ -75,10 +80,11 @@ impl State {
 
     fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
         let warm_on = item.flags & item_flags::WARM_START != 0;
+        let pair = item.pair();
         let options = gjk::Options {
-            tolerance: item.tolerance,
-            max_iterations: item.max_iterations,
-            margin: (item.flags & item_flags::MARGIN != 0).then_some(item.margin),
+            tolerance: pair.tolerance,
+            max_iterations: pair.max_iterations,
+            margin: (item.flags & item_flags::MARGIN != 0).then_some(pair.margin),
             warm_start: warm_on,
             precision: if item.flags & item_flags::SINGLE_PRECISION != 0 {
                 gjk::Precision::Single
@@ -101,7 +107,7 @@ impl State {
             a.pose
         };
         let pose_b = if item.flags & item_flags::POSE_B != 0 {
-            check_pose(&item.pose_b)?
+            check_pose(&pair.pose_b)?
         } else {
             b.pose
         };
@@ -171,7 +177,7 @@ mod tests {
     use super::*;
     use crate::engine::state::test_support::*;
     use gjk::{Convex, Shape};
-    use gjkd_proto::{AdminOp, AdminRequest, Pose, Vertex, piece_kind, shape_kind};
+    use gjkd_proto::{AdminChunk, AdminOp, AdminRequest, Pose, Vertex, piece_kind, shape_kind};
     use gjkd_proto::{ObjectId, PieceDesc, QueryOptions};
     use nalgebra::Vector3;
     use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
@@ -199,13 +205,13 @@ mod tests {
     fn cylinders_register_and_answer_exactly() {
         let mut s = state();
         let (req, v) = cylinder_request(0.5, 1.0, 0.0);
-        let reply = s.handle_admin(1, &req, &v);
+        let reply = s.handle_admin(1, &req, AdminChunk::from_vertices(&v));
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         let can = ObjectId::from_raw(reply.id);
         let mut ball = cylinder_request(0.0, 0.0, 0.25).0;
         ball.pieces[0].kind = piece_kind::HULL;
         ball.pieces[0].vertex_count = 1;
-        let ball = s.handle_admin(1, &ball, &[Vertex::default()]);
+        let ball = s.handle_admin(1, &ball, AdminChunk::from_vertices(&[Vertex::default()]));
         assert_eq!(ball.error_code(), ErrorCode::Ok);
         let ball = ObjectId::from_raw(ball.id);
         let cases = [
@@ -231,7 +237,7 @@ mod tests {
         pair.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(5.0, 0.0, 0.0));
         pair.pieces[1].vertex_count = 1;
         let verts = [Vertex::default()];
-        let reply = s.handle_admin(1, &pair, &verts);
+        let reply = s.handle_admin(1, &pair, AdminChunk::from_vertices(&verts));
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         let Shape::Compound(c) = &s.object(reply.id).expect("stored").shape else {
             panic!("not a compound");
@@ -263,7 +269,8 @@ mod tests {
         for ((r, h, rounding), want) in cases {
             let (req, v) = cylinder_request(r, h, rounding);
             assert_eq!(
-                s.handle_admin(1, &req, &v).error_code(),
+                s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                    .error_code(),
                 want,
                 "{r} {h} {rounding}"
             );
@@ -280,7 +287,8 @@ mod tests {
         for (count, sent) in [(1, &one_vertex[..]), (2, &two[..]), (0, &one_vertex[..])] {
             req.pieces[0].vertex_count = count;
             assert_eq!(
-                s.handle_admin(1, &req, sent).error_code(),
+                s.handle_admin(1, &req, AdminChunk::from_vertices(sent))
+                    .error_code(),
                 ErrorCode::Malformed,
                 "{count} counted, {} sent",
                 sent.len()
@@ -290,25 +298,29 @@ mod tests {
         let (mut req, v) = cylinder_request(0.5, 1.0, 0.0);
         req.pieces[0].kind = 3;
         assert_eq!(
-            s.handle_admin(1, &req, &v).error_code(),
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         req.shape = shape_kind::COMPOUND;
         assert_eq!(
-            s.handle_admin(1, &req, &v).error_code(),
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         // A compound whose cylinder piece is bad, or sits too far away.
         req.pieces[0].kind = piece_kind::CYLINDER;
         req.pieces[0].cylinder_radius = -1.0;
         assert_eq!(
-            s.handle_admin(1, &req, &v).error_code(),
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::InvalidRadius
         );
         req.pieces[0].cylinder_radius = 0.5;
         req.pieces[0].offset = Pose::from_isometry(&Isometry3::translation(6e300, 0.0, 0.0));
         assert_eq!(
-            s.handle_admin(1, &req, &v).error_code(),
+            s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::NonFinitePose
         );
         assert_eq!(s.stats().objects, before);
@@ -447,7 +459,8 @@ mod tests {
             z: 3.0,
         };
         let code = |s: &mut State, req: &AdminRequest, verts: &[Vertex]| {
-            s.handle_admin(1, req, verts).error_code()
+            s.handle_admin(1, req, AdminChunk::from_vertices(verts))
+                .error_code()
         };
         assert_eq!(code(&mut s, &req, &[]), ErrorCode::EmptyVertices);
         req.pieces[0].vertex_count = 1;
@@ -473,7 +486,7 @@ mod tests {
         assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::NonFinitePose);
         req.pieces[1].offset.translation[0] = 2.0;
         assert!(req.set_name("dumbbell"));
-        let reply = s.handle_admin(1, &req, &[v, v]);
+        let reply = s.handle_admin(1, &req, AdminChunk::from_vertices(&[v, v]));
         assert_eq!(reply.error_code(), ErrorCode::Ok);
         assert_eq!(code(&mut s, &req, &[v, v]), ErrorCode::NameTaken);
         req.shape = 9;
@@ -500,11 +513,11 @@ mod tests {
         let mut s = state();
         let a = ObjectId::from_raw(register_box(&mut s, 1));
         let mut reserved = Item::distance(a, a, &QueryOptions::default());
-        reserved.reserved = 1;
+        reserved.pair_mut().reserved = 1;
         let mut pose_flags = Item::set_pose(a, &Isometry3::identity());
         pose_flags.flags = 1 << 20;
         let mut pose_reserved = Item::set_pose(a, &Isometry3::identity());
-        pose_reserved.reserved = 7;
+        pose_reserved.pair_mut().reserved = 7;
         // A path step's end is a scene request's; here it moves nothing.
         let ending_step = Item::set_pose(a, &Isometry3::translation(5.0, 0.0, 0.0)).ending_step();
         let before = s.object(a.raw()).unwrap().pose;
@@ -540,7 +553,8 @@ mod tests {
             let mut req = AdminRequest::new(op);
             req.object = a.raw();
             assert_eq!(
-                s.handle_admin(1, &req, &v).error_code(),
+                s.handle_admin(1, &req, AdminChunk::from_vertices(&v))
+                    .error_code(),
                 ErrorCode::Malformed,
                 "{op:?}"
             );
@@ -555,44 +569,55 @@ mod tests {
         reg.pieces[0].vertex_count = 1;
         reg.pieces[0].kind = 3; // a piece kind from the future
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         reg.shape = shape_kind::COMPOUND;
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         reg.pieces[0].kind = piece_kind::HULL;
-        assert_eq!(s.handle_admin(1, &reg, &v).error_code(), ErrorCode::Ok);
+        assert_eq!(
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
+            ErrorCode::Ok
+        );
         // Quaternions: zero and NaN; registration poses as well as items.
         reg.pose.rotation = [0.0; 4];
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::BadQuaternion
         );
         reg.pose.rotation = [f64::NAN, 0.0, 0.0, 1.0];
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::NonFinitePose
         );
         reg.pose = Pose::IDENTITY;
         reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.5];
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::BadQuaternion
         );
         reg.pieces[0].offset.rotation = [0.0, 0.0, 0.0, 1.0];
         // Names: too long a length, bad UTF-8.
         reg.name_len = 65;
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         reg.name_len = 1;
         reg.name[0] = 0xC3;
         assert_eq!(
-            s.handle_admin(1, &reg, &v).error_code(),
+            s.handle_admin(1, &reg, AdminChunk::from_vertices(&v))
+                .error_code(),
             ErrorCode::Malformed
         );
         // Options: infinite tolerance, infinite margin.
@@ -623,7 +648,7 @@ mod tests {
         req.piece_count = 1;
         req.pieces[0].vertex_count = 4;
         req.pieces[0].rounding = 6.4000000000000006e100;
-        let v = |x: f64, y: f64, z: f64| Vertex { x, y, z };
+        let v = |x: f64, y: f64, z: f64| AdminChunk::from(Vertex { x, y, z });
         let a = s.handle_admin(
             1,
             &req,
@@ -713,11 +738,11 @@ mod tests {
             item.kind = (next() % 4) as u32;
             // Every known bit and the first unknown one.
             item.flags = (next() % 64) as u32;
-            item.tolerance = f64::from_bits(next());
-            item.margin = f64::from_bits(next());
-            item.max_iterations = (next() % 300) as u32;
+            item.pair_mut().tolerance = f64::from_bits(next());
+            item.pair_mut().margin = f64::from_bits(next());
+            item.pair_mut().max_iterations = (next() % 300) as u32;
             item.pose_a.translation[0] = f64::from_bits(next());
-            item.pose_b.rotation[1] = f64::from_bits(next());
+            item.pair_mut().pose_b.rotation[1] = f64::from_bits(next());
             let _ = one(&mut s, 3, item);
         }
     }

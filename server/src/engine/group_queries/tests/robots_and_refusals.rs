@@ -144,7 +144,7 @@ fn bad_requests_get_their_codes_and_change_nothing() {
     let mut bad_flag = good_move;
     bad_flag.flags |= 1 << 30;
     let mut reserved = good_move;
-    reserved.reserved = 1;
+    reserved.pair_mut().reserved = 1;
     let cases: Vec<(SceneRequest, Vec<Item>, ErrorCode)> = vec![
         (with(&|r| r.kind = 0), vec![good_move], ErrorCode::Malformed),
         (with(&|r| r.kind = 9), vec![good_move], ErrorCode::Malformed),

@@ -10,6 +10,7 @@ use rust_client::{Item, ObjectId, SceneSummary, Steps};
 use crate::args::{checked_pose, out, slice, slice_mut};
 use crate::gradient::gjkd_gradient;
 use crate::handle::{gjkd_client, with_client};
+#[cfg(feature = "robots")]
 use crate::robots::{gjkd_robot, path_steps};
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::{gjkd_answer, gjkd_id, gjkd_pose};
@@ -562,6 +563,7 @@ pub unsafe extern "C" fn gjkd_path(
 /// # Safety
 /// As `gjkd_clearance()`; `robot` NULL or live; `positions` NULL or
 /// `step_count * dof` doubles.
+#[cfg(feature = "robots")]
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn gjkd_path_joints(

@@ -3,6 +3,8 @@
 //! fixed joints), its link poses against transforms computed here by hand,
 //! link distances against analytic answers, and every error path with its
 //! status, code and message.
+// Robots and meshes are in the library with its `robots` feature only.
+#![cfg(feature = "robots")]
 
 use std::ffi::{CStr, CString, c_char};
 use std::path::Path;

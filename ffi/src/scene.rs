@@ -494,8 +494,10 @@ pub unsafe extern "C" fn gjkd_nearest(
 /// `poses` with non-zero counts), `GJKD_ERR_INVALID_ARGUMENT` (a
 /// `question` that is no `gjkd_path_question`, no moving object or no
 /// step, a pose that is not finite or not a unit quaternion: nothing is
-/// sent), `GJKD_CODE_BATCH_TOO_LARGE` (more steps times moving objects
-/// than the server's `max_batch` takes in one request).
+/// sent), `GJKD_CODE_BATCH_TOO_LARGE` (the group's members and allowed
+/// pairs plus one step's poses exceed the server's `max_batch`; a longer
+/// path is split into several requests by this library and answered
+/// whole).
 ///
 /// # Safety
 /// As `gjkd_clearance()`; `moving` and `poses` NULL or pointing to their

@@ -137,6 +137,7 @@
 
 mod builder;
 mod connection;
+mod ending;
 mod error;
 mod gradient;
 mod objects;
@@ -150,7 +151,7 @@ mod scene;
 
 pub use builder::{ClientBuilder, DEFAULT_TIMEOUT};
 pub use connection::Client;
-pub use error::ClientError;
+pub use error::{ClientError, ConnectError};
 pub use gradient::{gradient_matrix, row_gradient};
 #[cfg(feature = "robots")]
 pub use robots::{

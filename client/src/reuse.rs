@@ -90,7 +90,9 @@ impl Client {
     /// name over [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the
     /// connection errors.
     pub fn remove_robot(&mut self, name: &str) -> Result<(), ClientError> {
-        self.robot_request(AdminOp::RemoveRobot, name).map(|_| ())
+        self.robot_request(AdminOp::RemoveRobot, name)?;
+        self.ending.removed_robot(name);
+        Ok(())
     }
 
     /// The id of the robot named `name` on the server (one the scene file

@@ -670,7 +670,9 @@ fn every_mesh_and_robot_error_has_its_status() {
         );
         assert_eq!(id, 0, "a failed registration writes 0");
 
-        // Robot registration.
+        // Robot registration: a robot that cannot be read carries the code
+        // the server gives a robot it cannot attach, as in Rust and Python.
+        let robot_code = code(gjkd_error_code::GJKD_CODE_INVALID_ROBOT);
         let missing = cstr(&dir.join("none.urdf"));
         fails(
             gjkd_register_robot(
@@ -683,7 +685,7 @@ fn every_mesh_and_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "none.urdf",
         );
         fails(
@@ -738,7 +740,7 @@ fn every_mesh_and_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "none.srdf",
         );
         fails(
@@ -781,7 +783,7 @@ fn every_mesh_and_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "",
         );
         // Text: the relative mesh path resolves against mesh_dir only.
@@ -797,7 +799,7 @@ fn every_mesh_and_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "fore.stl",
         );
         let bad_srdf = c"<robot name=\"testarm\"><disable_collisions link1=\"base\" link2=\"nolink\"/></robot>";
@@ -814,7 +816,7 @@ fn every_mesh_and_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "nolink",
         );
         assert!(r.is_null(), "a failed registration writes NULL");
@@ -840,8 +842,8 @@ fn every_mesh_and_robot_error_has_its_status() {
         fails(
             gjkd_open_robot(c, c"arm".as_ptr(), c"<robot".as_ptr(), &mut r),
             inv,
-            0,
-            "",
+            robot_code,
+            "the robot cannot be read",
         );
 
         // Listing.

@@ -34,7 +34,8 @@ impl EndWithClient {
     }
 
     /// Notes a robot this client attached (by name: robots are removed
-    /// by name, whole).
+    /// by name, whole). Only a client with robots attaches them.
+    #[cfg(feature = "robots")]
     pub(crate) fn robot(&mut self, name: &str) {
         if self.on && !self.robots.iter().any(|r| r == name) {
             self.robots.push(name.to_owned());

@@ -4,5 +4,6 @@
 # environment (python/.venv) from what `cargo test` already built.
 set -euo pipefail
 cd "$(dirname "$0")"
-cargo test --workspace
+# The C library's robot and mesh tests need its `robots` feature.
+cargo test --workspace --features gjkd-c/robots
 bash python/run-tests.sh

@@ -2,9 +2,17 @@
 # Installs the gjkd C library, headers, CMake package and pkg-config file:
 #
 #   ffi/install.sh PREFIX              # builds with cargo --profile dist
-#                                      # first (stripped, into target/dist)
+#                                      # first (stripped, into target/dist),
+#                                      # with robots and meshes
+#   ffi/install.sh --no-robots PREFIX  # the same without them: a lean
+#                                      # library (no URDF or mesh crates)
 #   ffi/install.sh --from DIR PREFIX   # copies an existing build (DIR holds
 #                                      # libgjkd_c.so and libgjkd_c.a)
+#
+# Whether the library has robots is read from the library itself; without
+# them, the CMake package and the pkg-config file define GJKD_NO_ROBOTS, so
+# that the header hides their declarations and a program calling them
+# fails to compile rather than to link.
 #
 # The shared library is installed as libgjkd_c.so.VERSION, with links
 # from its soname (libgjkd_c.so.0.MINOR, what programs record) and from
@@ -16,14 +24,19 @@ set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 from=""
+features=(--features robots)
+if [[ "${1:-}" == "--no-robots" ]]; then
+  features=()
+  shift
+fi
 if [[ "${1:-}" == "--from" ]]; then
   from="${2:?--from needs a folder}"
   shift 2
 fi
-prefix="${1:?usage: ffi/install.sh [--from DIR] PREFIX}"
+prefix="${1:?usage: ffi/install.sh [--no-robots] [--from DIR] PREFIX}"
 
 if [[ -z "$from" ]]; then
-  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib)
+  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib "${features[@]}")
   target="$(cd "$here/.." && cargo metadata --format-version 1 --no-deps \
     | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')"
   from="$target/dist"
@@ -50,9 +63,18 @@ install -m 644 "$from/libgjkd_c.a" "$prefix/lib/"
 if command -v strip >/dev/null; then
   strip --strip-debug "$prefix/lib/libgjkd_c.a"
 fi
-install -m 644 "$here/cmake/gjkdConfig.cmake" "$prefix/lib/cmake/gjkd/"
+defines=""
+cmake_defines=""
+if command -v nm >/dev/null \
+  && ! nm -D --defined-only "$from/libgjkd_c.so" | grep -q ' gjkd_register_robot\(@.*\)\?$'; then
+  defines=" -DGJKD_NO_ROBOTS"
+  cmake_defines="GJKD_NO_ROBOTS"
+fi
+sed "s|@DEFINES@|$cmake_defines|g" "$here/cmake/gjkdConfig.cmake" \
+  > "$prefix/lib/cmake/gjkd/gjkdConfig.cmake"
 sed "s|@VERSION@|$version|g" "$here/cmake/gjkdConfigVersion.cmake.in" \
   > "$prefix/lib/cmake/gjkd/gjkdConfigVersion.cmake"
-sed -e "s|@VERSION@|$version|g" -e "s|@PREFIX@|$prefix|g" "$here/cmake/gjkd.pc.in" \
+sed -e "s|@VERSION@|$version|g" -e "s|@PREFIX@|$prefix|g" -e "s|@DEFINES@|$defines|g" \
+  "$here/cmake/gjkd.pc.in" \
   > "$prefix/lib/pkgconfig/gjkd.pc"
-echo "installed gjkd $version into $prefix"
+echo "installed gjkd $version into $prefix${defines:+ (without robots)}"

@@ -153,6 +153,9 @@ pub enum BenchError {
     /// A gjkd client call.
     #[error("client: {0}")]
     Client(#[from] gjkd_client::ClientError),
+    /// Connecting to the server.
+    #[error("connect: {0}")]
+    Connect(#[from] gjkd_client::ConnectError),
     /// The algorithm refused an input (a bug in the bench's inputs).
     #[error("gjk: {0}")]
     Gjk(#[from] gjk::Error),

@@ -60,10 +60,10 @@ pub fn joint_path(t: f64) -> [f64; 7] {
 /// as `name`; the folder is removed again.
 ///
 /// # Errors
-/// The client's, or [`ClientError::Model`] for the temporary file.
+/// The client's, or [`ClientError::InvalidRobot`] for the temporary file.
 pub fn register_arm(client: &mut Client, name: &str) -> Result<RobotHandle, ClientError> {
     let dir: PathBuf = std::env::temp_dir().join(format!("gjkd-arm-{}-{name}", std::process::id()));
-    let io = |e: std::io::Error| ClientError::Model(format!("{}: {e}", dir.display()));
+    let io = |e: std::io::Error| ClientError::InvalidRobot(format!("{}: {e}", dir.display()));
     std::fs::create_dir_all(&dir).map_err(io)?;
     let urdf = dir.join("gjkd_arm.urdf");
     std::fs::write(&urdf, ARM_URDF).map_err(io)?;

@@ -28,6 +28,9 @@ pub enum DemoError {
     /// A client call failed.
     #[error("client: {0}")]
     Client(#[from] ClientError),
+    /// Connecting to the server failed.
+    #[error("connect: {0}")]
+    Connect(#[from] gjkd_client::ConnectError),
     /// An answer failed or disagreed with the in-process computation.
     #[error("{0}")]
     Check(String),

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::prelude::*;
 
 use crate::connection::TokenSource;
-use crate::{Client, ClientError, ipc_err};
+use crate::{Client, ClientError, ConnectError, ipc_err};
 #[cfg(doc)]
 use gjkd_proto::DEFAULT_SERVICE;
 
@@ -35,6 +35,7 @@ pub struct ClientBuilder {
     service: String,
     timeout: Duration,
     connect_timeout: Option<Duration>,
+    remove_on_close: bool,
 }
 
 impl ClientBuilder {
@@ -54,21 +55,40 @@ impl ClientBuilder {
         self
     }
 
+    /// Whether what the client registers ends with it (default `false`):
+    /// objects it registers and robots it attaches are removed (robots
+    /// whole) when the [`Client`] is dropped. Without it objects outlive
+    /// their client, and a server with persistence keeps them across
+    /// restarts: right for a scene that must stay, wrong for tests and
+    /// short-lived programs, whose objects pile up. Best effort: a server
+    /// that is gone when the client ends keeps them. Objects found again
+    /// by name ([`Client::register_named_or_get`]) are not the client's to
+    /// end. (C: `gjkd_set_registration_options`'s `remove_on_close`.)
+    pub fn remove_on_close(mut self, yes: bool) -> Self {
+        self.remove_on_close = yes;
+        self
+    }
+
     /// Connects, waiting up to the connect timeout for a server to come up.
     ///
     /// # Errors
-    /// [`ClientError::ServerGone`] if no server serves the name within the
-    /// timeout; [`ClientError::VersionMismatch`],
-    /// [`ClientError::Incompatible`], [`ClientError::PermissionDenied`] or
-    /// [`ClientError::TooManyClients`] at once if a service of that name
-    /// exists but this client cannot use it; [`ClientError::Ipc`] if
+    /// [`ConnectError::ServerGone`] if no server serves the name within the
+    /// timeout; [`ConnectError::VersionMismatch`],
+    /// [`ConnectError::Incompatible`], [`ConnectError::PermissionDenied`] or
+    /// [`ConnectError::TooManyClients`] at once if a service of that name
+    /// exists but this client cannot use it; [`ConnectError::Ipc`] if
     /// iceoryx2 cannot set up this process.
-    pub fn connect(self) -> Result<Client, ClientError> {
+    pub fn connect(self) -> Result<Client, ConnectError> {
         quiet_iceoryx2_notices();
         let node = NodeBuilder::new()
-            .name(&NodeName::new("gjkd-client").map_err(ipc_err("node name"))?)
+            .name(
+                &NodeName::new("gjkd-client")
+                    .map_err(ipc_err("node name"))
+                    .map_err(ConnectError::from_client)?,
+            )
             .create::<ipc::Service>()
-            .map_err(ipc_err("node"))?;
+            .map_err(ipc_err("node"))
+            .map_err(ConnectError::from_client)?;
         let mut client = Client {
             service: self.service,
             timeout: self.timeout,
@@ -77,6 +97,7 @@ impl ClientBuilder {
             vertex_scratch: Vec::new(),
             tokens: TokenSource::new(),
             split_scratch: Default::default(),
+            ending: crate::ending::EndWithClient::new(self.remove_on_close),
         };
         let deadline = Instant::now() + self.connect_timeout.unwrap_or(client.timeout);
         let mut first = true;
@@ -87,7 +108,7 @@ impl ClientBuilder {
                     first = false;
                     std::thread::sleep(Duration::from_millis(5));
                 }
-                Err(e) => return Err(e),
+                Err(e) => return Err(ConnectError::from_client(e)),
             }
         }
     }
@@ -101,6 +122,7 @@ impl Client {
             service: service.to_owned(),
             timeout: DEFAULT_TIMEOUT,
             connect_timeout: None,
+            remove_on_close: false,
         }
     }
 
@@ -109,7 +131,7 @@ impl Client {
     ///
     /// # Errors
     /// As [`ClientBuilder::connect`].
-    pub fn connect(service: &str) -> Result<Self, ClientError> {
+    pub fn connect(service: &str) -> Result<Self, ConnectError> {
         Self::builder(service).connect()
     }
 }

@@ -95,6 +95,8 @@ pub struct Client {
     pub(crate) vertex_scratch: Vec<Vertex>,
     pub(crate) tokens: TokenSource,
     pub(crate) split_scratch: SplitScratch,
+    /// What ends with this client ([`crate::ClientBuilder::remove_on_close`]).
+    pub(crate) ending: crate::ending::EndWithClient,
 }
 
 /// Draws registration tokens: random (from the standard library's

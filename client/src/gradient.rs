@@ -9,7 +9,7 @@
 //! [`gradient_matrix`] copies them into one `(rows, columns)` array.
 //!
 //! The coordinates are those that move the pair's first object: a robot
-//! link's robot's moving joints (in [`RobotHandle::joint_names`](crate::RobotHandle)
+//! link's robot's moving joints (in `RobotHandle::joint_names`
 //! order; a self-collision pair's other link moves with them), then, when
 //! asked, the base pose's twist `[v, ω]`; any other object, its pose's
 //! twist (world frame, turning about its origin). For overlapping objects

@@ -85,6 +85,20 @@
 //! within a margin, the k nearest objects, all of it along a candidate
 //! motion), into a buffer of rows you own; see [`SceneQuery`].
 //!
+//! ## Features
+//!
+//! - `robots` (off by default): robots from URDF (`Client::register_robot`,
+//!   `RobotHandle`, joint paths, `Client::edge_contact`) and meshes from
+//!   files or arrays (`Client::register_mesh_file`). It links `gjkd-model`
+//!   and through it parry3d-f64, urdf-rs and mesh-loader, which a client of
+//!   spheres, boxes, capsules, cylinders and hulls does without. Without it
+//!   a client still reaches robots others registered (or the scene file
+//!   loaded) by name: [`Client::robot_id`] for scene questions,
+//!   [`Item::set_joints`] to move them, [`Client::remove_robot`].
+//!   `cargo add gjkd-client --features robots`.
+//! - `shared-access`: shared-memory files every user may open (see the
+//!   README's "Access" section).
+//!
 //! ## Errors, timeouts and a server that goes away
 //!
 //! Every call returns within the client's timeout (default one second, see
@@ -123,6 +137,7 @@
 
 mod builder;
 mod connection;
+mod ending;
 mod error;
 mod gradient;
 mod objects;
@@ -131,13 +146,15 @@ mod pairs;
 mod path_split;
 mod poses;
 mod reuse;
+#[cfg(feature = "robots")]
 mod robots;
 mod scene;
 
 pub use builder::{ClientBuilder, DEFAULT_TIMEOUT};
 pub use connection::Client;
-pub use error::ClientError;
+pub use error::{ClientError, ConnectError};
 pub use gradient::{gradient_matrix, row_gradient};
+#[cfg(feature = "robots")]
 pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
     RobotHandle, RobotModel,

@@ -94,7 +94,9 @@ impl Client {
         let built = Self::encode(geometry, &mut request, &mut vertices);
         let result = built.and_then(|()| self.register_retrying(&request, &vertices));
         self.vertex_scratch = vertices;
-        result.map(|r| ObjectId::from_raw(r.id))
+        let id = result.map(|r| ObjectId::from_raw(r.id))?;
+        self.ending.object(id);
+        Ok(id)
     }
 
     /// Sends a registration and, while the server is gone, sends it again
@@ -260,7 +262,9 @@ impl Client {
     pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.object = id.raw();
-        self.admin(&request, &[]).map(|_| ())
+        self.admin(&request, &[])?;
+        self.ending.removed(id);
+        Ok(())
     }
 
     /// The id of the object named `name` (scene objects, or objects

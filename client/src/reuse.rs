@@ -2,11 +2,13 @@
 //! a node restarted under the same names needs, since objects outlive the
 //! client that registered them (and, with persistence, the server).
 
+#[cfg(feature = "robots")]
 use std::path::Path;
 
-use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Geometry, ObjectId};
+use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Geometry, ObjectId, lookup_kind};
 use nalgebra::Isometry3;
 
+#[cfg(feature = "robots")]
 use crate::robots::{PackagePath, RobotHandle};
 use crate::{Client, ClientError};
 
@@ -52,6 +54,7 @@ impl Client {
     /// # Errors
     /// As [`Client::register_robot_text`], without
     /// [`ErrorCode::NameTaken`].
+    #[cfg(feature = "robots")]
     pub fn register_robot_text_or_get(
         &mut self,
         name: &str,
@@ -87,12 +90,38 @@ impl Client {
     /// name over [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the
     /// connection errors.
     pub fn remove_robot(&mut self, name: &str) -> Result<(), ClientError> {
-        let mut request = AdminRequest::new(AdminOp::RemoveRobot);
+        self.robot_request(AdminOp::RemoveRobot, name)?;
+        self.ending.removed_robot(name);
+        Ok(())
+    }
+
+    /// The id of the robot named `name` on the server (one the scene file
+    /// loaded, or a client attached): the group id of scene questions
+    /// about it ([`Group::Robot`](crate::Group::Robot)) and the robot of
+    /// [`Item::set_joints`](crate::Item::set_joints). Needs no URDF, so it
+    /// works without the `robots` feature; `Client::open_robot` (with the
+    /// feature) gives a handle that also knows the joints and links.
+    ///
+    /// # Errors
+    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`] (no robot
+    /// of that name); [`ClientError::InvalidArgument`] for a name over
+    /// [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the connection errors.
+    pub fn robot_id(&mut self, name: &str) -> Result<ObjectId, ClientError> {
+        self.robot_request(AdminOp::Lookup, name)
+    }
+
+    /// Sends a robot's admin request by name: a lookup asks for a robot,
+    /// not an object.
+    fn robot_request(&mut self, op: AdminOp, name: &str) -> Result<ObjectId, ClientError> {
+        let mut request = AdminRequest::new(op);
         if !request.set_name(name) {
             return Err(ClientError::InvalidArgument(
                 "name longer than MAX_NAME_LEN",
             ));
         }
-        self.admin(&request, &[]).map(|_| ())
+        if op == AdminOp::Lookup {
+            request.lookup = lookup_kind::ROBOT;
+        }
+        self.admin(&request, &[]).map(|r| ObjectId::from_raw(r.id))
     }
 }

@@ -126,8 +126,23 @@ impl RobotHandle {
     }
 }
 
-fn model_err(e: impl std::fmt::Display) -> ClientError {
-    ClientError::Model(e.to_string())
+/// A robot that cannot be read, with the model's words.
+fn robot_err(e: impl std::fmt::Display) -> ClientError {
+    ClientError::InvalidRobot(e.to_string())
+}
+
+/// A mesh that cannot be used, with the model's words.
+fn mesh_err(e: impl std::fmt::Display) -> ClientError {
+    ClientError::InvalidMesh(e.to_string())
+}
+
+/// Positions by name refused before sending: an unknown joint carries the
+/// code of an unknown name, as in Python and C.
+fn named_joint_err(e: JointError) -> ClientError {
+    match e {
+        JointError::UnknownJoint(name) => ClientError::UnknownJoint(name),
+        _ => ClientError::InvalidArgument("one position per moving joint of the robot"),
+    }
 }
 
 impl Client {
@@ -135,8 +150,8 @@ impl Client {
     /// axis, as its hull or decomposed, named and at `pose`.
     ///
     /// # Errors
-    /// [`ClientError::Model`] for a file that is missing or not a mesh, or a
-    /// bad scale; as [`Client::register_named`] otherwise.
+    /// [`ClientError::InvalidMesh`] for a file that is missing or not a
+    /// mesh, or a bad scale; as [`Client::register_named`] otherwise.
     pub fn register_mesh_file(
         &mut self,
         name: &str,
@@ -145,7 +160,7 @@ impl Client {
         mode: MeshMode,
         pose: &Isometry3<f64>,
     ) -> Result<RegisteredMesh, ClientError> {
-        let mesh = Mesh::load(path, scale).map_err(model_err)?;
+        let mesh = Mesh::load(path, scale).map_err(mesh_err)?;
         self.register_mesh(name, &mesh, mode, pose)
     }
 
@@ -153,7 +168,7 @@ impl Client {
     /// or decomposed, named and at `pose`.
     ///
     /// # Errors
-    /// [`ClientError::Model`] when the decomposition finds no pieces; as
+    /// [`ClientError::InvalidMesh`] when the decomposition finds no pieces; as
     /// [`Client::register_named`] otherwise.
     pub fn register_mesh(
         &mut self,
@@ -177,7 +192,7 @@ impl Client {
                 })
             }
             MeshMode::Decompose(resolution) => {
-                let parts = mesh.decompose(resolution).map_err(model_err)?;
+                let parts = mesh.decompose(resolution).map_err(mesh_err)?;
                 let pieces: Vec<Piece<'_>> = parts
                     .pieces
                     .iter()
@@ -207,8 +222,9 @@ impl Client {
     /// relative to the URDF's folder.
     ///
     /// # Errors
-    /// [`ClientError::Model`] for a URDF, SRDF or mesh that cannot be
-    /// loaded (the message names the file, link or joint);
+    /// [`ClientError::InvalidRobot`] (code [`ErrorCode::InvalidRobot`]) for
+    /// a URDF, SRDF or mesh that cannot be loaded (the message names the
+    /// file, link or joint);
     /// [`ClientError::Rejected`] with [`ErrorCode::NameTaken`] (a link
     /// object of that name exists: after a server restart, use
     /// [`Client::attach_robot`]), [`ErrorCode::InvalidRobot`], and the codes
@@ -223,11 +239,11 @@ impl Client {
         base: &Isometry3<f64>,
     ) -> Result<RobotHandle, ClientError> {
         let text = std::fs::read_to_string(urdf)
-            .map_err(|e| ClientError::Model(format!("{}: {e}", urdf.display())))?;
+            .map_err(|e| ClientError::InvalidRobot(format!("{}: {e}", urdf.display())))?;
         let srdf = srdf
             .map(|p| {
                 std::fs::read_to_string(p)
-                    .map_err(|e| ClientError::Model(format!("{}: {e}", p.display())))
+                    .map_err(|e| ClientError::InvalidRobot(format!("{}: {e}", p.display())))
             })
             .transpose()?;
         self.register_robot_text(name, &text, srdf.as_deref(), urdf.parent(), packages, base)
@@ -249,8 +265,8 @@ impl Client {
         packages: &PackagePath,
         base: &Isometry3<f64>,
     ) -> Result<RobotHandle, ClientError> {
-        let model = RobotModel::from_urdf_str(urdf, mesh_base, packages).map_err(model_err)?;
-        gjkd_model::disabled_pairs(srdf, &model.kinematics, true).map_err(model_err)?;
+        let model = RobotModel::from_urdf_str(urdf, mesh_base, packages).map_err(robot_err)?;
+        gjkd_model::disabled_pairs(srdf, &model.kinematics, true).map_err(robot_err)?;
         let mut registered = Vec::new();
         let outcome = self.register_links(name, &model, &mut registered);
         let outcome = outcome.and_then(|()| self.attach_robot(name, urdf, srdf, base));
@@ -302,7 +318,7 @@ impl Client {
     /// robot is put at `base`, joints at zero within their limits.
     ///
     /// # Errors
-    /// [`ClientError::Model`] for URDF text this client cannot read;
+    /// [`ClientError::InvalidRobot`] for URDF text this client cannot read;
     /// [`ClientError::Rejected`] with [`ErrorCode::InvalidRobot`] or
     /// [`ErrorCode::NotOwner`] (another client's robot has that name).
     pub fn attach_robot(
@@ -312,7 +328,7 @@ impl Client {
         srdf: Option<&str>,
         base: &Isometry3<f64>,
     ) -> Result<RobotHandle, ClientError> {
-        let kinematics = Kinematics::from_urdf_str(urdf).map_err(model_err)?;
+        let kinematics = Kinematics::from_urdf_str(urdf).map_err(robot_err)?;
         let text = match srdf {
             Some(srdf) => format!("{urdf}\0{srdf}"),
             None => urdf.to_owned(),
@@ -327,6 +343,7 @@ impl Client {
             .map_err(|_| ClientError::InvalidArgument("robot text longer than 4 GiB"))?;
         request.pose = Pose::from_isometry(base);
         let reply = self.admin(&request, &AdminChunk::pack_text(&text))?;
+        self.ending.robot(name);
         self.handle(ObjectId::from_raw(reply.id), name, kinematics)
     }
 
@@ -335,10 +352,10 @@ impl Client {
     /// and link names.
     ///
     /// # Errors
-    /// [`ClientError::Model`] for URDF text this client cannot read;
+    /// [`ClientError::InvalidRobot`] for URDF text this client cannot read;
     /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`].
     pub fn open_robot(&mut self, name: &str, urdf: &str) -> Result<RobotHandle, ClientError> {
-        let kinematics = Kinematics::from_urdf_str(urdf).map_err(model_err)?;
+        let kinematics = Kinematics::from_urdf_str(urdf).map_err(robot_err)?;
         let mut request = AdminRequest::new(AdminOp::Lookup);
         if !request.set_name(name) {
             return Err(ClientError::InvalidArgument(
@@ -367,7 +384,7 @@ impl Client {
         let mut positions = vec![0.0; kinematics.dof()];
         kinematics
             .check_positions(&mut positions, LimitMode::Clamp)
-            .map_err(model_err)?;
+            .map_err(robot_err)?;
         Ok(RobotHandle {
             id,
             name: name.to_owned(),
@@ -438,7 +455,8 @@ impl Client {
     /// last positions.
     ///
     /// # Errors
-    /// [`ClientError::Model`] for a name that is no moving joint; as
+    /// [`ClientError::UnknownJoint`] (code [`ErrorCode::UnknownName`]) for
+    /// a name that is no moving joint, before anything is sent; as
     /// [`Client::set_joints`].
     pub fn set_joints_by_name(
         &mut self,
@@ -448,7 +466,7 @@ impl Client {
         let q = robot
             .kinematics
             .positions_by_name(named, &robot.positions)
-            .map_err(model_err)?;
+            .map_err(named_joint_err)?;
         self.set_joints(robot, &q, None)
     }
 }

@@ -58,7 +58,9 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::request_response;
 use nalgebra::Isometry3;
 
-use crate::{Answer, Client, ClientError, RobotHandle, Waited, ipc_err};
+#[cfg(feature = "robots")]
+use crate::RobotHandle;
+use crate::{Answer, Client, ClientError, Waited, ipc_err};
 
 mod continuous;
 pub use continuous::Contact;
@@ -79,7 +81,8 @@ pub(crate) struct ScenePorts {
 pub enum Group<'a> {
     /// One object.
     Object(ObjectId),
-    /// A robot's links (by [`RobotHandle::id`]), with the robot's allowed
+    /// A robot's links (by its id: `RobotHandle::id`, or
+    /// [`Client::robot_id`]), with the robot's allowed
     /// pairs (adjacent links, the SRDF's `disable_collisions`).
     Robot(ObjectId),
     /// The objects listed.
@@ -92,6 +95,7 @@ impl From<ObjectId> for Group<'_> {
     }
 }
 
+#[cfg(feature = "robots")]
 impl From<&RobotHandle> for Group<'_> {
     fn from(robot: &RobotHandle) -> Self {
         Group::Robot(robot.id)
@@ -130,7 +134,7 @@ pub enum Steps<'a> {
         poses: &'a [Isometry3<f64>],
     },
     /// `positions[s * joints..][..joints]` are the robot's joint positions
-    /// (in [`RobotHandle::joint_names`] order) at step `s`.
+    /// (in `RobotHandle::joint_names` order) at step `s`.
     Joints {
         /// The robot's id.
         robot: ObjectId,
@@ -146,6 +150,7 @@ pub enum Steps<'a> {
 
 impl<'a> Steps<'a> {
     /// Steps of `robot`'s joint positions, `robot.positions.len()` per step.
+    #[cfg(feature = "robots")]
     pub fn joints(robot: &RobotHandle, positions: &'a [f64]) -> Self {
         Steps::Joints {
             robot: robot.id,

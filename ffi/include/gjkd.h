@@ -30,6 +30,20 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+/*
+ * Robots and meshes (gjkd_register_robot*, gjkd_open_robot,
+ * gjkd_register_mesh*, gjkd_set_joints*, gjkd_robot_*, gjkd_path_joints,
+ * gjkd_remove_robot) are in the library when it was built with the cargo
+ * feature `robots`, as ffi/install.sh builds it by default. They are
+ * declared under GJKD_ROBOTS, defined here unless the program defines
+ * GJKD_NO_ROBOTS: the CMake package and pkg-config file of a lean install
+ * (ffi/install.sh --no-robots) do, so that a call to them fails to compile
+ * rather than to link. gjkd_remove_robot_named needs no feature.
+ */
+#if !defined(GJKD_NO_ROBOTS) && !defined(GJKD_ROBOTS)
+#define GJKD_ROBOTS 1
+#endif
+
 
 // The wire protocol version this library speaks; a server of another
 // version is refused with `GJKD_ERR_VERSION_MISMATCH`.
@@ -170,12 +184,13 @@ enum gjkd_error_code
   // A radius is negative, NaN or infinite.
   GJKD_CODE_INVALID_RADIUS = 7,
   // A request has more items than the server accepts. Pair batches
-  // (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) are
-  // split by this library and never see it; a scene question sent as
-  // one request does: `gjkd_clearance()` and `gjkd_within()` with more
-  // members and allowed pairs, `gjkd_path()` and `gjkd_path_joints()`
-  // with more steps times moving objects (or joint items), than the
-  // server's `max_batch` (`gjkd_server_info()`).
+  // (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) and
+  // paths longer than one request (`gjkd_path()`, `gjkd_path_joints()`)
+  // are split by this library; what cannot be split does see it:
+  // `gjkd_clearance()`, `gjkd_within()` and `gjkd_nearest()` with more
+  // members and allowed pairs than the server's `max_batch`
+  // (`gjkd_server_info()`), and a path whose members and allowed pairs
+  // plus one step's poses (or joint items) exceed it.
   GJKD_CODE_BATCH_TOO_LARGE = 8,
   // A batch has no items.
   GJKD_CODE_EMPTY_BATCH = 9,
@@ -339,12 +354,14 @@ typedef uint32_t gjkd_path_question;
 // use it from any thread, one call at a time, free it with `gjkd_close()`.
 typedef struct gjkd_client gjkd_client;
 
+#if defined(GJKD_ROBOTS)
 // A robot registered on a server: its links (objects) and moving joints.
 // Opaque: made by `gjkd_register_robot()`, `gjkd_register_robot_text()`
 // or `gjkd_open_robot()`, freed with `gjkd_robot_free()`. It holds no
 // connection: any handle to the same server may move it, from any thread
 // (one call at a time).
 typedef struct gjkd_robot gjkd_robot;
+#endif
 
 // What the server said about itself at the last (re)connection.
 typedef struct gjkd_info {
@@ -453,6 +470,7 @@ typedef struct gjkd_pose {
 // Identifier of a registered object (never 0 for a real object).
 typedef uint64_t gjkd_id;
 
+#if defined(GJKD_ROBOTS)
 // What a mesh registration made (`out_info` of `gjkd_register_mesh()`).
 typedef struct gjkd_mesh_info {
   // Convex pieces: 1 for a hull.
@@ -463,6 +481,7 @@ typedef struct gjkd_mesh_info {
   // own convex hull.
   double deviation;
 } gjkd_mesh_info;
+#endif
 
 // A convex shape, in its body frame. Fields a kind does not use are
 // ignored.
@@ -909,6 +928,7 @@ struct gjkd_query_options gjkd_query_options_default(void);
 enum gjkd_status gjkd_set_registration_options(struct gjkd_client *client,
                                                const struct gjkd_registration_options *options);
 
+#if defined(GJKD_ROBOTS)
 // Removes `robot` from the server as a whole: its kinematics and every
 // link object, in one step (all or nothing; removing one link with
 // `gjkd_remove()` would leave a robot with a hole). `robot` stays to be
@@ -924,6 +944,7 @@ enum gjkd_status gjkd_set_registration_options(struct gjkd_client *client,
 // # Safety
 // `client` and `robot` are NULL or live.
 enum gjkd_status gjkd_remove_robot(struct gjkd_client *client, const struct gjkd_robot *robot);
+#endif
 
 // Removes the robot named `name` as a whole, as `gjkd_remove_robot()`
 // does, for a program that holds no `gjkd_robot` of it (one restarted,
@@ -938,6 +959,7 @@ enum gjkd_status gjkd_remove_robot(struct gjkd_client *client, const struct gjkd
 // `client` is NULL or live; `name` NULL or NUL-terminated.
 enum gjkd_status gjkd_remove_robot_named(struct gjkd_client *client, const char *name);
 
+#if defined(GJKD_ROBOTS)
 // Registers the triangle mesh in the file at `path` (binary or ASCII STL,
 // OBJ, COLLADA `.dae`) and writes its id to `*out_id`.
 //
@@ -967,7 +989,9 @@ enum gjkd_status gjkd_register_mesh_file(struct gjkd_client *client,
                                          const struct gjkd_pose *pose,
                                          gjkd_id *out_id,
                                          struct gjkd_mesh_info *out_info);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Registers the triangle mesh of `vertex_count` vertices (`3 *
 // vertex_count` doubles, `x, y, z` each) and `triangle_count` triangles
 // (`3 * triangle_count` vertex indices; may be NULL with a count of 0 for
@@ -988,6 +1012,7 @@ enum gjkd_status gjkd_register_mesh(struct gjkd_client *client,
                                     const struct gjkd_pose *pose,
                                     gjkd_id *out_id,
                                     struct gjkd_mesh_info *out_info);
+#endif
 
 // Registers a convex `shape` and writes its id to `*out_id`.
 //
@@ -1260,6 +1285,7 @@ enum gjkd_status gjkd_distances(struct gjkd_client *client,
                                 const struct gjkd_query_options *options,
                                 const struct gjkd_results *out);
 
+#if defined(GJKD_ROBOTS)
 // Registers a robot from the URDF file at `urdf_path`: each link with
 // collision geometry (boxes, spheres, cylinders, meshes; several elements
 // make a compound) becomes an object named `<name>/<link>`, then the
@@ -1294,7 +1320,9 @@ enum gjkd_status gjkd_register_robot(struct gjkd_client *client,
                                      const char *package_path,
                                      const struct gjkd_pose *base,
                                      struct gjkd_robot **out_robot);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // `gjkd_register_robot()` from URDF text (and SRDF text, or NULL) in
 // memory; relative mesh paths are relative to `mesh_dir` (NULL: the
 // working folder). Errors as `gjkd_register_robot()` (`urdf_text`
@@ -1310,7 +1338,9 @@ enum gjkd_status gjkd_register_robot_text(struct gjkd_client *client,
                                           const char *package_path,
                                           const struct gjkd_pose *base,
                                           struct gjkd_robot **out_robot);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // The robot named `name` already on the server (one the server's scene
 // file loaded, or another client registered), given its URDF text for
 // the joint order and link names. Writes a new robot to `*out_robot`.
@@ -1326,13 +1356,17 @@ enum gjkd_status gjkd_open_robot(struct gjkd_client *client,
                                  const char *name,
                                  const char *urdf_text,
                                  struct gjkd_robot **out_robot);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Frees a robot (the robot stays on the server). NULL is allowed.
 //
 // # Safety
 // `robot` is NULL or from this library, not yet freed.
 enum gjkd_status gjkd_robot_free(struct gjkd_robot *robot);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // The robot's id and its numbers of links and moving joints (each
 // output may be NULL). The robot's id is the group id of scene questions
 // about the robot (`gjkd_group::id`); it is no object id (robot ids are
@@ -1347,7 +1381,9 @@ enum gjkd_status gjkd_robot_info(const struct gjkd_robot *robot,
                                  gjkd_id *out_id,
                                  size_t *out_links,
                                  size_t *out_joints);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Link `index` (in the URDF's order, `0 <= index < links`): its name
 // (owned by the robot, valid until `gjkd_robot_free()`) and its object id
 // (0 for a link without collision geometry). Either output may be NULL.
@@ -1361,7 +1397,9 @@ enum gjkd_status gjkd_robot_link(const struct gjkd_robot *robot,
                                  size_t index,
                                  const char **out_name,
                                  gjkd_id *out_id);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // The object id of the link named `name` (0 for a link without collision
 // geometry).
 //
@@ -1376,7 +1414,9 @@ enum gjkd_status gjkd_robot_link(const struct gjkd_robot *robot,
 enum gjkd_status gjkd_robot_link_id(const struct gjkd_robot *robot,
                                     const char *name,
                                     gjkd_id *out_id);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Moving joint `index` (in position-array order): its name (owned by the
 // robot, valid until `gjkd_robot_free()`), its limits (`-inf`, `inf` for
 // a continuous joint) and its position last set. Any output may be NULL.
@@ -1392,7 +1432,9 @@ enum gjkd_status gjkd_robot_joint(const struct gjkd_robot *robot,
                                   double *out_lower,
                                   double *out_upper,
                                   double *out_position);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Sets every moving joint of `robot` (`count` positions in joint order,
 // see `gjkd_robot_joint()`) and, if `base` is not NULL, its base pose, in
 // one round trip: the server places every link by forward kinematics. A
@@ -1418,7 +1460,9 @@ enum gjkd_status gjkd_set_joints(struct gjkd_client *client,
                                  size_t count,
                                  const struct gjkd_pose *base,
                                  bool clamp);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // `gjkd_set_joints()` by joint name: `names[i]` gets `values[i]`, joints
 // not named keep their positions last set.
 //
@@ -1435,7 +1479,9 @@ enum gjkd_status gjkd_set_joints_by_name(struct gjkd_client *client,
                                          const double *values,
                                          size_t count,
                                          bool clamp);
+#endif
 
+#if defined(GJKD_ROBOTS)
 // Every link's pose by forward kinematics, computed here as the server
 // computes it, into `out_poses` (`out_count` must be the number of
 // links; URDF order): for `count` positions (NULL with 0: the positions
@@ -1455,6 +1501,7 @@ enum gjkd_status gjkd_robot_link_poses(const struct gjkd_robot *robot,
                                        bool clamp,
                                        struct gjkd_pose *out_poses,
                                        size_t out_count);
+#endif
 
 // A row asking the distance of `a` and `b` at their stored poses, with
 // `options` (NULL: the defaults). Options out of their domain (see
@@ -1569,8 +1616,10 @@ enum gjkd_status gjkd_nearest(struct gjkd_client *client,
 // `poses` with non-zero counts), `GJKD_ERR_INVALID_ARGUMENT` (a
 // `question` that is no `gjkd_path_question`, no moving object or no
 // step, a pose that is not finite or not a unit quaternion: nothing is
-// sent), `GJKD_CODE_BATCH_TOO_LARGE` (more steps times moving objects
-// than the server's `max_batch` takes in one request).
+// sent), `GJKD_CODE_BATCH_TOO_LARGE` (the group's members and allowed
+// pairs plus one step's poses exceed the server's `max_batch`; a longer
+// path is split into several requests by this library and answered
+// whole).
 //
 // # Safety
 // As `gjkd_clearance()`; `moving` and `poses` NULL or pointing to their
@@ -1588,6 +1637,7 @@ enum gjkd_status gjkd_path(struct gjkd_client *client,
                            size_t capacity,
                            struct gjkd_scene_summary *summary);
 
+#if defined(GJKD_ROBOTS)
 // `gjkd_path()` along a motion given as joint positions of `robot`:
 // `positions` holds `step_count` steps of the robot's moving joints
 // (`dof` doubles each, in `gjkd_robot_joint()` order), `positions[s * dof
@@ -1620,6 +1670,7 @@ enum gjkd_status gjkd_path_joints(struct gjkd_client *client,
                                   struct gjkd_scene_row *rows,
                                   size_t capacity,
                                   struct gjkd_scene_summary *summary);
+#endif
 
 // Pins the calling thread to CPU `cpu`: from now on it runs there and
 // nowhere else (threads it starts later inherit the pin). Pin the thread

@@ -26,6 +26,11 @@
 // them across restarts. Remove them (remove(), remove_robot()), or set
 // RegistrationOptions::remove_on_close to have them end with the Client.
 //
+// Robots and meshes (Robot, register_robot*, register_mesh*, set_joints*,
+// path_joints) are declared under GJKD_ROBOTS, as in gjkd.h: present when
+// the library was built with its `robots` feature (the default install),
+// hidden by GJKD_NO_ROBOTS (a lean install's build flags).
+//
 //   gjkd::Client client("gjkd");
 //   gjkd::Id box = client.register_box({1, 1, 1});
 //   gjkd::Id ball = client.register_sphere(0.5, gjkd::at(3, 0, 0));
@@ -79,8 +84,10 @@ using SceneRow = gjkd_scene_row;
 using SceneSummary = gjkd_scene_summary;
 /// Scene query options; start from default_scene_options().
 using SceneOptions = gjkd_scene_options;
+#if defined(GJKD_ROBOTS)
 /// What a mesh registration made: its pieces and their deviation.
 using MeshInfo = gjkd_mesh_info;
+#endif // GJKD_ROBOTS
 /// How registrations treat names and the Client's end (see
 /// Client::set_registration_options()).
 using RegistrationOptions = gjkd_registration_options;
@@ -349,6 +356,7 @@ static_assert(sizeof(bool) == sizeof(unsigned char), "warm_started holds one boo
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
 
+#if defined(GJKD_ROBOTS)
 /// A robot registered from URDF (see Client::register_robot): its links
 /// are objects, its joints move them. Owns its gjkd_robot; holds no
 /// connection.
@@ -452,6 +460,7 @@ private:
 
     gjkd_robot *handle_ = nullptr;
 };
+#endif // GJKD_ROBOTS
 
 /// A connection to a gjkd server. Every method throws gjkd::Error on
 /// failure; see gjkd.h for each call's errors.
@@ -524,6 +533,7 @@ public:
         check(gjkd_register_cylinder(handle_, radius, half_height, rounding, name, &pose, &id));
         return id;
     }
+#if defined(GJKD_ROBOTS)
     /// Registers the mesh in an STL, OBJ or COLLADA file, scaled by `scale`
     /// (null: 1), as its hull (`decompose` 0) or a V-HACD decomposition at
     /// that resolution.
@@ -637,15 +647,18 @@ public:
         check(gjkd_set_joints_by_name(handle_, robot.native_handle(), c_names.data(),
                                       values.data(), values.size(), clamp));
     }
+#endif // GJKD_ROBOTS
     /// Removes an object this client registered. (A robot's link so
     /// removed leaves a hole: use remove_robot(); a robot's id is no
     /// object id.)
     void remove(Id id) { check(gjkd_remove(handle_, id)); }
+#if defined(GJKD_ROBOTS)
     /// Removes `robot` as a whole: its kinematics and every link object,
     /// all or nothing. `robot` then names nothing on the server.
     void remove_robot(const Robot &robot) {
         check(gjkd_remove_robot(handle_, robot.native_handle()));
     }
+#endif // GJKD_ROBOTS
     /// Removes the robot named `name` as a whole.
     void remove_robot(const std::string &name) {
         check(gjkd_remove_robot_named(handle_, name.c_str()));
@@ -842,6 +855,7 @@ public:
         return s;
     }
 
+#if defined(GJKD_ROBOTS)
     /// `question` at every step of a motion of `robot` given as joint
     /// positions: `positions` holds `positions.size() / robot.dof()` steps
     /// of `dof` positions each (in Robot::joint_names() order). Nothing
@@ -864,6 +878,7 @@ public:
                                options, rows.data(), rows.size(), &s));
         return s;
     }
+#endif // GJKD_ROBOTS
 
 private:
     static void same_size(std::size_t a, std::size_t b) {

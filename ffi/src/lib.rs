@@ -16,6 +16,13 @@
 //! `gjkd_query_pairs` takes rows laid out as the server's requests and
 //! gives rows laid out as its answers, so both are copied whole.
 //!
+//! Robots and meshes need the cargo feature `robots` (off by default,
+//! on in what `install.sh` installs): it links `gjkd-model` and through it
+//! parry3d-f64, urdf-rs and mesh-loader. The header declares their
+//! functions under `GJKD_ROBOTS`, which it defines unless the program
+//! defines `GJKD_NO_ROBOTS` (as a lean install's CMake package and
+//! pkg-config file do).
+//!
 //! The semantics are the Rust client's (`gjkd-client`) and the names follow
 //! the Python API's (`gjkd.Client`): `register_sphere`, `set_poses`,
 //! `distance`, `distances`, ...
@@ -29,10 +36,12 @@ mod connect;
 mod gradient;
 mod handle;
 mod lifetime;
+#[cfg(feature = "robots")]
 mod meshes;
 mod objects;
 mod poses;
 mod query;
+#[cfg(feature = "robots")]
 mod robots;
 mod rows;
 mod scene;
@@ -44,10 +53,12 @@ pub use connect::*;
 pub use gradient::*;
 pub use handle::gjkd_client;
 pub use lifetime::*;
+#[cfg(feature = "robots")]
 pub use meshes::*;
 pub use objects::*;
 pub use poses::*;
 pub use query::*;
+#[cfg(feature = "robots")]
 pub use robots::*;
 pub use rows::*;
 pub use scene::*;

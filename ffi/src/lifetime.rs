@@ -3,8 +3,11 @@
 
 use std::ffi::c_char;
 
-use crate::args::{req_str, required};
+use crate::args::req_str;
+#[cfg(feature = "robots")]
+use crate::args::required;
 use crate::handle::{gjkd_client, with_client};
+#[cfg(feature = "robots")]
 use crate::robots::gjkd_robot;
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::gjkd_registration_options;
@@ -47,6 +50,7 @@ pub unsafe extern "C" fn gjkd_set_registration_options(
 ///
 /// # Safety
 /// `client` and `robot` are NULL or live.
+#[cfg(feature = "robots")]
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn gjkd_remove_robot(
     client: *mut gjkd_client,

@@ -126,8 +126,13 @@ pub unsafe extern "C" fn gjkd_register_robot(
                 let base = base_of(base.as_ref())?;
                 let handle = if c.registration.reuse_names {
                     let read = |p: &Path| {
-                        std::fs::read_to_string(p)
-                            .map_err(|e| Failure::invalid(format!("{}: {e}", p.display())))
+                        std::fs::read_to_string(p).map_err(|e| {
+                            // The code Rust's `ClientError::InvalidRobot` carries.
+                            Failure::invalid_code(
+                                ErrorCode::InvalidRobot,
+                                format!("{}: {e}", p.display()),
+                            )
+                        })
                     };
                     let text = read(urdf)?;
                     let srdf = srdf.map(read).transpose()?;

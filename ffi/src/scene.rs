@@ -10,6 +10,7 @@ use rust_client::{Item, ObjectId, SceneSummary, Steps};
 use crate::args::{checked_pose, out, slice, slice_mut};
 use crate::gradient::gjkd_gradient;
 use crate::handle::{gjkd_client, with_client};
+#[cfg(feature = "robots")]
 use crate::robots::{gjkd_robot, path_steps};
 use crate::status::{Failure, gjkd_status, guard};
 use crate::types::{gjkd_answer, gjkd_id, gjkd_pose};
@@ -493,8 +494,10 @@ pub unsafe extern "C" fn gjkd_nearest(
 /// `poses` with non-zero counts), `GJKD_ERR_INVALID_ARGUMENT` (a
 /// `question` that is no `gjkd_path_question`, no moving object or no
 /// step, a pose that is not finite or not a unit quaternion: nothing is
-/// sent), `GJKD_CODE_BATCH_TOO_LARGE` (more steps times moving objects
-/// than the server's `max_batch` takes in one request).
+/// sent), `GJKD_CODE_BATCH_TOO_LARGE` (the group's members and allowed
+/// pairs plus one step's poses exceed the server's `max_batch`; a longer
+/// path is split into several requests by this library and answered
+/// whole).
 ///
 /// # Safety
 /// As `gjkd_clearance()`; `moving` and `poses` NULL or pointing to their
@@ -562,6 +565,7 @@ pub unsafe extern "C" fn gjkd_path(
 /// # Safety
 /// As `gjkd_clearance()`; `robot` NULL or live; `positions` NULL or
 /// `step_count * dof` doubles.
+#[cfg(feature = "robots")]
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn gjkd_path_joints(

@@ -119,7 +119,9 @@ impl From<ClientError> for Failure {
             ClientError::Rejected(code) => return Failure::rejected(*code, ""),
             ClientError::ResultBufferTooSmall { .. }
             | ClientError::InvalidArgument(_)
-            | ClientError::Model(_) => GJKD_ERR_INVALID_ARGUMENT,
+            | ClientError::InvalidRobot(_)
+            | ClientError::UnknownJoint(_)
+            | ClientError::InvalidMesh(_) => GJKD_ERR_INVALID_ARGUMENT,
             ClientError::Protocol(_) => GJKD_ERR_PROTOCOL,
             ClientError::VersionMismatch { .. } => GJKD_ERR_VERSION_MISMATCH,
             ClientError::Incompatible { .. } => GJKD_ERR_INCOMPATIBLE,
@@ -127,7 +129,12 @@ impl From<ClientError> for Failure {
             ClientError::TooManyClients(_) => GJKD_ERR_TOO_MANY_CLIENTS,
             ClientError::Ipc(_) => GJKD_ERR_IPC,
         };
-        Failure::new(status, e.to_string())
+        // A fault found before sending carries the code the server gives
+        // it (an unreadable robot, an unknown joint), as in Rust and Python.
+        Failure {
+            code: e.code().map_or(0, ErrorCode::raw),
+            ..Failure::new(status, e.to_string())
+        }
     }
 }
 
@@ -318,5 +325,20 @@ mod tests {
         }
         let f = Failure::from(ClientError::Rejected(ErrorCode::UnknownObject));
         assert_eq!((f.status, f.code), (GJKD_ERR_REJECTED, 1));
+        // Faults the client finds carry the server's code for them, the
+        // same as Rust's `ClientError::code` and Python's `code`.
+        let cases = [
+            (ClientError::InvalidRobot("bad".into()), 22),
+            (ClientError::UnknownJoint("nope".into()), 16),
+            (ClientError::InvalidMesh("gone.stl".into()), 0),
+        ];
+        for (e, code) in cases {
+            let words = e.to_string();
+            let f = Failure::from(e);
+            assert_eq!((f.status, f.code), (GJKD_ERR_INVALID_ARGUMENT, code));
+            assert_eq!(f.message, words);
+        }
+        assert_eq!(code_name(22), "GJKD_CODE_INVALID_ROBOT");
+        assert_eq!(code_name(16), "GJKD_CODE_UNKNOWN_NAME");
     }
 }

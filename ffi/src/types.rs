@@ -265,12 +265,13 @@ pub enum gjkd_error_code {
     /// A radius is negative, NaN or infinite.
     GJKD_CODE_INVALID_RADIUS = 7,
     /// A request has more items than the server accepts. Pair batches
-    /// (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) are
-    /// split by this library and never see it; a scene question sent as
-    /// one request does: `gjkd_clearance()` and `gjkd_within()` with more
-    /// members and allowed pairs, `gjkd_path()` and `gjkd_path_joints()`
-    /// with more steps times moving objects (or joint items), than the
-    /// server's `max_batch` (`gjkd_server_info()`).
+    /// (`gjkd_set_poses()`, `gjkd_distances()`, `gjkd_query_pairs()`) and
+    /// paths longer than one request (`gjkd_path()`, `gjkd_path_joints()`)
+    /// are split by this library; what cannot be split does see it:
+    /// `gjkd_clearance()`, `gjkd_within()` and `gjkd_nearest()` with more
+    /// members and allowed pairs than the server's `max_batch`
+    /// (`gjkd_server_info()`), and a path whose members and allowed pairs
+    /// plus one step's poses (or joint items) exceed it.
     GJKD_CODE_BATCH_TOO_LARGE = 8,
     /// A batch has no items.
     GJKD_CODE_EMPTY_BATCH = 9,

@@ -5,6 +5,8 @@
 //! again under valgrind (no leak, no memory error) where it is installed.
 //! The C++ program is built as C++17, with Eigen's conversions when Eigen
 //! is installed, and as C++20 (the `std::span` overloads).
+// Both programs register robots: the library's `robots` feature.
+#![cfg(feature = "robots")]
 
 mod common;
 

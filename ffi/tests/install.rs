@@ -2,6 +2,9 @@
 //! and pkg-config find: the example project `examples/cmake` is configured
 //! against it, built, and its programs (shared and static) run against a
 //! real server. Skipped, saying so, where cmake or pkg-config is missing.
+// The example project's C++ program registers a robot: the library's
+// `robots` feature.
+#![cfg(feature = "robots")]
 
 mod common;
 

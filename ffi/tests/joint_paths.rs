@@ -1,6 +1,8 @@
 //! `gjkd_path_joints`: scene questions along joint positions answer the
 //! distances forward kinematics gives in closed form, move nothing on the
 //! server, and refuse bad positions naming their step and joint.
+// Joint paths need robots: the library's `robots` feature.
+#![cfg(feature = "robots")]
 
 use std::ffi::{CStr, CString};
 use std::ptr::{null, null_mut};

@@ -5,6 +5,8 @@
 //!
 //! `GJKD_LEAK_CALLS` sets the number of calls (default 100 000, about half
 //! a minute under valgrind). Skipped, saying so, where valgrind is missing.
+// The program registers and moves a robot: the library's `robots` feature.
+#![cfg(feature = "robots")]
 
 mod common;
 

@@ -475,10 +475,20 @@ class _Objects:
 
 @final
 class Client(_Objects):
-    """A connection to a gjkd server on this host."""
+    """A connection to a gjkd server on this host.
+
+    Objects outlive the client that registered them (a server with
+    persistence keeps them across restarts); with ``remove_on_close=True``
+    the objects and robots this client registers are removed when it closes
+    (best effort: a server gone then keeps them).
+    """
 
     def __new__(
-        cls, service: str = "gjkd", timeout: float = 1.0, connect_timeout: Optional[float] = None
+        cls,
+        service: str = "gjkd",
+        timeout: float = 1.0,
+        connect_timeout: Optional[float] = None,
+        remove_on_close: bool = False,
     ) -> Self: ...
     @property
     def service(self) -> str:
@@ -511,7 +521,10 @@ class Client(_Objects):
         folder of each ``$AMENT_PREFIX_PATH`` prefix, as ROS searches them
         (see the README's robot section)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
-        """The robot ``name`` already on the server."""
+        """The robot ``name`` already on the server, its joints and links read
+        from ``urdf_text``. Raises :class:`gjkd.InvalidInput` with ``code``
+        ``INVALID_ROBOT`` (``field`` ``"urdf"``) for text that cannot be read,
+        :class:`gjkd.NotFound` with ``UNKNOWN_NAME`` for no robot of that name."""
     def remove_robot(self, robot: Union[Robot, str]) -> None:
         """Removes a robot (or the robot named so) with every link."""
     def set_joints(

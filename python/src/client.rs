@@ -21,10 +21,14 @@ const DEFAULT_MAX_BATCH: usize = 1024;
 /// A connection to a gjkd server (`python -m gjkd serve`, `gjkd serve`, or
 /// `gjkd.Server`) on this host, over shared memory.
 ///
-/// `Client(service="gjkd", timeout=1.0, connect_timeout=None)` connects to
-/// the server of `service`, waiting up to `connect_timeout` seconds
-/// (default: `timeout`) for one to come up; `timeout` bounds every later
-/// call. Use it as a context manager, or call `close()`.
+/// `Client(service="gjkd", timeout=1.0, connect_timeout=None,
+/// remove_on_close=False)` connects to the server of `service`, waiting up
+/// to `connect_timeout` seconds (default: `timeout`) for one to come up;
+/// `timeout` bounds every later call. Use it as a context manager, or call
+/// `close()`. Objects outlive the client that registered them (a server
+/// with persistence keeps them across restarts); with
+/// `remove_on_close=True` the objects and robots this client registers are
+/// removed when it closes (best effort: a server gone then keeps them).
 ///
 /// Register objects once (`register_sphere`, `register_box`, ...: each
 /// returns an int id), store their poses (`set_pose`, `set_poses`), then
@@ -221,25 +225,28 @@ impl Backend for Client {
 
 backend_methods!(Client, {
     #[new]
-    #[pyo3(signature = (service = "gjkd", timeout = 1.0, connect_timeout = None))]
+    #[pyo3(signature = (service = "gjkd", timeout = 1.0, connect_timeout = None, remove_on_close = false))]
     fn new(
         py: Python<'_>,
         service: &str,
         timeout: f64,
         connect_timeout: Option<f64>,
+        remove_on_close: bool,
     ) -> PyResult<Self> {
         let t = seconds(py, "timeout", timeout)?;
         let ct = connect_timeout
             .map(|s| seconds(py, "connect_timeout", s))
             .transpose()?;
-        let mut builder = gjkd_client::Client::builder(service).timeout(t);
+        let mut builder = gjkd_client::Client::builder(service)
+            .timeout(t)
+            .remove_on_close(remove_on_close);
         if let Some(ct) = ct {
             builder = builder.connect_timeout(ct);
         }
         let connected = py
             .detach(move || OnThisThread::new(builder.connect()))
             .into_inner();
-        let inner = connected.map_err(|e| errors::client(py, e, None))?;
+        let inner = connected.map_err(|e| errors::client(py, e.into(), None))?;
         let max_batch = inner
             .server_info()
             .map_or(DEFAULT_MAX_BATCH, |i| i.max_batch as usize);

@@ -157,7 +157,11 @@ pub fn client(py: Python<'_>, e: ClientError, field: Option<&str>) -> PyErr {
         ClientError::ServerGone(_) => (Kind::ServerGone, None),
         ClientError::Timeout(_) => (Kind::Timeout, None),
         ClientError::Rejected(code) => return refused(py, *code, field, None),
-        ClientError::InvalidArgument(_) | ClientError::Model(_) => (Kind::InvalidInput, None),
+        ClientError::InvalidArgument(_) | ClientError::InvalidMesh(_) => (Kind::InvalidInput, None),
+        // Faults the client finds before sending carry the code the server
+        // gives them, as in Rust (`ClientError::code`) and C.
+        ClientError::InvalidRobot(_) => (Kind::InvalidInput, e.code()),
+        ClientError::UnknownJoint(_) => (Kind::NotFound, e.code()),
         ClientError::Protocol(_) => (Kind::Protocol, None),
         ClientError::Ipc(_) => (Kind::Ipc, None),
         ClientError::VersionMismatch { .. } | ClientError::Incompatible { .. } => {
@@ -171,7 +175,7 @@ pub fn client(py: Python<'_>, e: ClientError, field: Option<&str>) -> PyErr {
         kind,
         message: e.to_string(),
         code,
-        field: if kind == Kind::InvalidInput {
+        field: if kind == Kind::InvalidInput || code.is_some() {
             field
         } else {
             None

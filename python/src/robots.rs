@@ -394,19 +394,9 @@ pub fn register_robot(
                 &base,
             )
         })?
-        .map_err(|e| match e {
-            // A robot the client cannot read carries the code the server
-            // gives a robot it cannot attach (docs/errors.md).
-            gjkd_client::ClientError::Model(message) => Raise {
-                kind: Kind::InvalidInput,
-                message,
-                code: Some(ErrorCode::InvalidRobot),
-                field: Some("urdf"),
-                index: None,
-            }
-            .into_err(py),
-            e => errors::client(py, e, Some("urdf")),
-        })?;
+        // A robot the client cannot read carries the code the server gives
+        // a robot it cannot attach (docs/errors.md): `ClientError::code`.
+        .map_err(|e| errors::client(py, e, Some("urdf")))?;
     Ok(Robot::new(handle, base))
 }
 
@@ -421,7 +411,7 @@ pub fn open_robot(
         .call(py, |c| c.open_robot(name, urdf))?
         .map_err(|e| {
             let field = match e {
-                gjkd_client::ClientError::Model(_) => "urdf",
+                gjkd_client::ClientError::InvalidRobot(_) => "urdf",
                 _ => "name",
             };
             errors::client(py, e, Some(field))

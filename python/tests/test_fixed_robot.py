@@ -42,3 +42,9 @@ def test_robot_faults_carry_the_codes_of_the_server(client: gjkd.Client) -> None
         client.register_robot(unique_service("bad"), urdf_text="<robot name='x'><link")
     assert bad.value.code == gjkd.ErrorCode.INVALID_ROBOT
     assert bad.value.field == "urdf"
+    # Opening a robot by name reads its URDF here too: the same fault, the
+    # same code (Rust's ClientError::InvalidRobot, C's GJKD_CODE_INVALID_ROBOT).
+    with pytest.raises(gjkd.InvalidInput) as unread:
+        client.open_robot(unique_service("coded"), "<robot name='x'><link")
+    assert unread.value.code == gjkd.ErrorCode.INVALID_ROBOT
+    assert unread.value.field == "urdf"

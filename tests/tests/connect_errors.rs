@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use gjkd_client::{Client, ClientError};
+use gjkd_client::{Client, ConnectError};
 use gjkd_e2e::unique_service;
 use gjkd_proto::{PROTOCOL_VERSION, admin_service_name, query_service_name};
 use iceoryx2::prelude::*;
@@ -20,7 +20,7 @@ fn node() -> Node<ipc::Service> {
         .expect("iceoryx2 node")
 }
 
-fn connect(service: &str) -> (Result<Client, ClientError>, Duration) {
+fn connect(service: &str) -> (Result<Client, ConnectError>, Duration) {
     let start = Instant::now();
     let result = Client::builder(service).timeout(CONNECT_TIMEOUT).connect();
     (result, start.elapsed())
@@ -41,7 +41,7 @@ fn a_server_of_another_protocol_version_is_named() {
 
     let (result, waited) = connect(&service);
     match result {
-        Err(ClientError::VersionMismatch {
+        Err(ConnectError::VersionMismatch {
             service: s,
             server,
             client,
@@ -75,7 +75,7 @@ fn a_server_of_an_older_protocol_version_is_named() {
 
     let (result, waited) = connect(&service);
     match result {
-        Err(ClientError::VersionMismatch { server, client, .. }) => {
+        Err(ConnectError::VersionMismatch { server, client, .. }) => {
             assert_eq!((server, client), (theirs, PROTOCOL_VERSION));
         }
         other => panic!("expected VersionMismatch, got {:?}", other.map(|_| ())),
@@ -98,7 +98,7 @@ fn a_service_with_other_message_types_is_incompatible() {
         .expect("impostor query service");
 
     match connect(&service).0 {
-        Err(ClientError::Incompatible { service: s, cause }) => {
+        Err(ConnectError::Incompatible { service: s, cause }) => {
             assert_eq!(s, query);
             assert!(cause.contains("message types"), "cause: {cause}");
         }
@@ -118,7 +118,7 @@ fn a_service_of_another_pattern_is_incompatible() {
         .expect("impostor publish-subscribe service");
 
     match connect(&service).0 {
-        Err(ClientError::Incompatible { service: s, cause }) => {
+        Err(ConnectError::Incompatible { service: s, cause }) => {
             assert_eq!(s, query);
             assert!(cause.contains("publish-subscribe"), "cause: {cause}");
         }
@@ -134,7 +134,7 @@ fn no_service_at_all_is_a_server_gone() {
         .timeout(Duration::from_millis(200))
         .connect();
     match result {
-        Err(ClientError::ServerGone(s)) => assert_eq!(s, service),
+        Err(ConnectError::ServerGone(s)) => assert_eq!(s, service),
         other => panic!("expected ServerGone, got {:?}", other.map(|_| ())),
     }
     assert!(
@@ -159,7 +159,7 @@ fn a_server_half_set_up_is_waited_for_not_called_incompatible() {
         .timeout(Duration::from_millis(200))
         .connect();
     match result {
-        Err(ClientError::ServerGone(s)) => assert_eq!(s, service),
+        Err(ConnectError::ServerGone(s)) => assert_eq!(s, service),
         other => panic!("expected ServerGone, got {:?}", other.map(|_| ())),
     }
 }

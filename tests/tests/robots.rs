@@ -183,10 +183,13 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
         client.set_joints(&mut arm, &[0.3], None),
         Err(ClientError::InvalidArgument(_))
     ));
-    assert!(matches!(
-        client.set_joints_by_name(&mut arm, &[("flange", 0.1)]),
-        Err(ClientError::Model(m)) if m.contains("flange")
-    ));
+    // Found here before sending, with the code the server gives an
+    // unknown name (as Python's NotFound and C's last error code carry).
+    let e = client
+        .set_joints_by_name(&mut arm, &[("flange", 0.1)])
+        .unwrap_err();
+    assert_eq!(e, ClientError::UnknownJoint("flange".into()));
+    assert_eq!(e.code(), Some(ErrorCode::UnknownName));
     assert_eq!(client.distance(tip, ball, &o).unwrap().distance, before);
     assert_eq!(arm.positions, [0.3, 0.4, 0.05]);
     // Clamping, asked for, moves the elbow to its limit.
@@ -209,9 +212,11 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
         )
         .unwrap_err();
     assert!(
-        matches!(&e, ClientError::Model(m) if m.contains("gone.stl")),
+        matches!(&e, ClientError::InvalidRobot(m) if m.contains("gone.stl")),
         "{e}"
     );
+    // The code the server gives a robot it cannot attach.
+    assert_eq!(e.code(), Some(ErrorCode::InvalidRobot));
     // A cylinder is exact, but its sizes are checked like any other.
     let cylinder = URDF.replace(
         r#"<sphere radius="0.03"/>"#,
@@ -228,7 +233,7 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
         )
         .unwrap_err();
     assert!(
-        matches!(&e, ClientError::Model(m) if m.contains("cylinder")),
+        matches!(&e, ClientError::InvalidRobot(m) if m.contains("cylinder")),
         "{e}"
     );
     // The same name again: its links are taken, and what was registered
@@ -243,10 +248,11 @@ fn bad_joints_and_robots_are_refused_and_change_nothing() {
         )),
         ErrorCode::NameTaken
     );
-    assert!(matches!(
-        client.attach_robot("arm", "<robot", None, &Isometry3::identity()),
-        Err(ClientError::Model(_))
-    ));
+    let e = client
+        .attach_robot("arm", "<robot", None, &Isometry3::identity())
+        .unwrap_err();
+    assert!(matches!(e, ClientError::InvalidRobot(_)), "{e}");
+    assert_eq!(e.code(), Some(ErrorCode::InvalidRobot));
     assert_eq!(client.stats().unwrap().objects, objects);
     std::fs::remove_dir_all(dir).unwrap();
 }

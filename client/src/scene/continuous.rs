@@ -10,7 +10,9 @@
 use gjkd_proto::{PathMode, SceneRow, scene_flags};
 
 use super::{SceneQuery, Steps};
-use crate::{Answer, Client, ClientError, ErrorCode, ObjectId, RobotHandle};
+#[cfg(feature = "robots")]
+use crate::RobotHandle;
+use crate::{Answer, Client, ClientError, ErrorCode, ObjectId};
 
 /// The first contact along one segment of a continuous path.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -131,6 +133,7 @@ impl Client {
     /// position per joint; as [`SceneQuery::into_contacts`] otherwise
     /// ([`ErrorCode::OutOfLimits`], [`ErrorCode::NonFinitePose`],
     /// [`ErrorCode::Malformed`] for `from == to`).
+    #[cfg(feature = "robots")]
     pub fn edge_contact(
         &mut self,
         robot: &RobotHandle,

@@ -8,6 +8,9 @@
 //! moving (`moves.rs`), poses read back (`poses.rs`), meshes (`meshes.rs`), their errors
 //! (`mesh_errors.rs`, `robot_errors.rs`), cylinders (`cylinders.rs`).
 
+// Robots and meshes are in the library with its `robots` feature only.
+#![cfg(feature = "robots")]
+
 mod arm;
 mod cylinders;
 mod mesh_errors;

@@ -30,7 +30,9 @@ fn every_robot_error_has_its_status() {
     // SAFETY: valid pointers or NULLs where tested.
     unsafe {
         let (mut id, mut r) = (0, null_mut());
-        // Robot registration.
+        // Robot registration: a robot that cannot be read carries the code
+        // the server gives a robot it cannot attach, as in Rust and Python.
+        let robot_code = code(gjkd_error_code::GJKD_CODE_INVALID_ROBOT);
         let missing = cstr(&dir.join("none.urdf"));
         fails(
             gjkd_register_robot(
@@ -43,7 +45,7 @@ fn every_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "none.urdf",
         );
         fails(
@@ -98,7 +100,7 @@ fn every_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "none.srdf",
         );
         fails(
@@ -141,7 +143,7 @@ fn every_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "",
         );
         // Text: the relative mesh path resolves against mesh_dir only.
@@ -157,7 +159,7 @@ fn every_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "fore.stl",
         );
         let bad_srdf = c"<robot name=\"testarm\"><disable_collisions link1=\"base\" link2=\"nolink\"/></robot>";
@@ -174,7 +176,7 @@ fn every_robot_error_has_its_status() {
                 &mut r,
             ),
             inv,
-            0,
+            robot_code,
             "nolink",
         );
         assert!(r.is_null(), "a failed registration writes NULL");
@@ -200,8 +202,8 @@ fn every_robot_error_has_its_status() {
         fails(
             gjkd_open_robot(c, c"arm".as_ptr(), c"<robot".as_ptr(), &mut r),
             inv,
-            0,
-            "",
+            robot_code,
+            "the robot cannot be read",
         );
 
         // Listing.

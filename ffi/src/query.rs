@@ -111,7 +111,7 @@ unsafe fn set_poses(
 }
 
 /// The query item of pair `(a, b)` with `options`, and each pose given.
-fn pair_item(
+pub(crate) fn pair_item(
     template: &Item,
     a: u64,
     b: u64,
@@ -204,7 +204,7 @@ pub unsafe extern "C" fn gjkd_distance(
 }
 
 /// The caller's output arrays, as slices.
-struct Outputs<'a> {
+pub(crate) struct Outputs<'a> {
     distance: &'a mut [f64],
     error: &'a mut [u32],
     lower: Option<&'a mut [f64]>,
@@ -224,7 +224,7 @@ impl<'a> Outputs<'a> {
     ///
     /// # Safety
     /// Each non-NULL pointer of `r` has room for its rows.
-    unsafe fn new(r: &gjkd_results, n: usize) -> Result<Self, Failure> {
+    pub(crate) unsafe fn new(r: &gjkd_results, n: usize) -> Result<Self, Failure> {
         // SAFETY: the caller's promise, field by field.
         unsafe {
             Ok(Outputs {
@@ -247,7 +247,7 @@ impl<'a> Outputs<'a> {
     }
 
     /// Writes `results` into rows `start..`.
-    fn write(&mut self, start: usize, results: &[ItemResult]) {
+    pub(crate) fn write(&mut self, start: usize, results: &[ItemResult]) {
         /// `dst[i] = value` when the caller asked for that field.
         #[inline(always)]
         fn put<T>(dst: &mut Option<&mut [T]>, i: usize, value: T) {
@@ -345,7 +345,7 @@ pub unsafe extern "C" fn gjkd_distances(
 ///
 /// # Safety
 /// A non-NULL `ptr` points to `count` poses.
-unsafe fn optional<'a>(
+pub(crate) unsafe fn optional<'a>(
     ptr: *const gjkd_pose,
     count: usize,
     what: &str,

@@ -111,6 +111,32 @@ fn check(s: &Scene, pair: &ScenePair) {
 }
 
 #[test]
+fn readme_signed_rows_example_runs() -> Result<(), ClientError> {
+    let server = Server::start("doc-signed-rows", &[]);
+    let service = server.service.as_str();
+    // --- from README.md, "Signed distance in batches and scene rows" ---
+
+    let mut client = Client::connect(service)?;
+    let crate_ = client.register_cuboid(Vector3::new(1.0, 1.0, 1.0), 0.0)?;
+    let ball = client.register_sphere(0.5)?;
+    client.set_pose(ball, &Isometry3::translation(0.8, 0.0, 0.0))?; // 0.7 deep
+    let mut pairs = [ScenePair::default(); 8];
+    let got = client
+        .within(crate_, 0.0)
+        .signed_distance()
+        .into_pairs(&mut pairs)?;
+    assert_eq!(got.written, 1); // overlapping: within any margin
+    let signed = pairs[0]
+        .answer
+        .expect("answered")
+        .signed
+        .expect("asked for");
+    assert!((signed.value + 0.7).abs() < 1e-9);
+    assert!(signed.lower <= -0.7 && -0.7 <= signed.upper);
+    Ok(())
+}
+
+#[test]
 fn every_question_carries_the_signed_distance_when_asked() -> Result<(), ClientError> {
     let server = Server::start("signed-rows", &[]);
     let mut client = Client::connect(&server.service)?;

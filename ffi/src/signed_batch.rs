@@ -2,12 +2,12 @@
 //! optional output for the signed distance and its certified interval.
 
 use gjkd_proto::{item_flags, result_flags};
-use rust_client::ItemResult;
+use rust_client::{Item, ItemResult};
 
-use crate::args::{required, slice, slice_mut};
-use crate::handle::{gjkd_client, with_client};
-use crate::query::{Outputs, optional, pair_item, template};
-use crate::status::{Failure, gjkd_status, guard};
+use crate::args::slice_mut;
+use crate::handle::gjkd_client;
+use crate::query::distances_with;
+use crate::status::{Failure, gjkd_status};
 use crate::types::{gjkd_id, gjkd_pose, gjkd_query_options, gjkd_results};
 
 /// The caller's arrays for the signed distances of `count` pairs (see
@@ -82,48 +82,41 @@ pub unsafe extern "C" fn gjkd_signed_distances(
     out: *const gjkd_results,
     signed_out: *const gjkd_signed_results,
 ) -> gjkd_status {
-    guard("gjkd_signed_distances", || {
-        // SAFETY: the caller's promises.
-        unsafe {
-            with_client(client, |c| {
-                let mut template = template(options)?;
-                if count == 0 {
-                    return Ok(());
+    // SAFETY: the caller's promise: NULL or readable.
+    let signed_out = unsafe { signed_out.as_ref() };
+    // `signed_out`'s arrays are read once the common arguments are
+    // checked (a count of 0 reads nothing).
+    let prepare = |mut template: Item| {
+        let Some(s) = signed_out else {
+            return Ok((template, None));
+        };
+        template.flags |= item_flags::SIGNED_DISTANCE;
+        // SAFETY: the caller's promise: `count` doubles each.
+        let outputs = unsafe {
+            SignedOutputs {
+                value: slice_mut(s.value, count, "signed_out.value")?
+                    .ok_or_else(|| Failure::null("signed_out.value"))?,
+                lower: slice_mut(s.lower, count, "signed_out.lower")?,
+                upper: slice_mut(s.upper, count, "signed_out.upper")?,
+            }
+        };
+        Ok((template, Some(outputs)))
+    };
+    // SAFETY: forwarded.
+    unsafe {
+        distances_with(
+            "gjkd_signed_distances",
+            client,
+            (pairs, count),
+            (poses_a, poses_b),
+            options,
+            out,
+            prepare,
+            |signed: &mut Option<SignedOutputs<'_>>, start, results| {
+                if let Some(signed) = signed.as_mut() {
+                    signed.write(start, results);
                 }
-                let results = required(out, "out")?;
-                let pairs = slice(pairs.cast::<[gjkd_id; 2]>(), count, "pairs")?;
-                let poses_a = optional(poses_a, count, "poses_a")?;
-                let poses_b = optional(poses_b, count, "poses_b")?;
-                let mut outputs = Outputs::new(results, count)?;
-                let mut signed = match signed_out.as_ref() {
-                    Some(s) => {
-                        template.flags |= item_flags::SIGNED_DISTANCE;
-                        Some(SignedOutputs {
-                            value: slice_mut(s.value, count, "signed_out.value")?
-                                .ok_or_else(|| Failure::null("signed_out.value"))?,
-                            lower: slice_mut(s.lower, count, "signed_out.lower")?,
-                            upper: slice_mut(s.upper, count, "signed_out.upper")?,
-                        })
-                    }
-                    None => None,
-                };
-                let item = |i: usize| {
-                    let [a, b] = pairs[i];
-                    pair_item(
-                        &template,
-                        a,
-                        b,
-                        poses_a.map(|p| &p[i]),
-                        poses_b.map(|p| &p[i]),
-                    )
-                };
-                c.run(count, item, |start, results| {
-                    outputs.write(start, results);
-                    if let Some(signed) = signed.as_mut() {
-                        signed.write(start, results);
-                    }
-                })
-            })
-        }
-    })
+            },
+        )
+    }
 }

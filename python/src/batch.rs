@@ -342,7 +342,6 @@ impl Distances {
         self.warm_started.bind(py).clone()
     }
 
-    /// `(N,)` bool: the rows that were answered (`error == 0`).
     /// `(N,)` float64: the signed distances, NaN in rows without one.
     #[getter]
     fn signed_distance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -361,6 +360,7 @@ impl Distances {
         self.signed_upper.bind(py).clone()
     }
 
+    /// `(N,)` bool: the rows that were answered (`error == 0`).
     #[getter]
     fn ok<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.error.bind(py).call_method1("__eq__", (0u32,))

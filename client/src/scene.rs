@@ -391,6 +391,18 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
             .flag(scene_flags::GRADIENT_BASE, base)
     }
 
+    /// Every row also carries its pair's signed distance with its
+    /// certified interval ([`Answer::signed`]): the distance when apart
+    /// (the same interval), minus the penetration depth when overlapping,
+    /// with the depth's witnesses and normal (see
+    /// [`scene_flags::SIGNED_DISTANCE`]). Which rows are reported does not
+    /// change: every overlapping pair has distance 0, so [`Client::within`]
+    /// reports it whatever the margin and however deep. Refused with
+    /// [`SceneQuery::continuous`] (default off).
+    pub fn signed_distance(self) -> Self {
+        self.flag(scene_flags::SIGNED_DISTANCE, true)
+    }
+
     /// [`Client::within`]: every pair of the scene, not only the group
     /// against the rest.
     pub fn all_pairs(self) -> Self {

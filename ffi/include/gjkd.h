@@ -731,6 +731,15 @@ typedef struct gjkd_scene_options {
   // `GJKD_PATH_CONTINUOUS`: the widest bracket of a first contact, in
   // the segment's `s`, `> 0` (default 1e-6).
   double bracket;
+  // Every row also carries its pair's signed distance with its
+  // certified interval (`gjkd_result`'s `signed_distance`,
+  // `signed_lower`, `signed_upper`, flagged
+  // `GJKD_RESULT_SIGNED_DISTANCE`): the distance apart, minus the
+  // penetration depth overlapping, with the depth's witnesses. Which
+  // rows are reported does not change: every overlapping pair has
+  // distance 0, so within reports it whatever the margin. Refused
+  // (`GJKD_CODE_MALFORMED`) with `GJKD_PATH_CONTINUOUS`.
+  bool signed_distance;
 } gjkd_scene_options;
 
 // The objects a scene question is about: `id` (a robot, whose links are
@@ -802,6 +811,20 @@ typedef struct gjkd_scene_summary {
   // prefix of the answer.
   bool truncated;
 } gjkd_scene_summary;
+
+// The caller's arrays for the signed distances of `count` pairs (see
+// `gjkd_signed_distances()`): `value` is required, `lower` and `upper`
+// may be NULL (not wanted). Row `i` of a failed pair has zeros.
+typedef struct gjkd_signed_results {
+  // `count` signed distances: the distance apart, minus the
+  // penetration depth (the shortest translation that separates the
+  // shapes) overlapping. Required.
+  double *value;
+  // `count` certified lower bounds on the signed distance.
+  double *lower;
+  // `count` certified upper bounds on the signed distance.
+  double *upper;
+} gjkd_signed_results;
 
 #ifdef __cplusplus
 extern "C" {
@@ -1671,6 +1694,31 @@ enum gjkd_status gjkd_path_joints(struct gjkd_client *client,
                                   size_t capacity,
                                   struct gjkd_scene_summary *summary);
 #endif
+
+// `gjkd_distances()` that also answers each pair's signed distance with
+// its certified interval into `signed_out` (see `gjkd_signed_results`),
+// or, when `signed_out` is NULL, exactly `gjkd_distances()`.
+//
+// A pair apart has its distance as signed distance (the same interval;
+// it costs nothing more); a pair that may overlap is expanded, and its
+// row's `point_a`, `point_b`, `normal` and `pieces` in `out` are then the
+// depth's witnesses, direction (along which B leaves A) and deepest piece
+// pair, with `point_b - point_a = value * normal`.
+//
+// Errors: as `gjkd_distances()`, plus `GJKD_ERR_NULL_POINTER` for
+// `signed_out->value` (with a non-zero count).
+//
+// # Safety
+// As `gjkd_distances()`; `signed_out` is NULL or readable, and each of
+// its non-NULL pointers points to `count` doubles.
+enum gjkd_status gjkd_signed_distances(struct gjkd_client *client,
+                                       const gjkd_id *pairs,
+                                       size_t count,
+                                       const struct gjkd_pose *poses_a,
+                                       const struct gjkd_pose *poses_b,
+                                       const struct gjkd_query_options *options,
+                                       const struct gjkd_results *out,
+                                       const struct gjkd_signed_results *signed_out);
 
 // Pins the calling thread to CPU `cpu`: from now on it runs there and
 // nowhere else (threads it starts later inherit the pin). Pin the thread

@@ -310,7 +310,40 @@ pub unsafe extern "C" fn gjkd_distances(
     options: *const gjkd_query_options,
     out: *const gjkd_results,
 ) -> gjkd_status {
-    guard("gjkd_distances", || {
+    // SAFETY: forwarded.
+    unsafe {
+        distances_with(
+            "gjkd_distances",
+            client,
+            (pairs, count),
+            (poses_a, poses_b),
+            options,
+            out,
+            |template| Ok((template, ())),
+            |_, _, _| {},
+        )
+    }
+}
+
+/// `gjkd_distances()`'s body, shared with the calls that ask more of each
+/// pair: `prepare` may add to the query template and check the caller's
+/// further arrays (its state `S`) once the common arguments are checked,
+/// and `more` sees every chunk of results after `out` is written.
+///
+/// # Safety
+/// As `gjkd_distances()`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) unsafe fn distances_with<S>(
+    call: &'static str,
+    client: *mut gjkd_client,
+    (pairs, count): (*const gjkd_id, usize),
+    (poses_a, poses_b): (*const gjkd_pose, *const gjkd_pose),
+    options: *const gjkd_query_options,
+    out: *const gjkd_results,
+    prepare: impl FnOnce(Item) -> Result<(Item, S), Failure>,
+    mut more: impl FnMut(&mut S, usize, &[ItemResult]),
+) -> gjkd_status {
+    guard(call, || {
         // SAFETY: the caller's promises.
         unsafe {
             with_client(client, |c| {
@@ -325,6 +358,7 @@ pub unsafe extern "C" fn gjkd_distances(
                 let poses_a = optional(poses_a, count, "poses_a")?;
                 let poses_b = optional(poses_b, count, "poses_b")?;
                 let mut outputs = Outputs::new(results, count)?;
+                let (template, mut state) = prepare(template)?;
                 let item = |i: usize| {
                     let [a, b] = pairs[i];
                     pair_item(
@@ -335,7 +369,10 @@ pub unsafe extern "C" fn gjkd_distances(
                         poses_b.map(|p| &p[i]),
                     )
                 };
-                c.run(count, item, |start, results| outputs.write(start, results))
+                c.run(count, item, |start, results| {
+                    outputs.write(start, results);
+                    more(&mut state, start, results);
+                })
             })
         }
     })

@@ -85,6 +85,15 @@ pub struct gjkd_scene_options {
     /// `GJKD_PATH_CONTINUOUS`: the widest bracket of a first contact, in
     /// the segment's `s`, `> 0` (default 1e-6).
     pub bracket: f64,
+    /// Every row also carries its pair's signed distance with its
+    /// certified interval (`gjkd_result`'s `signed_distance`,
+    /// `signed_lower`, `signed_upper`, flagged
+    /// `GJKD_RESULT_SIGNED_DISTANCE`): the distance apart, minus the
+    /// penetration depth overlapping, with the depth's witnesses. Which
+    /// rows are reported does not change: every overlapping pair has
+    /// distance 0, so within reports it whatever the margin. Refused
+    /// (`GJKD_CODE_MALFORMED`) with `GJKD_PATH_CONTINUOUS`.
+    pub signed_distance: bool,
 }
 
 impl Default for gjkd_scene_options {
@@ -107,6 +116,7 @@ impl Default for gjkd_scene_options {
             gradient_base: false,
             linear_quaternions: false,
             bracket: gjkd_proto::DEFAULT_BRACKET,
+            signed_distance: false,
         }
     }
 }
@@ -269,6 +279,7 @@ impl<'a> Call<'a> {
                 scene_flags::GRADIENT_BASE,
             ),
             (options.linear_quaternions, scene_flags::LINEAR_QUATERNION),
+            (options.signed_distance, scene_flags::SIGNED_DISTANCE),
         ];
         request.flags = bits.iter().filter(|b| b.0).fold(0, |f, b| f | b.1);
         if options.use_cutoff {

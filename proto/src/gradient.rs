@@ -35,9 +35,12 @@ pub mod gradient_flags {
     /// entries hold it.
     pub const PRESENT: u32 = 1;
     /// The nearest points are not unique (parallel faces or edges, a face
-    /// and an edge along it): the distance may have no gradient here, and
-    /// the values are a one-sided (sub)gradient, that of the witness points
-    /// reported.
+    /// and an edge along it), or, for overlapping objects, the penetration
+    /// depth is reached along more than one direction within its certified
+    /// interval (a sphere's centre on a box's medial axis, a box centred in
+    /// a bigger one, crossing capsules): the distance may have no gradient
+    /// here, and the values are a one-sided (sub)gradient, that of the
+    /// witness points reported.
     pub const NOT_UNIQUE: u32 = 1 << 1;
     /// The last 6 columns are the robot base's twist.
     pub const BASE: u32 = 1 << 2;

@@ -162,6 +162,25 @@ pub mod scene_flags {
     /// the quaternions are taken with the signs given. Malformed in any
     /// other mode.
     pub const LINEAR_QUATERNION: u32 = 1 << 9;
+    /// Every reported row also carries its pair's signed distance with its
+    /// certified interval ([`ItemResult::signed_distance`](crate::ItemResult::signed_distance),
+    /// `signed_lower`, `signed_upper`, flagged
+    /// [`result_flags::SIGNED_DISTANCE`](crate::result_flags::SIGNED_DISTANCE)),
+    /// at the row's step: a pair apart carries its distance (the same
+    /// value and interval, also for a row answered from motion bounds or
+    /// at a margin's early exit), a pair that may overlap minus its
+    /// penetration depth, with the depth's witnesses, normal and pieces.
+    /// It changes which rows are reported in no way: the questions compare
+    /// the distance, which is 0 for every overlapping pair, so
+    /// [`SceneKind::Within`](super::SceneKind::Within) with any margin
+    /// reports every overlapping pair however deep, and
+    /// [`SceneKind::Nearest`](super::SceneKind::Nearest) and
+    /// [`SceneKind::Clearance`](super::SceneKind::Clearance) rank
+    /// overlapping objects as equally near (distance 0), not by depth.
+    /// Refused (malformed) with
+    /// [`PathMode::Continuous`](super::PathMode::Continuous), whose rows
+    /// answer poses between the waypoints.
+    pub const SIGNED_DISTANCE: u32 = 1 << 11;
     /// Every bit this version knows; others are refused as malformed.
     pub const ALL: u32 = WARM_START
         | MOTION_BOUNDS
@@ -173,7 +192,8 @@ pub mod scene_flags {
         | SELF_PAIRS
         | GRADIENTS
         | GRADIENT_BASE
-        | LINEAR_QUATERNION;
+        | LINEAR_QUATERNION
+        | SIGNED_DISTANCE;
 }
 
 /// Bits of [`SceneReply::flags`].
@@ -292,6 +312,8 @@ pub struct SceneRow {
     /// inside the interval for [`Status::Closer`](crate::Status::Closer)
     /// (a margin's early exit) and [`Status::Bounded`](crate::Status::Bounded)
     /// (motion bounds); [`scene_flags::EXACT`] asks for exact rows only.
+    /// With [`scene_flags::SIGNED_DISTANCE`], its signed-distance fields
+    /// hold the pair's signed distance.
     pub result: ItemResult,
     /// [`PathMode::Continuous`]: every pose of the segment before this `s`
     /// is certified clear (0 otherwise).

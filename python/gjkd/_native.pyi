@@ -230,6 +230,17 @@ class Distances:
     def warm_started(self) -> npt.NDArray[np.bool_]:
         """``(N,)`` whether each query started warm."""
     @property
+    def signed_distance(self) -> _F64:
+        """``(N,)`` signed distances (negative inside: minus the penetration
+        depth) of rows that asked for one, NaN in the others; such a row's
+        ``point_a``, ``point_b`` and ``normal`` are its witnesses."""
+    @property
+    def signed_lower(self) -> _F64:
+        """``(N,)`` certified lower bounds on the signed distances (NaN when none)."""
+    @property
+    def signed_upper(self) -> _F64:
+        """``(N,)`` certified upper bounds on the signed distances (NaN when none)."""
+    @property
     def ok(self) -> npt.NDArray[np.bool_]:
         """``(N,)`` the rows that were answered."""
     def as_dict(self) -> dict[str, npt.NDArray[np.generic]]:
@@ -249,9 +260,22 @@ class SceneRows:
     ``exact=True`` to a scene call for exact distances on every reported
     row."""
 
-    def __new__(cls, n: int, gradient_columns: int = 0, gradient_base: bool = False) -> Self:
+    def __new__(
+        cls,
+        n: int,
+        gradient_columns: int = 0,
+        gradient_base: bool = False,
+        signed_distance: bool = False,
+    ) -> Self:
         """Zeroed room for ``n`` rows (and ``gradient_columns`` gradient
-        entries per row: a call then asks each row's distance gradient)."""
+        entries per row: a call then asks each row's distance gradient).
+
+        ``signed_distance=True`` asks every call for each row's signed
+        distance with its certified interval (``signed_distance``,
+        ``signed_lower``, ``signed_upper``): the distance apart, minus the
+        penetration depth overlapping. Which rows are reported does not
+        change (an overlapping pair has distance 0, so ``within`` reports it
+        whatever the margin); a continuous path refuses it."""
     @property
     def gradient(self) -> _F64:
         """``(n, gradient_columns)`` each row's gradient with respect to the
@@ -291,6 +315,15 @@ class SceneRows:
     @property
     def upper(self) -> _F64:
         """``(n,)`` certified upper bounds."""
+    @property
+    def signed_distance(self) -> _F64:
+        """``(n,)`` signed distances (``answers.signed_distance``), NaN when none."""
+    @property
+    def signed_lower(self) -> _F64:
+        """``(n,)`` certified lower bounds on the signed distances."""
+    @property
+    def signed_upper(self) -> _F64:
+        """``(n,)`` certified upper bounds on the signed distances."""
     @property
     def status(self) -> _U32:
         """``(n,)`` ``gjkd.Status`` values."""
@@ -467,9 +500,14 @@ class _Objects:
         max_iterations: int = 128,
         margin: Optional[float] = None,
         warm_start: bool = True,
+        signed_distance: bool = False,
         out: Optional[Distances] = None,
     ) -> Distances:
-        """The distances of ``(N, 2)`` pairs in one call."""
+        """The distances of ``(N, 2)`` pairs in one call.
+
+        ``signed_distance=True`` also answers each pair's signed distance
+        with its certified interval (``Distances.signed_distance``,
+        ``signed_lower``, ``signed_upper``)."""
     def close(self) -> None:
         """Closes (a no-op for ``Local``)."""
 

@@ -190,7 +190,7 @@ pub struct QueryArgs {
     pub margin: Option<f64>,
     /// Start from the pair's last simplex.
     pub warm_start: bool,
-    /// Also answer the signed distance (`distance` only).
+    /// Also answer the signed distance.
     pub signed_distance: bool,
     /// Also the distance's gradient: `None`, or `Some(base)` with the base
     /// twist's columns when `base`.
@@ -550,10 +550,15 @@ macro_rules! backend_methods {
             /// that fails has its `ErrorCode` in `error` and the other
             /// pairs are still answered. `out`, a `Distances` of `N` rows
             /// from an earlier call, is filled instead of new arrays.
+            /// `signed_distance=True` also answers each pair's signed
+            /// distance with its certified interval, in the result's
+            /// `signed_distance`, `signed_lower` and `signed_upper` arrays
+            /// (NaN otherwise), and an overlapping pair's depth witnesses
+            /// in `point_a`, `point_b`, `normal`.
             #[pyo3(signature = (pairs, poses_a = None, poses_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
-                margin = None, warm_start = true, out = None),
-                text_signature = "($self, pairs, poses_a=None, poses_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, out=None)")]
+                margin = None, warm_start = true, signed_distance = false, out = None),
+                text_signature = "($self, pairs, poses_a=None, poses_b=None, *, tolerance=2.220446049250313e-14, max_iterations=128, margin=None, warm_start=True, signed_distance=False, out=None)")]
             #[allow(clippy::too_many_arguments)]
             fn distances(
                 &mut self,
@@ -565,10 +570,11 @@ macro_rules! backend_methods {
                 max_iterations: u32,
                 margin: Option<f64>,
                 warm_start: bool,
+                signed_distance: bool,
                 out: Option<Bound<'_, crate::batch::Distances>>,
             ) -> PyResult<Py<crate::batch::Distances>> {
                 let args = crate::api::QueryArgs {
-                    tolerance, max_iterations, margin, warm_start, signed_distance: false, gradient: None,
+                    tolerance, max_iterations, margin, warm_start, signed_distance, gradient: None,
                 };
                 crate::api::distances(self, py, pairs, poses_a, poses_b, &args, out)
             }

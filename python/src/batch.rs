@@ -187,7 +187,14 @@ pub fn set_pose_b(item: &mut Item, pose: Pose) {
 /// - `error` `(N,)` uint32: a `gjkd.ErrorCode` value, 0 (`OK`) when the
 ///   row was answered; the other fields of a failed row are 0;
 /// - `warm_started` `(N,)` bool: the query started from the pair's last
-///   simplex.
+///   simplex;
+/// - `signed_distance`, `signed_lower`, `signed_upper` `(N,)` float64: the
+///   signed distance (the distance apart, minus the penetration depth
+///   overlapping) and its certified bounds, for rows that asked for it
+///   (`signed_distance=True`, `SceneRows(n, signed_distance=True)`); NaN
+///   in rows without one (not asked, or failed). A row that has one holds
+///   its witnesses in `point_a`, `point_b` and `normal` (`point_b - point_a
+///   = signed_distance * normal`), also when overlapping.
 ///
 /// Pass it back as `out=` to a later call of the same `N` to reuse its
 /// arrays instead of allocating new ones.
@@ -205,6 +212,9 @@ pub struct Distances {
     pieces: Py<PyArray2<u32>>,
     error: Py<PyArray1<u32>>,
     warm_started: Py<PyArray1<bool>>,
+    signed_distance: Py<PyArray1<f64>>,
+    signed_lower: Py<PyArray1<f64>>,
+    signed_upper: Py<PyArray1<f64>>,
     len: usize,
     /// Set while a call writes the arrays: a second call given the same
     /// `out` meanwhile (from another thread) is refused.
@@ -212,7 +222,7 @@ pub struct Distances {
 }
 
 /// The field names of [`Distances`], in [`Distances::as_dict`]'s order.
-const FIELDS: [&str; 12] = [
+const FIELDS: [&str; 15] = [
     "distance",
     "lower",
     "upper",
@@ -225,6 +235,9 @@ const FIELDS: [&str; 12] = [
     "pieces",
     "error",
     "warm_started",
+    "signed_distance",
+    "signed_lower",
+    "signed_upper",
 ];
 
 #[pymethods]
@@ -245,6 +258,9 @@ impl Distances {
             pieces: PyArray2::zeros(py, [n, 2], false).unbind(),
             error: PyArray1::zeros(py, n, false).unbind(),
             warm_started: PyArray1::zeros(py, n, false).unbind(),
+            signed_distance: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
+            signed_lower: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
+            signed_upper: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
             len: n,
             busy: std::sync::atomic::AtomicBool::new(false),
         }
@@ -326,6 +342,24 @@ impl Distances {
         self.warm_started.bind(py).clone()
     }
 
+    /// `(N,)` float64: the signed distances, NaN in rows without one.
+    #[getter]
+    fn signed_distance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.signed_distance.bind(py).clone()
+    }
+
+    /// `(N,)` float64: certified lower bounds on the signed distances.
+    #[getter]
+    fn signed_lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.signed_lower.bind(py).clone()
+    }
+
+    /// `(N,)` float64: certified upper bounds on the signed distances.
+    #[getter]
+    fn signed_upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.signed_upper.bind(py).clone()
+    }
+
     /// `(N,)` bool: the rows that were answered (`error == 0`).
     #[getter]
     fn ok<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -394,6 +428,11 @@ impl Distances {
             self.error.bind(py),
             self.warm_started.bind(py),
         );
+        let (sd, slo, sup) = (
+            self.signed_distance.bind(py),
+            self.signed_lower.bind(py),
+            self.signed_upper.bind(py),
+        );
         use std::sync::atomic::Ordering;
         if self.busy.swap(true, Ordering::Acquire) {
             return Err(invalid(
@@ -417,6 +456,9 @@ impl Distances {
                 pieces: storage(pc)?,
                 error: storage(er)?,
                 warm: storage(wm)?,
+                signed_distance: storage(sd)?,
+                signed_lower: storage(slo)?,
+                signed_upper: storage(sup)?,
             })
         })();
         self.busy.store(false, Ordering::Release);
@@ -457,6 +499,9 @@ pub struct Writer<'a> {
     pieces: &'a mut [u32],
     error: &'a mut [u32],
     warm: &'a mut [bool],
+    signed_distance: &'a mut [f64],
+    signed_lower: &'a mut [f64],
+    signed_upper: &'a mut [f64],
 }
 
 impl Writer<'_> {
@@ -476,6 +521,14 @@ impl Writer<'_> {
             self.pieces[2 * i..2 * i + 2].copy_from_slice(&r.pieces);
             self.error[i] = r.error;
             self.warm[i] = r.flags & result_flags::WARM_STARTED != 0;
+            let (v, lo, up) = if r.flags & result_flags::SIGNED_DISTANCE != 0 {
+                (r.signed_distance, r.signed_lower, r.signed_upper)
+            } else {
+                (f64::NAN, f64::NAN, f64::NAN)
+            };
+            self.signed_distance[i] = v;
+            self.signed_lower[i] = lo;
+            self.signed_upper[i] = up;
         }
     }
 }

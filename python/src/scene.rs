@@ -61,6 +61,16 @@ use crate::robots::{Robot, path_steps};
 ///   direction (zeros);
 /// - `gradient_error` `(n,)` float64: a bound on each entry's error from
 ///   the distance's certified interval.
+///
+/// `SceneRows(n, signed_distance=True)` also asks every call for each
+/// row's signed distance with its certified interval, in
+/// `signed_distance`, `signed_lower`, `signed_upper` (`answers`' arrays):
+/// a pair apart carries its distance (the same interval), a pair that
+/// overlaps minus its penetration depth, with the depth's witnesses in
+/// `answers.point_a`, `point_b`, `normal`. Which rows are reported does not
+/// change: every overlapping pair has distance 0, so `within` reports it
+/// whatever the margin. A continuous path refuses it (`gjkd.InvalidInput`,
+/// code `MALFORMED`).
 #[pyclass(module = "gjkd", name = "SceneRows")]
 pub struct SceneRows {
     a: Py<PyArray1<u64>>,
@@ -73,20 +83,23 @@ pub struct SceneRows {
     gradient_flags: Py<PyArray1<u32>>,
     gradient_error: Py<PyArray1<f64>>,
     gradient_base: bool,
+    signed_distance: bool,
     busy: std::sync::atomic::AtomicBool,
 }
 
 #[pymethods]
 impl SceneRows {
     /// Zeroed room for `n` rows, and for `gradient_columns` gradient
-    /// entries per row (0: no gradients asked).
+    /// entries per row (0: no gradients asked); `signed_distance` asks
+    /// every call for each row's signed distance.
     #[new]
-    #[pyo3(signature = (n, gradient_columns = 0, gradient_base = false))]
+    #[pyo3(signature = (n, gradient_columns = 0, gradient_base = false, signed_distance = false))]
     fn new(
         py: Python<'_>,
         n: usize,
         gradient_columns: usize,
         gradient_base: bool,
+        signed_distance: bool,
     ) -> PyResult<Self> {
         if gradient_columns > GRADIENT_COLUMNS {
             return Err(invalid(
@@ -109,6 +122,7 @@ impl SceneRows {
             gradient_flags: PyArray1::zeros(py, n, false).unbind(),
             gradient_error: PyArray1::zeros(py, n, false).unbind(),
             gradient_base,
+            signed_distance,
             busy: std::sync::atomic::AtomicBool::new(false),
         })
     }
@@ -189,6 +203,25 @@ impl SceneRows {
     #[getter]
     fn upper<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.answers.bind(py).getattr("upper")
+    }
+
+    /// `(n,)` float64: the signed distances (`answers.signed_distance`),
+    /// NaN in rows without one.
+    #[getter]
+    fn signed_distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("signed_distance")
+    }
+
+    /// `(n,)` float64: certified lower bounds on the signed distances.
+    #[getter]
+    fn signed_lower<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("signed_lower")
+    }
+
+    /// `(n,)` float64: certified upper bounds on the signed distances.
+    #[getter]
+    fn signed_upper<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.answers.bind(py).getattr("signed_upper")
     }
 
     /// `(n,)` uint32: `gjkd.Status` values (`answers.status`).
@@ -432,11 +465,17 @@ impl SceneRows {
 
     /// The request flags this room asks for.
     fn gradient_request_flags(&self, py: Python<'_>) -> u32 {
-        match (self.gradient_columns(py), self.gradient_base) {
-            (0, _) => 0,
-            (_, false) => scene_flags::GRADIENTS,
-            (_, true) => scene_flags::GRADIENTS | scene_flags::GRADIENT_BASE,
-        }
+        let signed = if self.signed_distance {
+            scene_flags::SIGNED_DISTANCE
+        } else {
+            0
+        };
+        signed
+            | match (self.gradient_columns(py), self.gradient_base) {
+                (0, _) => 0,
+                (_, false) => scene_flags::GRADIENTS,
+                (_, true) => scene_flags::GRADIENTS | scene_flags::GRADIENT_BASE,
+            }
     }
 
     /// Number of rows (the answers' arrays are as long as the others).

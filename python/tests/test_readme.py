@@ -28,6 +28,11 @@ def test_readme_example_runs() -> None:
     exec(compile(code, str(README), "exec"), {"__name__": "readme_example"})
 
 
+def test_readme_signed_rows_example_runs() -> None:
+    code = section_code("Signed distance in batches and scene rows")
+    exec(compile(code, str(README), "exec"), {"__name__": "readme_signed_rows_example"})
+
+
 def test_readme_ompl_example_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip(
         "ompl", reason="OMPL's Python bindings are not installed (pip install ompl)"

@@ -16,6 +16,7 @@ use nalgebra::Vector3;
 
 use super::frame::{PairFrame, Vertex};
 use super::polytope::{Face, Polytope};
+use super::ties::tied;
 
 /// What the expansion found, in the frame (scaled).
 pub(super) struct DepthFound {
@@ -35,6 +36,9 @@ pub(super) struct DepthFound {
     pub(super) expansions: u32,
     /// Whether the nearest face met the tolerance.
     pub(super) converged: bool,
+    /// Whether another direction, far from `normal`, reaches the least
+    /// support value within the interval too (see [`super::ties`]).
+    pub(super) tied: bool,
 }
 
 /// The least support value seen (as computed, and certified), and along
@@ -92,6 +96,9 @@ pub(super) fn expand(
             witness_a: None,
             expansions: 0,
             converged: true,
+            // `K` is flat through the origin: its two normals (or, on a
+            // segment or a point, every direction across it) tie at 0.
+            tied: true,
         };
     };
     // Below this a gap is round-off, whatever the tolerance.
@@ -115,6 +122,11 @@ pub(super) fn expand(
         expansions += 1;
     }
     let lower = polytope.certified_depth(frame.delta);
+    let witness_a = last.map(|face| polytope.witness_a(&face));
+    // The interval's upper end, with the tolerance's room: a direction
+    // whose support value is within it is as good as the one found.
+    let bound = upper.value + tolerance * upper.value.abs() + floor;
+    let tied = last.is_some_and(|face| tied(frame, &mut polytope, &face, bound, max_points));
     DepthFound {
         lower,
         upper: upper.value,
@@ -123,9 +135,10 @@ pub(super) fn expand(
         // error, where the face's distance errs by the square of its size.
         depth: upper.computed.max(lower).min(upper.value),
         normal: upper.normal,
-        witness_a: last.map(|face| polytope.witness_a(&face)),
+        witness_a,
         expansions,
         converged,
+        tied,
     }
 }
 

@@ -7,7 +7,8 @@
 //!
 //! One concern a file: [`frame`] (the pair's frame and its support points),
 //! [`polytope`] (the closed surface and its certified inner radius),
-//! [`expand`] (the expansion and its interval), [`piece_pair`] (one convex
+//! [`expand`] (the expansion and its interval), [`ties`] (whether its
+//! direction is unique), [`piece_pair`] (one convex
 //! pair: rounded shapes, the cores' run), this file (unions, the entry
 //! points).
 
@@ -17,6 +18,7 @@ mod options;
 mod piece_pair;
 mod polytope;
 mod signed;
+mod ties;
 
 use nalgebra::Isometry3;
 
@@ -96,6 +98,7 @@ pub fn signed_distance_after(
             pieces: answer.pieces,
             expansions: 0,
             converged: answer.status == Status::Converged,
+            tied: false,
         });
     }
     if early {
@@ -134,6 +137,16 @@ pub fn signed_distance_after(
                     upper: old.upper.min(sd.upper),
                     expansions: old.expansions + sd.expansions,
                     converged: old.converged && sd.converged,
+                    // Two piece pairs as deep (their intervals meet) along
+                    // different directions: either's is a shortest
+                    // separating translation.
+                    tied: (if sd.value < old.value {
+                        sd.tied
+                    } else {
+                        old.tied
+                    }) || (sd.lower <= old.upper
+                        && old.lower <= sd.upper
+                        && ties::far(&sd.normal, &old.normal)),
                     ..if sd.value < old.value { sd } else { old }
                 },
                 None => sd,

@@ -50,6 +50,7 @@ pub(super) fn piece_signed_distance(
             pieces,
             expansions: 0,
             converged: answer.status == Status::Converged,
+            tied: false,
         };
     }
     let frame = PairFrame::new(&a, &b);
@@ -103,5 +104,6 @@ pub(super) fn piece_signed_distance(
         pieces,
         expansions: found.expansions,
         converged: found.converged,
+        tied: found.tied,
     }
 }

@@ -49,6 +49,11 @@ impl Face {
             distance,
         }
     }
+
+    /// The unit outward normal; `None` for a face without area.
+    pub(super) fn unit_normal(&self) -> Option<Vector3<f64>> {
+        (self.len2 > 0.0 && self.len2.is_finite()).then(|| self.normal / self.len2.sqrt())
+    }
 }
 
 /// The polytope: its points and faces.
@@ -76,6 +81,11 @@ impl Polytope {
             .map(|&f| Face::new(f, &points))
             .collect();
         Some(Polytope { points, faces })
+    }
+
+    /// The faces.
+    pub(super) fn faces(&self) -> &[Face] {
+        &self.faces
     }
 
     /// The face whose plane passes nearest the origin (signed: a face with

@@ -36,4 +36,14 @@ pub struct SignedDistance {
     /// Whether the stopping rule held: the distance query's, or the
     /// expansion's tolerance. The interval holds either way.
     pub converged: bool,
+    /// Overlapping: another direction, more than about a milliradian from
+    /// `normal`, separates the shapes as fast (its support value is within
+    /// the interval): the shortest separating translation, hence `normal`
+    /// and the witnesses, are not unique (a ball's centre on a box's
+    /// medial axis, a box centred in a bigger one, two crossing capsules),
+    /// and the signed distance has no gradient here; the answer is one of
+    /// its one-sided ones. Also set when the search could not decide.
+    /// Always `false` apart: whether nearest points are unique there is a
+    /// question of the features that realise them.
+    pub tied: bool,
 }

@@ -13,7 +13,8 @@ use super::checks::map_gjk_error;
 /// Fills `result`'s signed-distance fields (and, for a pair that may
 /// overlap, its witnesses, normal and pieces with the depth's) for the
 /// pair `a`, `b` that `result` answers, with the distance `options` it was
-/// asked with.
+/// asked with. Returns gjk's signed distance when it was computed (the
+/// pair may overlap), for the gradient to read its direction from.
 ///
 /// # Errors
 /// The wire code of gjk's error (none for inputs the distance query
@@ -23,13 +24,13 @@ pub(crate) fn add_signed_distance(
     (a, pose_a): (&Shape, &Isometry3<f64>),
     (b, pose_b): (&Shape, &Isometry3<f64>),
     options: &gjk::Options,
-) -> Result<(), ErrorCode> {
+) -> Result<Option<gjk::SignedDistance>, ErrorCode> {
     result.flags |= result_flags::SIGNED_DISTANCE;
     if result.lower > 0.0 {
         result.signed_distance = result.distance;
         result.signed_lower = result.lower;
         result.signed_upper = result.upper;
-        return Ok(());
+        return Ok(None);
     }
     let depth = gjk::DepthOptions {
         distance: *options,
@@ -43,5 +44,5 @@ pub(crate) fn add_signed_distance(
     result.point_b = sd.point_b.coords.into();
     result.normal = sd.normal.into();
     result.pieces = sd.pieces;
-    Ok(())
+    Ok(Some(sd))
 }

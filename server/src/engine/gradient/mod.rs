@@ -14,7 +14,7 @@ use gjkd_proto::{ErrorCode, GRADIENT_COLUMNS, Gradient, ItemResult, gradient_fla
 use nalgebra::{Isometry3, Point3, Vector3};
 
 pub(crate) use poses::{LinkPoses, StepConfigurations};
-pub(crate) use witness::{not_unique, overlap_witness, witness};
+pub(crate) use witness::{depth_witness, not_unique, overlap_witness, witness};
 
 use super::robots::Robots;
 
@@ -42,7 +42,10 @@ pub(crate) struct Stance<'a> {
 }
 
 /// Writes into `result` the gradient of its distance with respect to the
-/// coordinates that move `a` (see `gjkd_proto::Gradient`).
+/// coordinates that move `a` (see `gjkd_proto::Gradient`). `depth` is the
+/// pair's signed distance when the caller computed it (a pair that asked
+/// for it and may overlap): its direction is then the gradient's, and
+/// `result`'s normal (already the depth's) is not read as a distance's.
 ///
 /// # Errors
 /// [`ErrorCode::InvalidOptions`] when `a`'s robot has more coordinates
@@ -54,8 +57,12 @@ pub(crate) fn fill(
     robots: &Robots,
     cache: &mut LinkPoses,
     stance: Stance<'_>,
+    depth: Option<&gjk::SignedDistance>,
 ) -> Result<(), ErrorCode> {
-    let w = witness(result).or_else(|| overlap_witness(result, &a, &b));
+    let w = match depth {
+        Some(sd) => depth_witness(result, sd),
+        None => witness(result).or_else(|| overlap_witness(result, &a, &b)),
+    };
     let (point_a, point_b) = match &w {
         Some(w) => (w.point_a, w.point_b),
         None => (Point3::from(result.point_a), Point3::from(result.point_b)),
@@ -114,12 +121,16 @@ pub(crate) fn fill(
                 widest = widest.max(column.norm());
             }
             gradient.error = w.normal_error * widest;
-            if not_unique(
-                (a.shape, a.pose),
-                (b.shape, b.pose),
-                result.pieces,
-                &w.normal,
-            ) {
+            // Two kinds of non-unique witness: a tied depth direction
+            // (overlapping), or parallel supporting features (either).
+            if w.tied
+                || not_unique(
+                    (a.shape, a.pose),
+                    (b.shape, b.pose),
+                    result.pieces,
+                    &w.normal,
+                )
+            {
                 flags |= gradient_flags::NOT_UNIQUE;
             }
         }

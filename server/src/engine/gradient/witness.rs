@@ -17,6 +17,10 @@ pub(crate) struct Witness {
     /// A bound on `|n − n*|`, the reported normal's distance to the true
     /// one ([`normal_error`]).
     pub normal_error: f64,
+    /// An overlapping pair's depth is reached along more than one
+    /// direction (`gjk::SignedDistance::tied`): the witness is one of
+    /// several.
+    pub tied: bool,
 }
 
 /// The witness of `result`'s distance, `None` when the objects overlap
@@ -31,6 +35,7 @@ pub(crate) fn witness(result: &ItemResult) -> Option<Witness> {
         point_b: Point3::from(result.point_b),
         normal: normal.normalize(),
         normal_error: normal_error(result.lower, result.upper),
+        tied: false,
     })
 }
 
@@ -45,6 +50,14 @@ pub(crate) fn overlap_witness(
 ) -> Option<Witness> {
     let sd =
         gjk::signed_distance(a.shape, a.pose, b.shape, b.pose, &DepthOptions::default()).ok()?;
+    depth_witness(result, &sd)
+}
+
+/// The witness of `sd`, the signed distance of the pair `result` answers
+/// (computed by the caller, as a pair that asked for its signed distance
+/// has); raises `result.penetration` to the depth's lower bound. `None`
+/// when `sd` has no direction.
+pub(crate) fn depth_witness(result: &mut ItemResult, sd: &gjk::SignedDistance) -> Option<Witness> {
     if sd.normal.norm_squared() <= 0.25 || !sd.normal.iter().all(|c| c.is_finite()) {
         return None;
     }
@@ -57,6 +70,7 @@ pub(crate) fn overlap_witness(
         // normal's error, not a proof of it (the depth's normal is the
         // minimiser of a support function, not a nearest point).
         normal_error: normal_error(-sd.upper, -sd.lower),
+        tied: sd.tied,
     })
 }
 

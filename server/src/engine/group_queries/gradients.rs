@@ -1,22 +1,28 @@
-//! The gradients of a scene answer's rows (with
-//! [`scene_flags::GRADIENTS`](gjkd_proto::scene_flags::GRADIENTS)): each
-//! written row's, at its step's poses, once the step is answered. A row
+//! What a scene answer's written rows get besides their distance, at
+//! their step's poses, once the step is answered: the signed distance
+//! (with [`scene_flags::SIGNED_DISTANCE`](gjkd_proto::scene_flags::SIGNED_DISTANCE))
+//! and the gradient (with
+//! [`scene_flags::GRADIENTS`](gjkd_proto::scene_flags::GRADIENTS)). A row
 //! answered without its nearest points (from a motion bound, or by an
-//! early exit at the margin) is asked again to convergence first.
+//! early exit at the margin) is asked again to convergence first for its
+//! gradient; the signed distance of a pair that may overlap is computed
+//! once and read by both.
 
 use gjkd_proto::{ErrorCode, SceneRow, Status};
 
 use super::Question;
 use crate::engine::gradient::{self, Side, Stance};
 use crate::engine::pair_query::run_pair;
+use crate::engine::signed_pair::add_signed_distance;
 use crate::engine::state::State;
 
 impl State {
-    /// Fills the gradient of every row of `rows` (one step's, written into
-    /// the caller's buffer) that answers a pair; `path` says whether the
-    /// robots stand where the path's step put them.
-    pub(super) fn row_gradients(&mut self, q: &Question, rows: &mut [SceneRow], path: bool) {
-        if !q.gradients {
+    /// Fills the signed distance and the gradient, as asked, of every row
+    /// of `rows` (one step's, written into the caller's buffer) that
+    /// answers a pair; `path` says whether the robots stand where the
+    /// path's step put them.
+    pub(super) fn finish_rows(&mut self, q: &Question, rows: &mut [SceneRow], path: bool) {
+        if !(q.gradients || q.signed) {
             return;
         }
         let engine = &mut self.groups;
@@ -44,7 +50,7 @@ impl State {
                 Status::from_raw(row.result.status),
                 Some(Status::Closer | Status::Farther | Status::Bounded)
             );
-            if approximate {
+            if q.gradients && approximate {
                 let mut options = q.options;
                 options.margin = None;
                 match run_pair(
@@ -61,6 +67,25 @@ impl State {
                     }
                 }
             }
+            let depth = if q.signed {
+                match add_signed_distance(
+                    &mut row.result,
+                    (a.shape, a.pose),
+                    (b.shape, b.pose),
+                    &q.options,
+                ) {
+                    Ok(depth) => depth,
+                    Err(code) => {
+                        row.result.error = code as u32;
+                        continue;
+                    }
+                }
+            } else {
+                None
+            };
+            if !q.gradients {
+                continue;
+            }
             let stance = Stance {
                 steps: path.then_some(&engine.step_configurations),
                 step: row.step,
@@ -73,6 +98,7 @@ impl State {
                 &self.robots,
                 &mut engine.link_poses,
                 stance,
+                depth.as_ref(),
             ) {
                 row.result.error = code as u32;
             }

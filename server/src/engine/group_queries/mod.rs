@@ -103,6 +103,8 @@ pub(crate) struct Question {
     gradients: bool,
     /// [`scene_flags::GRADIENT_BASE`].
     gradient_base: bool,
+    /// [`scene_flags::SIGNED_DISTANCE`].
+    signed: bool,
 }
 
 /// What a request cost, for the reply.
@@ -166,7 +168,7 @@ impl GroupQueries {
 /// [`ErrorCode::Malformed`] for an unknown kind, path mode or flag, a
 /// first-hit or continuous path of another kind than within, linear
 /// quaternions outside a continuous path, the group's own pairs asked of
-/// nearest; [`ErrorCode::InvalidOptions`]
+/// nearest, signed distances asked of a continuous path; [`ErrorCode::InvalidOptions`]
 /// for a margin, tolerance or accuracy that is not a finite number `>= 0`,
 /// no iterations, `k = 0` for nearest, or a continuous path's bracket that
 /// is not a finite number `> 0`.
@@ -179,6 +181,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         || (within_only && kind != SceneKind::Within)
         || (linear_quaternion && mode != PathMode::Continuous)
         || (r.flags & scene_flags::SELF_PAIRS != 0 && kind == SceneKind::Nearest)
+        || (r.flags & scene_flags::SIGNED_DISTANCE != 0 && mode == PathMode::Continuous)
     {
         return Err(ErrorCode::Malformed);
     }
@@ -225,6 +228,7 @@ fn decode(r: &SceneRequest) -> Result<Question, ErrorCode> {
         k: usize::try_from(r.k).unwrap_or(usize::MAX),
         gradients: has(scene_flags::GRADIENTS),
         gradient_base: has(scene_flags::GRADIENT_BASE),
+        signed: has(scene_flags::SIGNED_DISTANCE),
     })
 }
 
@@ -326,7 +330,7 @@ impl State {
             self.apply_poses(&q, inputs)?;
             self.groups.broadphase.sync(&mut self.store);
             self.answer_step(client, &q, 0, &mut rows, &mut counters);
-            self.row_gradients(&q, rows.written_since(0), false);
+            self.finish_rows(&q, rows.written_since(0), false);
             reply.steps = 1;
         } else if let Some(waypoints) = &waypoints {
             (reply.steps, reply.first_hit) =
@@ -492,7 +496,7 @@ impl State {
                 rows.truncate(written, total);
                 continue;
             }
-            self.row_gradients(q, rows.written_since(written), true);
+            self.finish_rows(q, rows.written_since(written), true);
             if q.mode == PathMode::FirstHit {
                 first_hit = step - 1;
                 break;

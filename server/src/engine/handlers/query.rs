@@ -134,6 +134,18 @@ impl State {
             &options,
             warm.as_ref(),
         )?;
+        // The signed distance first: a gradient of a pair that may
+        // overlap reads its direction from the same depth, computed once.
+        let depth = if item.flags & item_flags::SIGNED_DISTANCE != 0 {
+            add_signed_distance(
+                &mut result,
+                (&a.shape, &pose_a),
+                (&b.shape, &pose_b),
+                &options,
+            )?
+        } else {
+            None
+        };
         if wants_gradient {
             self.gradient_poses.reset();
             gradient::fill(
@@ -155,18 +167,11 @@ impl State {
                     step: 0,
                     base: item.flags & item_flags::GRADIENT_BASE != 0,
                 },
+                depth.as_ref(),
             )?;
         }
         if warm_on {
             self.cache.put(key, next);
-        }
-        if item.flags & item_flags::SIGNED_DISTANCE != 0 {
-            add_signed_distance(
-                &mut result,
-                (&a.shape, &pose_a),
-                (&b.shape, &pose_b),
-                &options,
-            )?;
         }
         Ok(result)
     }

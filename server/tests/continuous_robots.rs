@@ -7,6 +7,12 @@
 //! hold the first sampled contact (allowing the sampling step), and the
 //! pose at its `s_hi` must be within the margin.
 
+// The model tests' deterministic generator (the same motions every run).
+#[path = "../../model/tests/files.rs"]
+mod files;
+
+use files::Rng;
+
 use gjk::{Convex, Shape};
 use gjkd_model::{LimitMode, PackagePath, RobotModel};
 use gjkd_proto::{Item, ObjectId, PathMode, SceneKind, SceneRequest, SceneRow, WaitMode};
@@ -24,18 +30,6 @@ const BRACKET: f64 = 1e-6;
 /// Agreement expected between the server's intervals and the truth (parry's
 /// distance to a cylinder converges to about this).
 const TOL: f64 = 1e-6;
-
-/// A xorshift generator, so that every run asks the same motions.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// One convex piece of the truth.
 enum Piece {

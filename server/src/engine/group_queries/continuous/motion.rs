@@ -174,7 +174,10 @@ struct RobotMotion<'a> {
     q: Vec<f64>,
     /// Per link, the joints from the root down to it: a pair needs one
     /// link's pose at each `s`, and the links below it cost as much again.
-    chains: Vec<Vec<usize>>,
+    /// Link `l`'s are `chains[starts[l]..starts[l + 1]]` (two allocations
+    /// a segment, not one a link).
+    chains: Vec<usize>,
+    starts: Vec<usize>,
     /// Each position's limits (the order of `q0`).
     limits: Vec<(f64, f64)>,
 }
@@ -187,18 +190,19 @@ impl<'a> RobotMotion<'a> {
         parent_joint: &[Option<usize>],
     ) -> Self {
         let joints = kinematics.joints();
-        let chains = (0..parent_joint.len())
-            .map(|link| {
-                let mut chain = Vec::new();
-                let mut l = link;
-                while let Some(j) = parent_joint[l] {
-                    chain.push(j);
-                    l = joints[j].parent;
-                }
-                chain.reverse();
-                chain
-            })
-            .collect();
+        let mut chains = Vec::new();
+        let mut starts = Vec::with_capacity(parent_joint.len() + 1);
+        for link in 0..parent_joint.len() {
+            let start = chains.len();
+            starts.push(start);
+            let mut l = link;
+            while let Some(j) = parent_joint[l] {
+                chains.push(j);
+                l = joints[j].parent;
+            }
+            chains[start..].reverse();
+        }
+        starts.push(chains.len());
         RobotMotion {
             kinematics,
             q0,
@@ -209,6 +213,7 @@ impl<'a> RobotMotion<'a> {
             poses: Vec::new(),
             q: Vec::new(),
             chains,
+            starts,
             limits: kinematics
                 .moving_joints()
                 .map(|j| (j.lower, j.upper))
@@ -232,8 +237,9 @@ impl<'a> RobotMotion<'a> {
         Ok(&self.poses)
     }
 
-    /// Link `link`'s pose at `s`: the same arithmetic as
-    /// [`Self::poses_at`]'s, in the same order, for its chain alone.
+    /// Link `link`'s pose at `s`: the arithmetic of [`Self::poses_at`] for
+    /// its chain alone, less the products with identities (within the
+    /// poses' round-off `slack` of it).
     fn link_pose_at(&self, link: usize, s: f64) -> Isometry3<f64> {
         if self.at == s {
             return self.poses[link];
@@ -243,9 +249,19 @@ impl<'a> RobotMotion<'a> {
             (self.q0[k] + (self.q1[k] - self.q0[k]) * s).clamp(lo, hi)
         };
         let joints = self.kinematics.joints();
-        let mut pose = interpolate(&self.base0, &self.base1, s, false);
-        for &j in &self.chains[link] {
+        // A base that stays needs no slerp (most robots' bases stay).
+        let mut pose = if self.base0 == self.base1 {
+            self.base0
+        } else {
+            interpolate(&self.base0, &self.base1, s, false)
+        };
+        for &j in &self.chains[self.starts[link]..self.starts[link + 1]] {
             let joint = &joints[j];
+            // A fixed joint's motion is the identity: its origin alone.
+            if joint.kind == JointKind::Fixed {
+                pose *= joint.origin;
+                continue;
+            }
             let q = match joint.source {
                 JointSource::Fixed => 0.0,
                 JointSource::Moving(k) => position(k),

@@ -4,6 +4,12 @@
 //! moved by the model's forward kinematics at dense `s`: no point may
 //! move farther between two values of `s` than the bound allows.
 
+// The model tests' deterministic generator (the same motions every run).
+#[path = "../../../../../model/tests/files.rs"]
+mod files;
+
+use files::Rng;
+
 use gjkd_model::{LimitMode, PackagePath, RobotModel};
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -21,18 +27,6 @@ fn model(name: &str) -> RobotModel {
     });
     let urdf = std::fs::read_to_string(&path).unwrap();
     RobotModel::from_urdf_str(&urdf, path.parent(), &PackagePath::new([data])).unwrap()
-}
-
-/// A xorshift generator: the same segments every run.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// The centre and points on the surface of a ball, in its link's frame.

@@ -2,7 +2,7 @@
 //! validator asks most: is the straight joint-space motion from `q0` to
 //! `q1` clear? The 7-link arm of `bench scene-robot` among its 1 000
 //! obstacles ([`crate::scene_world`]), random edges of several lengths,
-//! margin 0, checked three ways in one run:
+//! margin 0, checked four ways in one run:
 //!
 //! - **gjkd continuous (server)**: one scene request per edge
 //!   ([`PathMode::Continuous`]): certified clear, or the first contact
@@ -13,11 +13,19 @@
 //! - **parry3d-f64 in process**, sampled at the same resolution as a parry
 //!   user would write it: per state, per link, the obstacles whose AABB
 //!   meets the link's, each with `closest_points` and the margin, stopping
-//!   at the first contact ([`crate::scene_parry`]).
+//!   at the first contact ([`crate::scene_parry`]);
+//! - **parry3d-f64's nonlinear time of impact in process** (FCL-style
+//!   conservative advancement per pair, the peer a parry user reaches
+//!   for): per link, the rigid motion from its pose at `q0` to its pose at
+//!   `q1` (translation linear, rotation at a constant rate about its
+//!   origin), against each obstacle whose AABB meets the link's swept AABB
+//!   (`compute_swept_aabb`), stopping at the first impact. The link's
+//!   true motion along a joint-space edge is not that rigid motion, so
+//!   this check can miss.
 //!
 //! Each edge's truth is dense sampling with parry (a state every 1e-3 rad
 //! of the edge's largest joint motion): an edge a checker calls clear that
-//! the dense check finds touching is a **missed collision**. The three take
+//! the dense check finds touching is a **missed collision**. The four take
 //! turns edge by edge, so drift in the machine's speed hits all alike.
 //!
 //! The arm is attached to the server as a robot whose URDF places each
@@ -32,6 +40,8 @@ use gjkd_proto::{PathMode, SceneKind, SceneRequest, SceneRow};
 use gjkd_testkit::parry::parry_pose;
 use gjkd_testkit::sweep::Rng;
 use nalgebra::Isometry3;
+use parry3d_f64::math::Vector;
+use parry3d_f64::query::NonlinearRigidMotion;
 use parry3d_f64::shape::Shape as ParryShape;
 
 use crate::scene_parry::ParryScene;
@@ -63,10 +73,11 @@ pub struct EdgesArgs {
 }
 
 /// The variants, in the table's order.
-const VARIANTS: [&str; 3] = [
+const VARIANTS: [&str; 4] = [
     "gjkd continuous (server)",
     "gjkd sampled, OMPL resolution (server)",
     "parry3d-f64 sampled, OMPL resolution",
+    "parry3d-f64 nonlinear time of impact per pair",
 ];
 
 /// OMPL's default longest valid segment: this share of the space's
@@ -132,6 +143,37 @@ fn parry_touches(arm: &Arm, p: &Parry, q: &[f64; 7], poses: &mut Vec<Isometry3<f
         }
     }
     false
+}
+
+/// Whether parry's nonlinear time of impact finds an impact of a link,
+/// each link moved rigidly from its pose at the edge's start to its pose at
+/// its end.
+fn parry_impact(
+    arm: &Arm,
+    p: &Parry,
+    e: &Edge,
+    start: &mut Vec<Isometry3<f64>>,
+    end: &mut Vec<Isometry3<f64>>,
+) -> bool {
+    arm.link_poses(&e.q0, start);
+    arm.link_poses(&e.q1, end);
+    p.links
+        .iter()
+        .zip(start.iter())
+        .zip(end.iter())
+        .any(|((link, a), b)| {
+            let (pa, pb) = (parry_pose(a), parry_pose(b));
+            let swept = link.compute_swept_aabb(&pa, &pb);
+            let dt = b.translation.vector - a.translation.vector;
+            let w = (b.rotation * a.rotation.inverse()).scaled_axis();
+            let motion = NonlinearRigidMotion::new(
+                pa,
+                Vector::ZERO,
+                Vector::new(dt.x, dt.y, dt.z),
+                Vector::new(w.x, w.y, w.z),
+            );
+            p.scene.impact(&**link, &motion, &swept)
+        })
 }
 
 /// Interior states of OMPL's discrete motion check: `n` segments of at
@@ -216,11 +258,16 @@ fn measure(service: &str, args: &EdgesArgs) -> Result<(), BenchError> {
     // Times (µs) and verdicts per variant, edge by edge.
     let mut times = vec![Vec::new(); VARIANTS.len()];
     let mut clear = vec![Vec::new(); VARIANTS.len()];
+    // The continuous check's GJK runs per edge: its work, free of the
+    // host's noise.
+    let mut runs = Vec::new();
     let mut rows = vec![SceneRow::default(); 4];
+    let mut ends = Vec::new();
     let mut items = Vec::new();
     for e in &edges {
         let start = Instant::now();
-        let c = continuous_clear(&mut client, &robot, e, args.bracket, &mut rows)?;
+        let (c, r) = continuous_clear(&mut client, &robot, e, args.bracket, &mut rows)?;
+        runs.push(r);
         times[0].push(start.elapsed().as_secs_f64() * 1e6);
         let start = Instant::now();
         let s = sampled_clear(&mut client, &robot, e, &mut items, &mut rows)?;
@@ -230,11 +277,14 @@ fn measure(service: &str, args: &EdgesArgs) -> Result<(), BenchError> {
         let p = !(0..=n)
             .any(|i| parry_touches(&arm, &parry, &along(e, i as f64 / n as f64), &mut poses));
         times[2].push(start.elapsed().as_secs_f64() * 1e6);
-        for (v, verdict) in [c, s, p].into_iter().enumerate() {
+        let start = Instant::now();
+        let t = !parry_impact(&arm, &parry, e, &mut poses, &mut ends);
+        times[3].push(start.elapsed().as_secs_f64() * 1e6);
+        for (v, verdict) in [c, s, p, t].into_iter().enumerate() {
             clear[v].push(verdict);
         }
     }
-    report(args, &edges, &times, &clear)
+    report(args, &edges, &times, &clear, &runs)
 }
 
 fn continuous_clear(
@@ -243,13 +293,16 @@ fn continuous_clear(
     e: &Edge,
     bracket: f64,
     rows: &mut [SceneRow],
-) -> Result<bool, BenchError> {
+) -> Result<(bool, (f64, f64)), BenchError> {
     let both: Vec<f64> = e.q0.iter().chain(&e.q1).copied().collect();
     let summary = client
         .within(robot, 0.0)
         .continuous(Steps::joints(robot, &both), bracket)
         .into_rows(rows)?;
-    Ok(summary.total == 0)
+    Ok((
+        summary.total == 0,
+        (summary.gjk_runs as f64, summary.candidates as f64),
+    ))
 }
 
 fn sampled_clear(
@@ -277,6 +330,7 @@ fn report(
     edges: &[Edge],
     times: &[Vec<f64>],
     clear: &[Vec<bool>],
+    runs: &[(f64, f64)],
 ) -> Result<(), BenchError> {
     let mut md = String::new();
     let _ = writeln!(
@@ -312,6 +366,21 @@ fn report(
     let wrong = (0..edges.len())
         .filter(|&i| clear[0][i] && edges[i].touches)
         .count();
+    let _ = write!(
+        md,
+        "\nThe continuous check's work per edge (mean GJK runs, candidate pairs):"
+    );
+    for &length in &args.lengths {
+        let of = |f: fn(&(f64, f64)) -> f64| {
+            let r: Vec<f64> = (0..edges.len())
+                .filter(|&i| edges[i].length == length)
+                .map(|i| f(&runs[i]))
+                .collect();
+            mean(&r)
+        };
+        let _ = write!(md, " {length} rad {:.0}, {:.0};", of(|r| r.0), of(|r| r.1));
+    }
+    md.push('\n');
     println!("{md}");
     println!("gjkd continuous: {wrong} edges called clear that dense sampling finds touching.");
     let dir = out_dir(&args.common)?;

@@ -18,7 +18,7 @@
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhNode};
-use parry3d_f64::query::{self, ClosestPoints};
+use parry3d_f64::query::{self, ClosestPoints, NonlinearRigidMotion};
 use parry3d_f64::shape::Shape;
 
 use crate::BenchError;
@@ -90,6 +90,31 @@ impl ParryScene {
                 Ok(ClosestPoints::Disjoint) | Err(_) => {}
             }
         }
+    }
+}
+
+impl ParryScene {
+    /// Whether `link`, moving by `motion` over times `[0, 1]`, touches an
+    /// obstacle whose AABB meets `swept`: parry's nonlinear time of impact
+    /// ([`query::cast_shapes_nonlinear`], conservative advancement per
+    /// pair), stopping at the first impact found.
+    pub fn impact(&self, link: &dyn Shape, motion: &NonlinearRigidMotion, swept: &Aabb) -> bool {
+        self.bvh.intersect_aabb(swept).any(|leaf| {
+            let i = leaf as usize;
+            let still = NonlinearRigidMotion::constant_position(self.poses[i]);
+            matches!(
+                query::cast_shapes_nonlinear(
+                    motion,
+                    link,
+                    &still,
+                    &*self.shapes[i],
+                    0.0,
+                    1.0,
+                    true
+                ),
+                Ok(Some(_))
+            )
+        })
     }
 }
 

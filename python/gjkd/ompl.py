@@ -302,6 +302,10 @@ class RobotChecker:
             question=question,
             margin=self.margin,
             self_pairs=True,
+            # OMPL asks only whether an edge is valid: a bracket as wide as
+            # the edge lets the first pose found within the margin settle
+            # it, where a narrow one would locate the first contact.
+            bracket=1.0,
         )
 
     # -- the questions ------------------------------------------------------

@@ -13,7 +13,10 @@
 //! only be cleared up to it.
 
 mod motion;
+mod probe;
 mod search;
+#[cfg(test)]
+mod tests;
 mod waypoints;
 
 use gjkd_proto::{ErrorCode, SceneRow};
@@ -25,6 +28,7 @@ use super::rows::Rows;
 use super::{Counters, Question};
 use crate::engine::state::State;
 use motion::{Mover, Segment};
+use probe::probe_points;
 use search::{Hit, Pair, Search, Side};
 pub(crate) use waypoints::Waypoints;
 
@@ -53,6 +57,9 @@ impl State {
     ///
     /// # Errors
     /// As [`Segment::new`].
+    // Never inlined: profiles (callgrind's `--toggle-collect`) count the
+    // continuous check's work under its name.
+    #[inline(never)]
     pub(super) fn answer_continuous(
         &mut self,
         q: &Question,
@@ -69,14 +76,22 @@ impl State {
             let starts = (0..segment.movers.len())
                 .map(|i| segment.pose(i, 0.0))
                 .collect::<Result<Vec<_>, _>>()?;
-            let mut pairs = self.continuous_pairs(q, &segment, &starts);
-            counters.candidates += pairs.len() as u64;
+            let probes = probe_count(bp, &segment.movers);
+            let found_pairs = self.continuous_pairs(q, &segment, &starts);
+            counters.candidates += found_pairs.len() as u64;
             // Nearest to contact first: its contact shortens the horizon
-            // of every later pair.
-            pairs.sort_by(|x, y| {
-                let key = |p: &Pair| (p.sphere_gap - q.margin) / p.rate;
-                key(x).total_cmp(&key(y))
-            });
+            // of every later pair. The pairs are large (warm starts), so
+            // their keys are sorted, and pairs the spheres clear for the
+            // whole segment are left out first.
+            let mut order: Vec<(f64, usize)> = found_pairs
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.sphere_gap - p.slack - q.margin <= p.rate)
+                .map(|(i, p)| ((p.sphere_gap - q.margin) / p.rate, i))
+                .collect();
+            counters.bounded += (found_pairs.len() - order.len()) as u64;
+            order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            let mut pairs: Vec<Pair> = order.iter().map(|&(_, i)| found_pairs[i]).collect();
             let mut options = q.options;
             options.margin = None;
             options.warm_start = true;
@@ -87,10 +102,31 @@ impl State {
                 margin: q.margin,
                 bracket: q.bracket,
                 runs: 0,
+                horizon: 1.0,
             };
             let mut horizon = 1.0;
             let mut found: Option<(u32, u32, Hit)> = None;
+            let any = q.bracket >= 1.0;
+            if let Some(p) = search.probe(&mut pairs, &probe_points(probes, any)) {
+                let slots = pairs[p.pair].slots;
+                // `[0, s]` is a bracket when the caller allows its width:
+                // nothing before 0 needs clearing.
+                let lo = if p.s <= q.bracket { 0.0 } else { p.s };
+                found = Some((
+                    slots.0,
+                    slots.1,
+                    Hit {
+                        lo,
+                        hi: p.s,
+                        result: p.result,
+                    },
+                ));
+                horizon = if lo == 0.0 { 0.0 } else { p.s };
+            }
             for pair in &mut pairs {
+                if horizon == 0.0 {
+                    break;
+                }
                 // Beyond the margin up to the horizon by the spheres alone.
                 if pair.sphere_gap - pair.slack - q.margin > pair.rate * horizon {
                     counters.bounded += 1;
@@ -98,11 +134,10 @@ impl State {
                 }
                 if let Some(hit) = search.first_contact(pair, horizon) {
                     let lo = found.map_or(hit.lo, |(_, _, f)| f.lo.min(hit.lo));
-                    horizon = hit.hi;
+                    // As for a probe: `[0, hi]` when it is narrow enough.
+                    let lo = if hit.hi <= q.bracket { 0.0 } else { lo };
+                    horizon = if lo == 0.0 { 0.0 } else { hit.hi };
                     found = Some((pair.slots.0, pair.slots.1, Hit { lo, ..hit }));
-                    if hit.hi == 0.0 {
-                        break;
-                    }
                 }
             }
             counters.gjk_runs += search.runs;
@@ -159,6 +194,10 @@ impl State {
             .collect();
         let mut pairs = Vec::new();
         let make = |(a, b): (u32, u32)| {
+            let ball = |slot: u32| {
+                let e = bp.entry(slot);
+                (e.centre, e.extent)
+            };
             let side = |slot: u32| match mover_of(slot) {
                 Some(i) => (Side::Moving(i), spheres[i], movers[i]),
                 None => {
@@ -179,7 +218,14 @@ impl State {
                 mb.drift - ma.drift,
                 ma.spin + mb.spin,
             );
-            Pair::new((a, b), (sa, sb), bounds, ma.slack + mb.slack, gap)
+            Pair::new(
+                (a, b),
+                (sa, sb),
+                bounds,
+                ma.slack + mb.slack,
+                gap,
+                [ball(a), ball(b)],
+            )
         };
         for (i, m) in movers.iter().enumerate() {
             // Pairs of two movers, once, if either moves.
@@ -211,5 +257,25 @@ impl State {
             }
         }
         pairs
+    }
+}
+
+/// Most probes a segment takes: too many and a clear segment pays for
+/// them, too few and a short contact slips between them.
+const MOST_PROBES: f64 = 16.0;
+
+/// How many probes a segment takes: enough that no mover's point moves
+/// much more than its object's diameter between two.
+fn probe_count(bp: &super::broadphase::Broadphase, movers: &[Mover]) -> u32 {
+    let moving = movers.iter().filter(|m| m.rate > 0.0);
+    let fastest = moving.clone().map(|m| m.rate).fold(0.0, f64::max);
+    let smallest = moving
+        .map(|m| bp.entry(m.slot).extent)
+        .fold(f64::INFINITY, f64::min);
+    let count = (fastest / (2.0 * smallest)).ceil();
+    if count.is_nan() {
+        1
+    } else {
+        count.clamp(1.0, MOST_PROBES) as u32
     }
 }

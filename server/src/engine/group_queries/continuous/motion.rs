@@ -30,7 +30,7 @@
 use gjk::Shape;
 use gjkd_model::{JointKind, JointSource, Kinematics, LimitMode};
 use gjkd_proto::ErrorCode;
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 
 use super::super::broadphase::Broadphase;
 use super::super::entry::ROUND_OFF;
@@ -172,9 +172,55 @@ struct RobotMotion<'a> {
     at: f64,
     poses: Vec<Isometry3<f64>>,
     q: Vec<f64>,
+    /// Per link, the joints from the root down to it: a pair needs one
+    /// link's pose at each `s`, and the links below it cost as much again.
+    /// Link `l`'s are `chains[starts[l]..starts[l + 1]]` (two allocations
+    /// a segment, not one a link).
+    chains: Vec<usize>,
+    starts: Vec<usize>,
+    /// Each position's limits (the order of `q0`).
+    limits: Vec<(f64, f64)>,
 }
 
-impl RobotMotion<'_> {
+impl<'a> RobotMotion<'a> {
+    fn new(
+        kinematics: &'a Kinematics,
+        (q0, q1): (&'a [f64], &'a [f64]),
+        (base0, base1): (Isometry3<f64>, Isometry3<f64>),
+        parent_joint: &[Option<usize>],
+    ) -> Self {
+        let joints = kinematics.joints();
+        let mut chains = Vec::new();
+        let mut starts = Vec::with_capacity(parent_joint.len() + 1);
+        for link in 0..parent_joint.len() {
+            let start = chains.len();
+            starts.push(start);
+            let mut l = link;
+            while let Some(j) = parent_joint[l] {
+                chains.push(j);
+                l = joints[j].parent;
+            }
+            chains[start..].reverse();
+        }
+        starts.push(chains.len());
+        RobotMotion {
+            kinematics,
+            q0,
+            q1,
+            base0,
+            base1,
+            at: f64::NAN,
+            poses: Vec::new(),
+            q: Vec::new(),
+            chains,
+            starts,
+            limits: kinematics
+                .moving_joints()
+                .map(|j| (j.lower, j.upper))
+                .collect(),
+        }
+    }
+
     fn poses_at(&mut self, s: f64) -> Result<&[Isometry3<f64>], ErrorCode> {
         if self.at != s {
             self.q.clear();
@@ -189,6 +235,45 @@ impl RobotMotion<'_> {
             self.at = s;
         }
         Ok(&self.poses)
+    }
+
+    /// Link `link`'s pose at `s`: the arithmetic of [`Self::poses_at`] for
+    /// its chain alone, less the products with identities (within the
+    /// poses' round-off `slack` of it).
+    fn link_pose_at(&self, link: usize, s: f64) -> Isometry3<f64> {
+        if self.at == s {
+            return self.poses[link];
+        }
+        let position = |k: usize| {
+            let (lo, hi) = self.limits[k];
+            (self.q0[k] + (self.q1[k] - self.q0[k]) * s).clamp(lo, hi)
+        };
+        let joints = self.kinematics.joints();
+        // A base that stays needs no slerp (most robots' bases stay).
+        let mut pose = if self.base0 == self.base1 {
+            self.base0
+        } else {
+            interpolate(&self.base0, &self.base1, s, false)
+        };
+        for &j in &self.chains[self.starts[link]..self.starts[link + 1]] {
+            let joint = &joints[j];
+            // A fixed joint's motion is the identity: its origin alone.
+            if joint.kind == JointKind::Fixed {
+                pose *= joint.origin;
+                continue;
+            }
+            let q = match joint.source {
+                JointSource::Fixed => 0.0,
+                JointSource::Moving(k) => position(k),
+                JointSource::Mimic {
+                    index,
+                    multiplier,
+                    offset,
+                } => multiplier * position(index) + offset,
+            };
+            pose = pose * joint.origin * joint.motion(q);
+        }
+        pose
     }
 }
 
@@ -242,17 +327,14 @@ impl<'a> Segment<'a> {
         let mut motions = Vec::with_capacity(w.robots.len());
         for (i, way) in w.robots.iter().enumerate() {
             let robot = robots.get(way.id).ok_or(ErrorCode::UnknownObject)?;
-            let motion = RobotMotion {
-                kinematics: &robot.kinematics,
-                q0: way.at(k),
-                q1: way.at(k + 1),
-                base0: way.bases[k],
-                base1: way.bases[k + 1],
-                at: f64::NAN,
-                poses: Vec::new(),
-                q: Vec::new(),
-            };
-            link_movers(&motion, bp, &robot.links, i, &mut movers);
+            let parent_joint = parent_joints(&robot.kinematics);
+            let mut motion = RobotMotion::new(
+                &robot.kinematics,
+                (way.at(k), way.at(k + 1)),
+                (way.bases[k], way.bases[k + 1]),
+                &parent_joint,
+            );
+            link_movers(&mut motion, bp, &robot.links, &parent_joint, i, &mut movers)?;
             motions.push(motion);
         }
         Ok(Segment {
@@ -272,8 +354,20 @@ impl<'a> Segment<'a> {
     pub(crate) fn pose(&mut self, i: usize, s: f64) -> Result<Isometry3<f64>, ErrorCode> {
         match self.movers[i].source {
             Source::Rigid { from, to } => Ok(interpolate(&from, &to, s, self.linear)),
-            Source::Link { robot, link } => Ok(self.robots[robot].poses_at(s)?[link]),
+            Source::Link { robot, link } => Ok(self.robots[robot].link_pose_at(link, s)),
         }
+    }
+
+    /// Computes every robot's links at `s` at once, for the many pairs
+    /// about to ask their poses there.
+    ///
+    /// # Errors
+    /// As [`Self::pose`].
+    pub(crate) fn prepare(&mut self, s: f64) -> Result<(), ErrorCode> {
+        for robot in &mut self.robots {
+            robot.poses_at(s)?;
+        }
+        Ok(())
     }
 
     /// The shape of the object in `slot`.
@@ -284,21 +378,160 @@ impl<'a> Segment<'a> {
     }
 }
 
-/// Adds the movers of `robot`'s links (segment robot `index`), with their
-/// lever-arm bounds.
-fn link_movers(
-    motion: &RobotMotion<'_>,
-    bp: &Broadphase,
-    links: &[Option<u64>],
-    index: usize,
-    movers: &mut Vec<Mover>,
-) {
-    let kinematics = motion.kinematics;
+/// The distance from `p` to the axis of a joint whose child frame is
+/// `frame` (the axis `axis` in that frame, through its origin).
+fn axis_distance(frame: &Isometry3<f64>, axis: &Unit<Vector3<f64>>, p: &Point3<f64>) -> f64 {
+    (p - Point3::from(frame.translation.vector))
+        .cross(&(frame.rotation * axis.into_inner()))
+        .norm()
+}
+
+/// A joint's position change over the segment and the largest absolute
+/// position at either end (a prismatic joint's offset).
+fn joint_motion(source: &JointSource, q0: &[f64], q1: &[f64]) -> (f64, f64) {
+    match *source {
+        JointSource::Fixed => (0.0, 0.0),
+        JointSource::Moving(k) => ((q1[k] - q0[k]).abs(), q0[k].abs().max(q1[k].abs())),
+        JointSource::Mimic {
+            index,
+            multiplier,
+            offset,
+        } => (
+            (multiplier * (q1[index] - q0[index])).abs(),
+            (multiplier * q0[index] + offset)
+                .abs()
+                .max((multiplier * q1[index] + offset).abs()),
+        ),
+    }
+}
+
+/// The forward kinematics of a segment's robot at both ends.
+pub(crate) struct EndPoses<'p> {
+    /// Every link's frame at `s = 0`.
+    pub start: &'p [Isometry3<f64>],
+    /// Every link's frame at `s = 1`.
+    pub end: &'p [Isometry3<f64>],
+}
+
+/// One robot link's bounding sphere: its centre in the link's frame and
+/// the largest distance of a point from it, and its largest distance from
+/// the link's frame origin.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LinkBall {
+    /// The sphere's centre in the link frame.
+    pub centre: Point3<f64>,
+    /// Its radius.
+    pub extent: f64,
+    /// The largest distance of a point from the link frame's origin.
+    pub reach: f64,
+}
+
+/// Bounds on how fast any point of `link`'s ball moves with `s` when the
+/// joints go linearly from `q0` to `q1` (the base still), and the
+/// round-off of its computed pose.
+///
+/// A revolute joint moves a point at `|Δq|` times the point's distance
+/// from its axis. That distance is known at both ends from `ends`; in
+/// between it changes no faster than the link moves relative to the
+/// joint's frame, which is what the joints nearer the link contribute
+/// (summed first, walking from the link up), so over the segment it is at
+/// most the mean of the two ends plus half that rate. The chain's lengths
+/// (every configuration's bound) cap it where they are smaller.
+pub(crate) fn link_rate(
+    kinematics: &Kinematics,
+    parent_joint: &[Option<usize>],
+    (q0, q1): (&[f64], &[f64]),
+    ends: &EndPoses<'_>,
+    link: usize,
+    ball: &LinkBall,
+) -> LinkRate {
     let joints = kinematics.joints();
+    // First pass: the chain's length and depth, which bound the computed
+    // poses' round-off.
+    let (mut chain, mut depth) = (ball.reach, 1.0);
+    let mut l = link;
+    while let Some(j) = parent_joint[l] {
+        let joint = &joints[j];
+        if joint.kind == JointKind::Prismatic {
+            chain += joint_motion(&joint.source, q0, q1).1;
+        }
+        chain += joint.origin.translation.vector.norm();
+        depth += 1.0;
+        l = joint.parent;
+    }
+    // How far a computed distance to an axis may be from the exact one:
+    // both frames' round-off, with room to spare.
+    let base_t = ends.start[kinematics.root()].translation.vector.abs().sum()
+        + ends.end[kinematics.root()].translation.vector.abs().sum();
+    let slack = ROUND_OFF * depth * (base_t + chain) + f64::MIN_POSITIVE;
+    let (c0, c1) = (ends.start[link] * ball.centre, ends.end[link] * ball.centre);
+    // `arm` bounds the distance of the link's points from the frame of the
+    // joint reached so far, whatever the configuration.
+    let mut arm = ball.reach;
+    let mut rate = 0.0;
+    let mut l = link;
+    while let Some(j) = parent_joint[l] {
+        let joint = &joints[j];
+        let (dq, most) = joint_motion(&joint.source, q0, q1);
+        match joint.kind {
+            JointKind::Revolute | JointKind::Continuous => {
+                let d0 = axis_distance(&ends.start[joint.child], &joint.axis, &c0);
+                let d1 = axis_distance(&ends.end[joint.child], &joint.axis, &c1);
+                let lever =
+                    (0.5 * (d0 + d1 + rate) + ball.extent) * (1.0 + 8.0 * ROUND_OFF) + 8.0 * slack;
+                rate += dq * lever.min(arm);
+            }
+            JointKind::Prismatic => {
+                rate += dq;
+                arm += most;
+            }
+            JointKind::Fixed => {}
+        }
+        arm += joint.origin.translation.vector.norm();
+        l = joint.parent;
+    }
+    LinkRate {
+        rate: rate * (1.0 + 4.0 * depth * ROUND_OFF),
+        arm,
+        slack,
+    }
+}
+
+/// A link's bounds from [`link_rate`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LinkRate {
+    /// Bound on how fast any point of the link moves with `s`, the base
+    /// still.
+    pub rate: f64,
+    /// Bound on the distance of any point of the link from the root frame.
+    pub arm: f64,
+    /// How far its computed pose's points may lie from the exact ones.
+    pub slack: f64,
+}
+
+/// Every link's parent joint.
+fn parent_joints(kinematics: &Kinematics) -> Vec<Option<usize>> {
     let mut parent_joint = vec![None; kinematics.link_names().len()];
-    for (j, joint) in joints.iter().enumerate() {
+    for (j, joint) in kinematics.joints().iter().enumerate() {
         parent_joint[joint.child] = Some(j);
     }
+    parent_joint
+}
+
+/// Adds the movers of `robot`'s links (segment robot `index`), with their
+/// lever-arm bounds.
+///
+/// # Errors
+/// As [`RobotMotion::poses_at`].
+fn link_movers(
+    motion: &mut RobotMotion<'_>,
+    bp: &Broadphase,
+    links: &[Option<u64>],
+    parent_joint: &[Option<usize>],
+    index: usize,
+    movers: &mut Vec<Mover>,
+) -> Result<(), ErrorCode> {
+    let kinematics = motion.kinematics;
     let base_moved = (motion.base1.translation.vector - motion.base0.translation.vector).norm();
     let base_turn = if motion.base0.rotation == motion.base1.rotation {
         0.0
@@ -306,62 +539,30 @@ fn link_movers(
         turn_angle(&motion.base0.rotation, &motion.base1.rotation)
     };
     let still = motion.q0 == motion.q1 && motion.base0 == motion.base1;
-    let base_t =
-        motion.base0.translation.vector.abs().sum() + motion.base1.translation.vector.abs().sum();
+    let (q0, q1) = (motion.q0, motion.q1);
+    let end = motion.poses_at(1.0)?.to_vec();
+    let start = motion.poses_at(0.0)?;
+    let ends = EndPoses { start, end: &end };
     for (link, id) in links.iter().enumerate() {
         let Some(slot) = id.and_then(|id| bp.slot(id)) else {
             continue;
         };
-        // `arm` bounds the distance of the link's points from the frame
-        // of the joint reached so far.
-        let mut arm = bp.entry(slot).reach;
-        let mut rate = 0.0;
-        let mut depth = 1.0;
-        let mut l = link;
-        while let Some(j) = parent_joint[l] {
-            let joint = &joints[j];
-            let (dq, most) = match joint.source {
-                JointSource::Fixed => (0.0, 0.0),
-                JointSource::Moving(k) => (
-                    (motion.q1[k] - motion.q0[k]).abs(),
-                    motion.q0[k].abs().max(motion.q1[k].abs()),
-                ),
-                JointSource::Mimic {
-                    index,
-                    multiplier,
-                    offset,
-                } => (
-                    (multiplier * (motion.q1[index] - motion.q0[index])).abs(),
-                    (multiplier * motion.q0[index] + offset)
-                        .abs()
-                        .max((multiplier * motion.q1[index] + offset).abs()),
-                ),
-            };
-            match joint.kind {
-                JointKind::Revolute | JointKind::Continuous => rate += dq * arm,
-                JointKind::Prismatic => {
-                    rate += dq;
-                    arm += most;
-                }
-                JointKind::Fixed => {}
-            }
-            arm += joint.origin.translation.vector.norm();
-            depth += 1.0;
-            l = joint.parent;
-        }
-        rate += base_moved + base_turn * arm;
-        let rate = if still {
-            0.0
-        } else {
-            rate * (1.0 + 4.0 * depth * ROUND_OFF)
+        let e = bp.entry(slot);
+        let ball = LinkBall {
+            centre: e.centre,
+            extent: e.extent,
+            reach: e.reach,
         };
+        let bound = link_rate(kinematics, parent_joint, (q0, q1), &ends, link, &ball);
+        let rate = bound.rate + (base_moved + base_turn * bound.arm) * (1.0 + 4.0 * ROUND_OFF);
         movers.push(Mover {
             slot,
             source: Source::Link { robot: index, link },
-            rate,
-            slack: ROUND_OFF * depth * (base_t + arm) + f64::MIN_POSITIVE,
+            rate: if still { 0.0 } else { rate },
+            slack: bound.slack,
             drift: Vector3::zeros(),
-            spin: rate,
+            spin: if still { 0.0 } else { rate },
         });
     }
+    Ok(())
 }

@@ -14,7 +14,7 @@
 
 use gjk::WarmStart;
 use gjkd_proto::{ErrorCode, ItemResult};
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::motion::Segment;
 use crate::engine::pair_query::run_pair;
@@ -48,6 +48,9 @@ pub(crate) struct Pair {
     pub slack: f64,
     /// Lower bound on the distance at `s = 0` from bounding spheres.
     pub sphere_gap: f64,
+    /// Each side's bounding sphere: its centre in the side's body frame and
+    /// its radius.
+    pub balls: [(Point3<f64>, f64); 2],
     warm: Option<WarmStart>,
 }
 
@@ -59,6 +62,7 @@ impl Pair {
         (rate, drift, spin): (f64, Vector3<f64>, f64),
         slack: f64,
         sphere_gap: f64,
+        balls: [(Point3<f64>, f64); 2],
     ) -> Self {
         Pair {
             slots,
@@ -68,6 +72,7 @@ impl Pair {
             spin,
             slack,
             sphere_gap,
+            balls,
             warm: None,
         }
     }
@@ -94,10 +99,12 @@ pub(crate) struct Hit {
 /// `<= 0`), how far in `s` either side of it is certified clear, and the
 /// row it would make.
 #[derive(Clone, Copy, Debug)]
-struct Eval {
-    gap: f64,
+pub(super) struct Eval {
+    /// The margin left: a hit when `<= 0`.
+    pub gap: f64,
     reach: f64,
-    result: ItemResult,
+    /// The row it would make.
+    pub result: ItemResult,
 }
 
 /// What one search works with.
@@ -115,17 +122,19 @@ pub(crate) struct Search<'s, 'a> {
     pub bracket: f64,
     /// GJK runs so far.
     pub runs: u64,
+    /// The current pair's horizon: no contact beyond it is asked.
+    pub horizon: f64,
 }
 
 impl Search<'_, '_> {
-    fn side_pose(&mut self, side: Side, s: f64) -> Result<Isometry3<f64>, ErrorCode> {
+    pub(super) fn side_pose(&mut self, side: Side, s: f64) -> Result<Isometry3<f64>, ErrorCode> {
         match side {
             Side::Moving(i) => self.segment.pose(i, s),
             Side::Still(pose) => Ok(pose),
         }
     }
 
-    fn eval(&mut self, pair: &mut Pair, s: f64) -> Eval {
+    pub(super) fn eval(&mut self, pair: &mut Pair, s: f64) -> Eval {
         match self.try_eval(pair, s) {
             Ok(e) => e,
             Err(code) => Eval {
@@ -178,6 +187,7 @@ impl Search<'_, '_> {
     /// The pair's first contact in `[0, horizon]`, or `None` when that is
     /// certified clear.
     pub(crate) fn first_contact(&mut self, pair: &mut Pair, horizon: f64) -> Option<Hit> {
+        self.horizon = horizon;
         let mut ex = self.eval(pair, 0.0);
         if ex.gap <= 0.0 {
             return Some(Hit {
@@ -227,8 +237,24 @@ impl Search<'_, '_> {
         let a = x + ex.reach;
         let (from, to) = if ey.gap <= 0.0 {
             if y - a <= self.bracket {
+                let lo = a.min(y);
+                // A pose within the margin only by the interval's round-off
+                // (a crossing of the margin, where the distance is the
+                // margin itself): the bracket's far end, further into the
+                // contact, is within it beyond doubt more often.
+                let z = lo + self.bracket;
+                if ey.result.upper > self.margin && z > y && z <= self.horizon {
+                    let ez = self.eval(pair, z);
+                    if ez.gap <= 0.0 && ez.result.upper <= self.margin {
+                        return Some(Hit {
+                            lo,
+                            hi: z,
+                            result: ez.result,
+                        });
+                    }
+                }
                 return Some(Hit {
-                    lo: a.min(y),
+                    lo,
                     hi: y,
                     result: ey.result,
                 });

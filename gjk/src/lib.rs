@@ -40,7 +40,9 @@ mod separation;
 mod shape;
 mod support_map;
 
-pub use depth::{DepthOptions, SignedDistance, signed_distance, signed_distance_after};
+pub use depth::{
+    DepthOptions, SignedDistance, signed_distance, signed_distance_after, signed_distance_between,
+};
 pub use overlap::penetration_bound;
 #[doc(hidden)]
 pub use query::distance_in_baseline;

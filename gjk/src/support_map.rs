@@ -20,7 +20,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 /// takes any two), monomorphised, so a support search is inlined where it
 /// is cheap; the stored [`Convex`](crate::Convex) dispatches to its form by
 /// one match, as parry's `TypedShape` does. A shape defined outside the
-/// crate implements the five required methods and is queried as the
+/// crate implements the six required methods and is queried as the
 /// crate's own are, with the same bounds.
 pub trait SupportMap {
     /// The point of the core (the rounding radius left out) farthest along

@@ -9,7 +9,10 @@
 
 use std::cell::RefCell;
 
-use gjk::{Convex, Error, Options, SupportMap, WarmStart, distance_between, support_of_difference};
+use gjk::{
+    Convex, DepthOptions, Error, Options, SupportMap, WarmStart, distance_between,
+    signed_distance_between, support_of_difference,
+};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 /// An ellipsoid centred at its body origin. A curved shape has no vertex
@@ -316,4 +319,43 @@ fn the_difference_support_takes_the_foreign_shape() {
     assert_eq!(s.witness_a.point, Point3::new(2.0, 0.0, 0.0));
     assert_eq!(s.witness_b.point, Point3::new(-0.25, 0.0, 1.0));
     assert_eq!(s.point, Vector3::new(2.25, 0.0, -1.0));
+}
+
+#[test]
+fn ellipsoid_sunk_into_a_box_face_has_its_analytic_depth() {
+    // Overlapping the face by less than the box's thickness and far from
+    // its sides: the shortest separating move is straight up, by the depth
+    // of the lowest point, so the signed distance is its (negative) height.
+    let slab = Convex::cuboid(Vector3::new(100.0, 100.0, 1.0), 0.0).expect("box");
+    let slab_pose = Isometry3::translation(0.0, 0.0, -1.0);
+    let egg = Ellipsoid::new(1.5, 0.7, 0.4);
+    let options = DepthOptions::default();
+    for seed in 0..20 {
+        let r = rotation(seed);
+        let down_in_body = r.inverse_transform_vector(&-Vector3::z());
+        let reach = egg.support_value(&down_in_body);
+        let height = reach - 0.05 - 0.01 * seed as f64;
+        let pose = Isometry3::from_parts(Translation3::new(0.3, -0.2, height), r);
+        let truth = height - reach;
+        let sd =
+            signed_distance_between(&egg, &pose, &slab, &slab_pose, &options).expect("queried");
+        assert!(
+            sd.lower <= truth && truth <= sd.upper,
+            "seed {seed}: [{}, {}] against {truth}",
+            sd.lower,
+            sd.upper
+        );
+        assert!(
+            (sd.value - truth).abs() <= 1e-6,
+            "seed {seed}: {} against {truth}",
+            sd.value
+        );
+        assert!(sd.expansions > 0, "seed {seed}: the depth was expanded");
+        // Apart, it is the distance itself.
+        let above = Isometry3::from_parts(Translation3::new(0.3, -0.2, reach + 0.5), r);
+        let apart =
+            signed_distance_between(&egg, &above, &slab, &slab_pose, &options).expect("queried");
+        assert!((apart.value - 0.5).abs() <= CLOSE, "seed {seed}");
+        assert_eq!(apart.expansions, 0);
+    }
 }

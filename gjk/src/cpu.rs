@@ -144,6 +144,23 @@ macro_rules! cpu_forms {
     };
     (entry
         $(#[$attr:meta])* $vis:vis fn $base:ident / $avx2:ident
+        <$($g:ident: $bound:path),*>
+        ($($arg:ident: $ty:ty),*) $(-> $ret:ty)? => $body:ident
+    ) => {
+        $(#[$attr])*
+        $vis fn $base<$($g: $bound),*>($($arg: $ty),*) $(-> $ret)? {
+            $body::<false, $($g),*>($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        $(#[$attr])*
+        $vis fn $avx2<$($g: $bound),*>($($arg: $ty),*) $(-> $ret)? {
+            $body::<true, $($g),*>($($arg),*)
+        }
+    };
+    (entry
+        $(#[$attr:meta])* $vis:vis fn $base:ident / $avx2:ident
         ($($arg:ident: $ty:ty),*) $(-> $ret:ty)? => $body:ident
     ) => {
         $(#[$attr])*

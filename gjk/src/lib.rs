@@ -40,11 +40,16 @@ mod separation;
 mod shape;
 mod support_map;
 
-pub use depth::{DepthOptions, SignedDistance, signed_distance, signed_distance_after};
+pub use depth::{
+    DepthOptions, SignedDistance, signed_distance, signed_distance_after, signed_distance_between,
+};
 pub use overlap::penetration_bound;
 #[doc(hidden)]
 pub use query::distance_in_baseline;
-pub use query::{Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_in};
+pub use query::{
+    Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_between,
+    distance_between_in, distance_in,
+};
 pub use separation::separation_bound;
 pub use shape::{Compound, Convex, Shape};
 pub use support_map::{DifferencePoint, SeedForm, SupportMap, SupportPoint, support_of_difference};

@@ -16,9 +16,12 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 /// A convex shape's support function, in its body frame.
 ///
-/// The query calls it by static dispatch (the stored [`Convex`](crate::Convex)
-/// dispatches to its form by one match, as parry's `TypedShape` does), so a
-/// support search is inlined where it is cheap.
+/// The distance query is generic over it ([`distance_between`](crate::distance_between)
+/// takes any two), monomorphised, so a support search is inlined where it
+/// is cheap; the stored [`Convex`](crate::Convex) dispatches to its form by
+/// one match, as parry's `TypedShape` does. A shape defined outside the
+/// crate implements the six required methods and is queried as the
+/// crate's own are, with the same bounds.
 pub trait SupportMap {
     /// The point of the core (the rounding radius left out) farthest along
     /// `dir`, relative to [`centre`](Self::centre), with its index. Exact
@@ -26,8 +29,11 @@ pub trait SupportMap {
     fn local_support(&self, dir: &Vector3<f64>) -> (usize, Vector3<f64>);
 
     /// The core's point of index `index`, relative to
-    /// [`centre`](Self::centre). The index must be one that
-    /// [`local_support`](Self::local_support) can return.
+    /// [`centre`](Self::centre): for an index that
+    /// [`local_support`](Self::local_support) returned, the same point,
+    /// bit for bit, as the answer's nearest points and a warm start are
+    /// rebuilt from the indices alone. Any index below
+    /// [`index_count`](Self::index_count) must name a point of the core.
     fn local_point(&self, index: usize) -> Vector3<f64>;
 
     /// The point every support point is relative to, in the body frame.
@@ -35,6 +41,30 @@ pub trait SupportMap {
 
     /// The rounding radius grown around the core.
     fn rounding(&self) -> f64;
+
+    /// An upper bound on the distance of every point of the core from
+    /// [`centre`](Self::centre): the `D(coZ - z̄)` of the paper's (6.4),
+    /// which scales the stopping rule and the round-off allowance.
+    fn size(&self) -> f64;
+
+    /// How many indices name a point: [`local_point`](Self::local_point)
+    /// takes every index below this. A warm start naming another is
+    /// refused ([`Error::WarmStartOutOfRange`](crate::Error::WarmStartOutOfRange)).
+    fn index_count(&self) -> usize;
+
+    /// `|centre|`, for the precision checks of a query; computed from
+    /// [`centre`](Self::centre) by default, kept by a shape that stores it.
+    fn centre_norm(&self) -> f64 {
+        crate::numeric::robust_norm(&self.centre().coords)
+    }
+
+    /// The size that [`local_support_single`](Self::local_support_single)'s
+    /// shortfall is relative to: a shape whose f32 search may land below
+    /// the support value by up to `2^-20 · single_size · |dir|` returns
+    /// its [`size`](Self::size); one whose search is exact, 0 (the default).
+    fn single_size(&self) -> f64 {
+        0.0
+    }
 
     /// [`local_support`](Self::local_support) in f32 arithmetic where the
     /// shape has such a search ([`Precision::Single`](crate::Precision::Single)):
@@ -44,9 +74,11 @@ pub trait SupportMap {
         self.local_support(dir)
     }
 
-    /// The curved core that the run's Newton seed solves for (see
-    /// [`SeedForm`]), or `None` (the default) for a shape whose plain run
-    /// ends in a few iterations, as a polytope's does.
+    /// The seed hook: the curved core that the run's Newton seed solves
+    /// for (see [`SeedForm`]), or `None` (the default, "no seed") for a
+    /// shape whose plain run ends in a few iterations, as a polytope's
+    /// does. A pair with a seed form is seeded, the others run the
+    /// paper's plain loop; the query decides once, at the pair's setup.
     fn seed_form(&self) -> Option<SeedForm> {
         None
     }

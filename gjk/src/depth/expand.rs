@@ -17,6 +17,7 @@ use nalgebra::Vector3;
 use super::frame::{PairFrame, Vertex};
 use super::polytope::{Face, Polytope};
 use super::ties::tied;
+use crate::support_map::SupportMap;
 
 /// What the expansion found, in the frame (scaled).
 pub(super) struct DepthFound {
@@ -53,7 +54,11 @@ impl Upper {
     /// The support point along `dir`, its support value (per unit of
     /// `dir`) kept as an upper bound when it is the least; the value is
     /// returned uncertified.
-    fn probe(&mut self, frame: &PairFrame<'_>, dir: &Vector3<f64>) -> Option<(Vertex, f64)> {
+    fn probe<A: SupportMap, B: SupportMap>(
+        &mut self,
+        frame: &PairFrame<'_, A, B>,
+        dir: &Vector3<f64>,
+    ) -> Option<(Vertex, f64)> {
         let len = dir.norm();
         if !(len > 0.0 && len.is_finite()) {
             return None;
@@ -76,8 +81,8 @@ impl Upper {
 /// The expansion of the pair in `frame` from `start` (GJK's final
 /// simplex, 0 to 4 points), stopping when the nearest face's support gap
 /// is within `tolerance` of the depth, or at `max_points` points.
-pub(super) fn expand(
-    frame: &PairFrame<'_>,
+pub(super) fn expand<A: SupportMap, B: SupportMap>(
+    frame: &PairFrame<'_, A, B>,
     start: &[Vertex],
     tolerance: f64,
     max_points: usize,
@@ -146,8 +151,8 @@ pub(super) fn expand(
 /// points along directions out of its affine hull (each probed as an upper
 /// bound); `None` when `K` is flat to round-off in some direction, whose
 /// support values then bound the depth by that round-off.
-fn initial_tetrahedron(
-    frame: &PairFrame<'_>,
+fn initial_tetrahedron<A: SupportMap, B: SupportMap>(
+    frame: &PairFrame<'_, A, B>,
     start: &[Vertex],
     upper: &mut Upper,
 ) -> Option<Polytope> {

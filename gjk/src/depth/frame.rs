@@ -28,9 +28,9 @@ pub(super) struct Vertex {
 }
 
 /// A piece pair placed in the frame (see the module).
-pub(super) struct PairFrame<'s> {
-    a: &'s Convex,
-    b: &'s Convex,
+pub(super) struct PairFrame<'s, A = Convex, B = Convex> {
+    a: &'s A,
+    b: &'s B,
     /// B's piece frame into A's.
     rotation: Matrix3<f64>,
     /// B's centroid less A's, in A's piece frame (unscaled).
@@ -47,9 +47,9 @@ pub(super) struct PairFrame<'s> {
     pub(super) delta: f64,
 }
 
-impl<'s> PairFrame<'s> {
+impl<'s, A: SupportMap, B: SupportMap> PairFrame<'s, A, B> {
     /// The frame of pieces `a` and `b` as they sit.
-    pub(super) fn new(a: &Placed<'s>, b: &Placed<'s>) -> Self {
+    pub(super) fn new(a: &Placed<'s, A>, b: &Placed<'s, B>) -> Self {
         let rel = b.relative_to(a);
         let rotation = *rel.rotation.to_rotation_matrix().matrix();
         // The centroids' gap in double-double in the world, rotated once:

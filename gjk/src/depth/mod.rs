@@ -26,7 +26,8 @@ pub use options::DepthOptions;
 pub use signed::SignedDistance;
 
 use crate::query::core_run::Placed;
-use crate::{Answer, Error, Options, Shape, Status, Workspace, distance};
+use crate::support_map::SupportMap;
+use crate::{Answer, Error, Options, Shape, Status, Workspace, distance, distance_between};
 use piece_pair::piece_signed_distance;
 
 /// The signed distance between `a` at `pose_a` and `b` at `pose_b`:
@@ -86,22 +87,10 @@ pub fn signed_distance_after(
     options: &DepthOptions,
 ) -> Result<SignedDistance, Error> {
     options.validate()?;
-    let early = matches!(answer.status, Status::Farther | Status::Closer);
-    if answer.lower > 0.0 && !early {
-        return Ok(SignedDistance {
-            value: answer.distance,
-            lower: answer.lower,
-            upper: answer.upper,
-            point_a: answer.point_a,
-            point_b: answer.point_b,
-            normal: answer.normal,
-            pieces: answer.pieces,
-            expansions: 0,
-            converged: answer.status == Status::Converged,
-            tied: false,
-        });
+    if let Some(apart) = proven_apart(answer) {
+        return Ok(apart);
     }
-    if early {
+    if matches!(answer.status, Status::Farther | Status::Closer) {
         // A margin's answer bounds nothing the pieces need: ask again.
         return signed_distance(a, pose_a, b, pose_b, options);
     }
@@ -156,6 +145,84 @@ pub fn signed_distance_after(
     // The answer's own pair always passes the sphere test (its gap is at
     // most its distance), so some pair ran.
     best.ok_or(Error::EmptyCompound)
+}
+
+/// The signed distance of an answer that proves its shapes apart (its
+/// lower bound positive, and not an early exit on a margin): the answer
+/// itself, at no further cost.
+fn proven_apart(answer: &Answer) -> Option<SignedDistance> {
+    let early = matches!(answer.status, Status::Farther | Status::Closer);
+    (answer.lower > 0.0 && !early).then(|| SignedDistance {
+        value: answer.distance,
+        lower: answer.lower,
+        upper: answer.upper,
+        point_a: answer.point_a,
+        point_b: answer.point_b,
+        normal: answer.normal,
+        pieces: answer.pieces,
+        expansions: 0,
+        converged: answer.status == Status::Converged,
+        tied: false,
+    })
+}
+
+/// [`signed_distance`] of any two convex shapes known by their
+/// [`SupportMap`]s, a shape defined outside the crate among them: the
+/// distance by [`distance_between`], and for overlapping shapes the
+/// expansion of `A - B` through the same trait.
+///
+/// ```
+/// use gjk::{Convex, DepthOptions, signed_distance_between};
+/// use nalgebra::Isometry3;
+///
+/// let ball = Convex::sphere(1.0)?;
+/// let near = Isometry3::translation(1.5, 0.0, 0.0);
+/// let sd = signed_distance_between(&ball, &Isometry3::identity(), &ball, &near, &DepthOptions::default())?;
+/// assert!((sd.value + 0.5).abs() < 1e-9);
+/// assert!(sd.lower <= -0.5 && -0.5 <= sd.upper);
+/// # Ok::<(), gjk::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`signed_distance`].
+pub fn signed_distance_between<A: SupportMap, B: SupportMap>(
+    a: &A,
+    pose_a: &Isometry3<f64>,
+    b: &B,
+    pose_b: &Isometry3<f64>,
+    options: &DepthOptions,
+) -> Result<SignedDistance, Error> {
+    options.validate()?;
+    let converged = Options {
+        margin: None,
+        ..options.distance
+    };
+    let answer = distance_between(a, pose_a, b, pose_b, &converged, None)?;
+    if let Some(apart) = proven_apart(&answer) {
+        return Ok(apart);
+    }
+    let body = Isometry3::identity();
+    let (pa, pb) = (
+        Placed {
+            convex: a,
+            pose: pose_a,
+            offset: &body,
+        },
+        Placed {
+            convex: b,
+            pose: pose_b,
+            offset: &body,
+        },
+    );
+    let warm = Some(&answer.warm_start);
+    Ok(piece_signed_distance(
+        &mut Workspace::new(),
+        pa,
+        pb,
+        [0, 0],
+        options,
+        warm,
+    ))
 }
 
 /// A lower bound on the distance between two placed pieces: their

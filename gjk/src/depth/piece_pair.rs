@@ -11,6 +11,7 @@ use super::expand::expand;
 use super::frame::PairFrame;
 use super::{DepthOptions, SignedDistance};
 use crate::query::core_run::{Placed, core_run};
+use crate::support_map::SupportMap;
 use crate::{Status, WarmStart, Workspace};
 
 /// `x - y` rounded down: less a bound on the subtraction's round-off, so
@@ -27,16 +28,16 @@ fn sub_up(x: f64, y: f64) -> f64 {
 }
 
 /// The signed distance of pieces `a` and `b` (see the module).
-pub(super) fn piece_signed_distance(
+pub(super) fn piece_signed_distance<A: SupportMap, B: SupportMap>(
     workspace: &mut Workspace,
-    a: Placed<'_>,
-    b: Placed<'_>,
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
     pieces: [u32; 2],
     options: &DepthOptions,
     warm: Option<&WarmStart>,
 ) -> SignedDistance {
     let run = core_run(workspace, a, b, pieces, &options.distance, warm);
-    let (ra, rb) = (a.convex.radius(), b.convex.radius());
+    let (ra, rb) = (a.convex.rounding(), b.convex.rounding());
     let radii = ra + rb;
     let answer = &run.answer;
     if run.core_lower > 0.0 {

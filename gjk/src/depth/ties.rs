@@ -18,6 +18,7 @@ use nalgebra::Vector3;
 
 use super::frame::PairFrame;
 use super::polytope::{Face, Polytope};
+use crate::support_map::SupportMap;
 
 /// Two unit normals less than this far apart (in radians, about) are one
 /// direction: on a round `K`, the faces next to the converged one have
@@ -35,8 +36,8 @@ const TIE_POINTS: usize = 48;
 /// has a support value of `K` at most `bound` (the interval's upper end
 /// with the tolerance's room), growing `polytope` (at most `max_points`
 /// points) to decide.
-pub(super) fn tied(
-    frame: &PairFrame<'_>,
+pub(super) fn tied<A: SupportMap, B: SupportMap>(
+    frame: &PairFrame<'_, A, B>,
     polytope: &mut Polytope,
     nearest: &Face,
     bound: f64,

@@ -8,6 +8,7 @@ use super::numerical_algorithm::{Exit, RunOutcome};
 use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::warm_start::{PieceSimplex, WarmStart};
 use crate::johnson::{Simplex, Solution};
+use crate::support_map::SupportMap;
 
 /// Everything a query returns. Distances are after radii; points are in world
 /// coordinates.
@@ -65,7 +66,7 @@ pub(super) fn all_finite(answer: &Answer) -> bool {
     ((bounds + points) + (rest + zeroed(n.z))) == 0.0
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// A lower bound on the cores' penetration depth once `v` is the origin.
     /// (5.9) needs a tetrahedron around the origin. When the run stopped on a
     /// smaller simplex with `v` exactly zero (the first support point was the
@@ -141,7 +142,7 @@ impl ConvexPair<'_> {
         let mut len = 0;
         for (slot, (vertex, weight)) in simplex.vertices.iter().zip(lambda).enumerate() {
             if run.solution.mask & (1 << slot) != 0 {
-                nearest_a += self.a.point(vertex.ia as usize) * weight;
+                nearest_a += self.a.local_point(vertex.ia as usize) * weight;
                 pairs[len & 3] = [vertex.ia, vertex.ib];
                 len += 1;
             }
@@ -156,7 +157,7 @@ impl ConvexPair<'_> {
             ),
             _ => (pose_a.rotation, pose_a.translation.vector),
         };
-        let core_a = Point3::from(rotation * (self.a.centroid().coords + nearest_a) + shift);
+        let core_a = Point3::from(rotation * (self.a.centre().coords + nearest_a) + shift);
         let separated = run.norm > self.slack_world;
         // b - a = -v, in world coordinates. Where the cores touch or cross,
         // `v` is the origin by definition, and the weights' own sum
@@ -192,8 +193,8 @@ impl ConvexPair<'_> {
             distance,
             lower,
             upper,
-            point_a: core_a + normal * self.a.radius(),
-            point_b: core_b - normal * self.b.radius(),
+            point_a: core_a + normal * self.a.rounding(),
+            point_b: core_b - normal * self.b.rounding(),
             normal,
             penetration,
             iterations: run.iterations,

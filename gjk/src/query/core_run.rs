@@ -8,6 +8,7 @@ use nalgebra::Isometry3;
 use super::pair::{ConvexPair, PiecePlacement, is_identity};
 use super::{Answer, Options, WarmStart, Workspace};
 use crate::shape::Convex;
+use crate::support_map::SupportMap;
 
 /// A piece pair's answer and the certified interval of its cores' distance.
 pub(crate) struct CoreRun {
@@ -23,21 +24,29 @@ pub(crate) struct CoreRun {
 
 /// Where one piece sits: its shape's pose and its offset in the shape's
 /// body frame (the identity for a convex shape).
-#[derive(Clone, Copy)]
-pub(crate) struct Placed<'p> {
+pub(crate) struct Placed<'p, S = Convex> {
     /// The piece.
-    pub(crate) convex: &'p Convex,
+    pub(crate) convex: &'p S,
     /// Its shape's pose.
     pub(crate) pose: &'p Isometry3<f64>,
     /// Its offset in the shape's body frame.
     pub(crate) offset: &'p Isometry3<f64>,
 }
 
-impl Placed<'_> {
+// By hand: derived, they would ask `S` to be `Copy` too.
+impl<S> Clone for Placed<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S> Copy for Placed<'_, S> {}
+
+impl<S> Placed<'_, S> {
     /// The pose of the piece's own frame relative to `other`'s, `other⁻¹ ·
     /// self`, the shapes' poses composed first so that translations far
     /// from the world's origin cancel before anything is rotated.
-    pub(crate) fn relative_to(&self, other: &Placed<'_>) -> Isometry3<f64> {
+    pub(crate) fn relative_to<T>(&self, other: &Placed<'_, T>) -> Isometry3<f64> {
         let rel = other.pose.inv_mul(self.pose);
         let placed = if is_identity(self.offset) {
             rel
@@ -55,10 +64,10 @@ impl Placed<'_> {
 /// The distance query of one piece pair, run to convergence (no margin),
 /// in the portable compiled form: the depth's caller runs it only for
 /// pairs that may overlap, a path whose time is the expansion's.
-pub(crate) fn core_run(
+pub(crate) fn core_run<A: SupportMap, B: SupportMap>(
     workspace: &mut Workspace,
-    a: Placed<'_>,
-    b: Placed<'_>,
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
     pieces: [u32; 2],
     options: &Options,
     warm: Option<&WarmStart>,

@@ -9,6 +9,7 @@ use super::numerical_algorithm::{Exit, RunOutcome, RunProgress, push_vertex};
 use super::pair::ConvexPair;
 use super::{Options, Status};
 use crate::johnson::{Simplex, Solution, Vertex};
+use crate::support_map::SupportMap;
 
 /// What step (3) found for one `v` (the subalgorithm's solution, kept
 /// beside it), read by every later decision of the iteration.
@@ -47,7 +48,7 @@ struct Tolerance {
     stop_d: f64,
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// Steps (3) to (6) of the Numerical Algorithm for the subalgorithm's
     /// `solution` (from the Backup Procedure when `by_backup`), in full: the
     /// ends, repeats, flat steps, refinement and the Backup Procedure.

@@ -2,6 +2,7 @@
 //! pair's relative frame, with certified bounds, margins and warm start.
 
 mod answer;
+mod between;
 mod compound;
 pub(crate) mod core_run;
 mod full_step;
@@ -20,8 +21,10 @@ use nalgebra::Isometry3;
 use crate::Error;
 use crate::johnson::Simplex;
 use crate::shape::{Shape, shift_is_in_range};
+use crate::support_map::SupportMap;
 
 pub use answer::Answer;
+pub use between::{distance_between, distance_between_in};
 pub use options::{Options, Precision, Status};
 pub use warm_start::WarmStart;
 
@@ -80,6 +83,23 @@ pub fn distance(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
+    // Written out, not through `with_spare_workspace`: the answer then
+    // goes straight to the caller, where the closure's return cost a copy
+    // of it (callgrind: 30 instructions and a memcpy a family query).
+    let mut workspace = SPARE
+        .try_with(Cell::take)
+        .ok()
+        .flatten()
+        .unwrap_or_else(|| Box::new(Workspace::new()));
+    let answer = distance_in(&mut workspace, a, pose_a, b, pose_b, options, warm);
+    let _ = SPARE.try_with(|spare| spare.set(Some(workspace)));
+    answer
+}
+
+/// `run` in the thread's spare workspace, lent out and put back, for
+/// [`distance_between`].
+#[inline(always)]
+fn with_spare_workspace<R>(run: impl FnOnce(&mut Workspace) -> R) -> R {
     // Any workspace gives the same answer: a fresh one serves the first
     // query of a thread, and any query while the thread's is out of reach
     // (during thread teardown).
@@ -88,7 +108,7 @@ pub fn distance(
         .ok()
         .flatten()
         .unwrap_or_else(|| Box::new(Workspace::new()));
-    let answer = distance_in(&mut workspace, a, pose_a, b, pose_b, options, warm);
+    let answer = run(&mut workspace);
     // Dropped instead if the thread-local is gone.
     let _ = SPARE.try_with(|spare| spare.set(Some(workspace)));
     answer
@@ -157,12 +177,12 @@ pub fn distance_in_baseline(
 }
 
 /// One query's inputs, handed whole between [`distance_in`]'s compiled
-/// forms.
-#[derive(Clone, Copy)]
-struct Query<'q> {
-    a: &'q Shape,
+/// forms: two [`Shape`]s, or for [`distance_between`] any two
+/// [`SupportMap`](crate::SupportMap)s.
+struct Query<'q, A = Shape, B = Shape> {
+    a: &'q A,
     pose_a: &'q Isometry3<f64>,
-    b: &'q Shape,
+    b: &'q B,
     pose_b: &'q Isometry3<f64>,
     options: &'q Options,
     warm: Option<&'q WarmStart>,
@@ -171,13 +191,22 @@ struct Query<'q> {
     swapped: bool,
 }
 
-impl<'q> Query<'q> {
+// By hand: derived, they would ask `A` and `B` to be `Copy` too.
+impl<A, B> Clone for Query<'_, A, B> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<A, B> Copy for Query<'_, A, B> {}
+
+impl<'q, A, B> Query<'q, A, B> {
     /// A query asked the way round its caller gave it.
     #[inline(always)]
     fn new(
-        a: &'q Shape,
+        a: &'q A,
         pose_a: &'q Isometry3<f64>,
-        b: &'q Shape,
+        b: &'q B,
         pose_b: &'q Isometry3<f64>,
         options: &'q Options,
         warm: Option<&'q WarmStart>,
@@ -190,6 +219,21 @@ impl<'q> Query<'q> {
             options,
             warm,
             swapped: false,
+        }
+    }
+
+    /// The same query with A and B swapped, cold: the second opinion of
+    /// [`second_opinion`](recovery::second_opinion), asked no further.
+    #[inline(always)]
+    fn swapped(&self) -> Query<'q, B, A> {
+        Query {
+            a: self.b,
+            pose_a: self.pose_b,
+            b: self.a,
+            pose_b: self.pose_a,
+            options: self.options,
+            warm: None,
+            swapped: true,
         }
     }
 }
@@ -229,6 +273,40 @@ fn distance_body<const AVX2: bool>(
         return Err(Error::WarmStartOutOfRange);
     }
     let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
+    let rel = relative_pose(pose_a, pose_b)?;
+    // `stuck_width`: the interval width beyond which the answer is asked again
+    // the other way round (see `second_opinion`).
+    let (answer, stuck_width) = match (a, b) {
+        (Shape::Convex(convex_a), Shape::Convex(convex_b)) => pair_answer::<AVX2, _, _>(
+            &mut workspace.simplex,
+            (convex_a, pose_a),
+            (convex_b, pose_b),
+            &rel,
+            options,
+            warm,
+            swapped,
+        ),
+        _ => {
+            let (answer, stuck_width) =
+                search_compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
+            (answer, if swapped { f64::INFINITY } else { stuck_width })
+        }
+    };
+    // The answer goes out as it was built unless one of the three rare
+    // checks below needs to change it (kept out of line, so that the common
+    // path neither copies nor rewrites it).
+    if is_suspect(&answer, stuck_width) {
+        return recover_suspect_answer::<AVX2>(answer, workspace, query, stuck_width);
+    }
+    Ok(answer)
+}
+
+/// `a⁻¹·b`, the pose of B in A's frame, or [`Error::NonFinitePose`].
+#[inline(always)]
+fn relative_pose(
+    pose_a: &Isometry3<f64>,
+    pose_b: &Isometry3<f64>,
+) -> Result<Isometry3<f64>, Error> {
     // a⁻¹·b: the translations are subtracted before rotating, so poses far from
     // the world origin cancel exactly when the objects are near each other.
     let rel = pose_a.inv_mul(pose_b);
@@ -243,51 +321,53 @@ fn distance_body<const AVX2: bool>(
         // of 0, before shapes were held to MAX_REACH).
         return Err(Error::NonFinitePose);
     }
-    // `stuck_width`: the interval width beyond which the answer is asked again
-    // the other way round (see `second_opinion`).
-    let (answer, stuck_width) = match (a, b) {
-        (Shape::Convex(convex_a), Shape::Convex(convex_b)) => {
-            let place_a = PiecePlacement {
-                pose: pose_a,
-                offset: None,
-            };
-            let place_b = PiecePlacement {
-                pose: pose_b,
-                offset: None,
-            };
-            let pair = ConvexPair::new(
-                convex_a,
-                convex_b,
-                &rel,
-                (place_a, place_b),
-                options.precision,
-            );
-            let simplex = &mut workspace.simplex;
-            let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
-            let mut run =
-                pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
-            pair.deepen(&mut run, simplex, options);
-            let stuck_width = if swapped {
-                f64::INFINITY
-            } else {
-                pair.stuck_width(options.tolerance)
-            };
-            (pair.to_answer(&run, simplex, place_a, [0, 0]), stuck_width)
-        }
-        _ => {
-            let (answer, stuck_width) =
-                search_compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
-            (answer, if swapped { f64::INFINITY } else { stuck_width })
-        }
+    Ok(rel)
+}
+
+/// Whether an answer needs one of the three rare checks of
+/// `recover_suspect_answer` (kept out of line, so that the common path
+/// neither copies nor rewrites it): contradicting bounds, a number that
+/// overflowed, or an interval wider than `stuck_width`.
+#[inline(always)]
+fn is_suspect(answer: &Answer, stuck_width: f64) -> bool {
+    answer.lower > answer.upper || !all_finite(answer) || answer.upper - answer.lower > stuck_width
+}
+
+/// One convex pair's answer, whatever the shapes' types (two [`Convex`]
+/// pieces of [`distance`], or any two support maps of
+/// [`distance_between`]), with the interval width beyond which it is asked
+/// again swapped (infinite for the swapped query itself): the pair set up in
+/// A's frame, the Numerical Algorithm run (warm, or rerun cold), the
+/// penetration deepened and the answer built. `warm` is the query's warm
+/// start, already filtered by the options.
+///
+/// [`Convex`]: crate::Convex
+#[inline(always)]
+fn pair_answer<const AVX2: bool, A: SupportMap, B: SupportMap>(
+    simplex: &mut Simplex,
+    (a, pose_a): (&A, &Isometry3<f64>),
+    (b, pose_b): (&B, &Isometry3<f64>),
+    rel: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+    swapped: bool,
+) -> (Answer, f64) {
+    let place_a = PiecePlacement {
+        pose: pose_a,
+        offset: None,
     };
-    // The answer goes out as it was built unless one of the three rare
-    // checks below needs to change it (kept out of line, so that the common
-    // path neither copies nor rewrites it).
-    if answer.lower > answer.upper
-        || !all_finite(&answer)
-        || answer.upper - answer.lower > stuck_width
-    {
-        return recover_suspect_answer::<AVX2>(answer, workspace, query, stuck_width);
-    }
-    Ok(answer)
+    let place_b = PiecePlacement {
+        pose: pose_b,
+        offset: None,
+    };
+    let pair = ConvexPair::new(a, b, rel, (place_a, place_b), options.precision);
+    let warm_pairs = warm.and_then(|w| w.for_pieces([0, 0]));
+    let mut run = pair.solve_or_rerun_cold::<AVX2>(simplex, options, warm_pairs, f64::INFINITY);
+    pair.deepen(&mut run, simplex, options);
+    let stuck_width = if swapped {
+        f64::INFINITY
+    } else {
+        pair.stuck_width(options.tolerance)
+    };
+    (pair.to_answer(&run, simplex, place_a, [0, 0]), stuck_width)
 }

@@ -5,6 +5,7 @@ use super::pair::ConvexPair;
 use super::seed::{Certificate, Seeding};
 use super::{Options, Status};
 use crate::johnson::{Simplex, Solution, Vertex};
+use crate::support_map::SupportMap;
 
 /// Johnson's subalgorithm in the query's compiled form (see
 /// [`distance_avx2`](super::distance_avx2)).
@@ -108,7 +109,7 @@ pub(super) enum Exit {
     Pruned,
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// The Numerical Algorithm, steps (1) to (6): one run, its lengths in the
     /// world's units (the simplex's points stay in the scaled frame).
     #[inline(always)]
@@ -119,10 +120,12 @@ impl ConvexPair<'_> {
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> RunOutcome {
-        // Two copies of the loop: pairs without a cylinder (never seeded)
-        // run one with no trace of the seed, which keeps their time.
+        // Two copies of the loop, by the seed hook's answer at the pair's
+        // setup (`SupportMap::seed_form`): in this one the compiler knows
+        // that `seed_after` is `u32::MAX` and drops every trace of the seed,
+        // which keeps the time of the pairs without one.
         let mut run = if self.seed_after == u32::MAX {
-            self.solve_scaled::<AVX2, false>(simplex, options, warm, cutoff)
+            self.solve_scaled::<AVX2>(simplex, options, warm, cutoff)
         } else {
             self.solve_seeded::<AVX2>(simplex, options, warm, cutoff)
         };
@@ -145,7 +148,7 @@ impl ConvexPair<'_> {
         warm: Option<&[[u32; 2]]>,
         cutoff: f64,
     ) -> RunOutcome {
-        self.solve_scaled::<AVX2, true>(simplex, options, warm, cutoff)
+        self.solve_scaled::<AVX2>(simplex, options, warm, cutoff)
     }
 
     /// [`solve`](Self::solve) in the scaled frame: every length in the
@@ -158,7 +161,7 @@ impl ConvexPair<'_> {
     /// Both take the same decisions on the same values, so the split changes
     /// the time of a query, never its answer.
     #[inline(always)]
-    pub(super) fn solve_scaled<const AVX2: bool, const SEED: bool>(
+    pub(super) fn solve_scaled<const AVX2: bool>(
         &self,
         simplex: &mut Simplex,
         options: &Options,
@@ -167,7 +170,9 @@ impl ConvexPair<'_> {
     ) -> RunOutcome {
         // Step (1): V0 from the warm start (for a pair with a cylinder,
         // the seed solved from it), else the single point s_K(z̄2 - z̄1).
-        let seed_after = if SEED { self.seed_after } else { u32::MAX };
+        // Whether the pair is seeded at all (see `seed`), from the hook.
+        let seeded = self.seed_after != u32::MAX;
+        let seed_after = self.seed_after;
         // The iteration from which the run is next seeded, how many seeds
         // it has left, and the share of `|v|` and the length its lower
         // bound must reach.
@@ -191,7 +196,7 @@ impl ConvexPair<'_> {
             level_v2: f64::INFINITY,
         };
         match warm {
-            Some(pairs) => match if SEED {
+            Some(pairs) => match if seeded {
                 self.warm_seed(pairs, stop_d)
             } else {
                 None
@@ -248,7 +253,7 @@ impl ConvexPair<'_> {
             // A seed's own lower bound, from the direction it was solved
             // at, may already meet the stopping rule: then no support
             // search is needed.
-            if SEED && norm - state.lower <= stop_d {
+            if seeded && norm - state.lower <= stop_d {
                 return self.end_run(simplex, &state, Status::Converged, solution, state.lower);
             }
             // Step (3).
@@ -299,7 +304,7 @@ impl ConvexPair<'_> {
             // distance lost in round-off, and a fresh start would lose a
             // slow run's progress (a touching contact 1e9 from the origin
             // hit the iteration cap).
-            if SEED
+            if seeded
                 && state.iterations >= next_seed
                 && seeds_left > 0
                 && v_dot_support > seed_share * v2

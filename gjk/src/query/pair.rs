@@ -9,10 +9,13 @@ use crate::shape::Convex;
 use crate::support_map::SupportMap;
 
 /// Two convex pieces in the frame of A's piece, origin at A's centroid: the
-/// quantities that do not change during one query.
-pub(super) struct ConvexPair<'s> {
-    pub(super) a: &'s Convex,
-    pub(super) b: &'s Convex,
+/// quantities that do not change during one query. Generic over the two
+/// shapes' [`SupportMap`]s and monomorphised, so that each pair of types
+/// gets its own loop with the support searches inlined; the stored
+/// [`Convex`] pair is the default, what unions and the server run.
+pub(super) struct ConvexPair<'s, A = Convex, B = Convex> {
+    pub(super) a: &'s A,
+    pub(super) b: &'s B,
     /// Rotation of B's piece into A's piece frame.
     pub(super) rotation: Matrix3<f64>,
     /// B's centroid minus A's centroid, in A's piece frame: `z̄2 - z̄1`,
@@ -101,26 +104,26 @@ pub(super) struct PiecePlacement<'p> {
     pub(super) offset: Option<&'p Isometry3<f64>>,
 }
 
-impl<'s> ConvexPair<'s> {
+impl<'s, A: SupportMap, B: SupportMap> ConvexPair<'s, A, B> {
     /// The pair at relative pose `rel = A⁻¹·B`. `world` holds where each
     /// piece sits (its shape's pose and a compound piece's offset), for the
     /// exact centroid offset of a frame far from its vertices.
     #[inline(always)]
     pub(super) fn new(
-        a: &'s Convex,
-        b: &'s Convex,
+        a: &'s A,
+        b: &'s B,
         rel: &Isometry3<f64>,
         world: (PiecePlacement<'_>, PiecePlacement<'_>),
         precision: Precision,
     ) -> Self {
         let rotation = *rel.rotation.to_rotation_matrix().matrix();
-        let rotated_centroid_b = rotation * b.centroid().coords;
-        let (centroid_a, centroid_b) = (a.centroid(), b.centroid());
+        let rotated_centroid_b = rotation * b.centre().coords;
+        let (centroid_a, centroid_b) = (a.centre(), b.centre());
         // Centroids far from their body origins (relative to the shapes'
         // sizes) make the rotated centroid and the translation cancel: then
         // the offset is taken in world coordinates in double-double and
         // rotated once.
-        let (norm_a, norm_b) = (a.centroid_norm(), b.centroid_norm());
+        let (norm_a, norm_b) = (a.centre_norm(), b.centre_norm());
         let far = norm_a + norm_b > 16.0 * (a.size() + b.size());
         let (centroid_gap, exact) = if far {
             (exact_centroid_gap(world, &centroid_a, &centroid_b), true)
@@ -149,8 +152,9 @@ impl<'s> ConvexPair<'s> {
         // support value; every direction it is given has |η| = |v|, so the
         // support value of K = A - B may be missed by this times |v|.
         let single_slack = if single_precision {
-            let f32_size = |c: &Convex| if c.has_single() { c.size() } else { 0.0 };
-            crate::shape::polytope::single::SINGLE_SLACK * (f32_size(a) + f32_size(b)) * scale
+            crate::shape::polytope::single::SINGLE_SLACK
+                * (a.single_size() + b.single_size())
+                * scale
         } else {
             0.0
         };
@@ -176,7 +180,7 @@ impl<'s> ConvexPair<'s> {
             size_bound,
             slack,
             slack_world: slack * inv_scale,
-            radii: a.radius() + b.radius(),
+            radii: a.rounding() + b.rounding(),
             scale,
             inv_scale,
             single_precision,

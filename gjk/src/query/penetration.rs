@@ -23,6 +23,7 @@ use super::Options;
 use super::numerical_algorithm::RunOutcome;
 use super::pair::ConvexPair;
 use crate::johnson::{Simplex, face_round_off};
+use crate::support_map::SupportMap;
 
 /// At most this many points are added, whatever the options ask.
 pub(super) const MAX_EXPANSIONS: u32 = 12;
@@ -185,7 +186,7 @@ impl Polytope {
     }
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// Raises `run`'s core penetration bound by growing its final
     /// tetrahedron (see the module), when the options ask for expansions,
     /// the cores intersect and neither piece is a cylinder (whose support

@@ -7,34 +7,21 @@ use super::pair::ConvexPair;
 use super::{Answer, Options, Query, Status, Workspace, all_finite, distance_body, distance_in};
 use crate::Error;
 use crate::johnson::Simplex;
+use crate::support_map::SupportMap;
 
 /// A query that ended with an interval wider than the tolerance (stuck,
 /// its support point tied between far points by `v`'s round-off), asked
-/// once more with the shapes swapped: B's frame rounds differently, and a
-/// needle along a prism's edge (vertex lists repeated) that stopped far
-/// short of its distance reaches it that way. Unions too: their piece
-/// pairs run the same way, and
-/// the needle as a union's piece stopped where it did alone. Both answers
-/// are certified, so the nearer upper bound wins and the lower bounds
-/// combine. Cold, as a warm start names the pairs the other way round;
-/// rare, so out of line.
+/// once more with the shapes swapped (`second`): B's frame rounds
+/// differently, and a needle along a prism's edge (vertex lists repeated)
+/// that stopped far short of its distance reaches it that way. Unions too:
+/// their piece pairs run the same way, and the needle as a union's piece
+/// stopped where it did alone. Both answers are certified, so the nearer
+/// upper bound wins and the lower bounds combine. Cold, as a warm start
+/// names the pairs the other way round; rare, so out of line.
 #[cold]
 #[inline(never)]
-pub(super) fn second_opinion<const AVX2: bool>(
-    first: Answer,
-    workspace: &mut Workspace,
-    query: &Query<'_>,
-) -> Answer {
-    let other = Query {
-        a: query.b,
-        pose_a: query.pose_b,
-        b: query.a,
-        pose_b: query.pose_a,
-        options: query.options,
-        warm: None,
-        swapped: true,
-    };
-    let Ok(second) = distance_body::<AVX2>(workspace, &other) else {
+pub(super) fn second_opinion(first: Answer, second: Result<Answer, Error>) -> Answer {
+    let Ok(second) = second else {
         return first;
     };
     let lower = first.lower.max(second.lower);
@@ -74,28 +61,12 @@ pub(super) fn recover_suspect_answer<const AVX2: bool>(
     query: &Query<'_>,
     stuck_width: f64,
 ) -> Result<Answer, Error> {
-    let answer = mend_bounds_or_reject_overflow(answer, workspace, query)?;
-    let converging = matches!(answer.status, Status::Converged | Status::ToleranceNotMet);
-    if converging && answer.upper - answer.lower > stuck_width {
-        return Ok(second_opinion::<AVX2>(answer, workspace, query));
-    }
-    Ok(answer)
-}
-
-/// Bounds that contradict each other, or a number that overflowed.
-pub(super) fn mend_bounds_or_reject_overflow(
-    mut answer: Answer,
-    workspace: &mut Workspace,
-    query: &Query<'_>,
-) -> Result<Answer, Error> {
-    if answer.lower > answer.upper {
-        // The bounds contradict each other: round-off beyond the slack. The
-        // one case fuzzing found (NaN weights from overflowing cofactors)
-        // is handled in `solve`; this is the last line of defence. A cold
-        // start is tried first; if that too is inconsistent, the lower
-        // bound is given up (0) rather than returning an interval that
-        // cannot hold.
-        if query.warm.is_some() {
+    recover_with(
+        answer,
+        workspace,
+        query,
+        stuck_width,
+        |workspace| {
             let Query {
                 a,
                 pose_a,
@@ -104,7 +75,48 @@ pub(super) fn mend_bounds_or_reject_overflow(
                 options,
                 ..
             } = *query;
-            return distance_in(workspace, a, pose_a, b, pose_b, options, None);
+            distance_in(workspace, a, pose_a, b, pose_b, options, None)
+        },
+        |workspace| distance_body::<AVX2>(workspace, &query.swapped()),
+    )
+}
+
+/// The rare ends of any query, whatever its shapes' types: `cold` asks the
+/// query again with no warm start, `swapped` with A and B swapped.
+#[inline(always)]
+pub(super) fn recover_with<A, B>(
+    answer: Answer,
+    workspace: &mut Workspace,
+    query: &Query<'_, A, B>,
+    stuck_width: f64,
+    cold: impl FnOnce(&mut Workspace) -> Result<Answer, Error>,
+    swapped: impl FnOnce(&mut Workspace) -> Result<Answer, Error>,
+) -> Result<Answer, Error> {
+    let answer = mend_bounds_or_reject_overflow(answer, workspace, query.warm.is_some(), cold)?;
+    let converging = matches!(answer.status, Status::Converged | Status::ToleranceNotMet);
+    if converging && answer.upper - answer.lower > stuck_width {
+        let second = swapped(workspace);
+        return Ok(second_opinion(answer, second));
+    }
+    Ok(answer)
+}
+
+/// Bounds that contradict each other, or a number that overflowed.
+pub(super) fn mend_bounds_or_reject_overflow(
+    mut answer: Answer,
+    workspace: &mut Workspace,
+    warm: bool,
+    cold: impl FnOnce(&mut Workspace) -> Result<Answer, Error>,
+) -> Result<Answer, Error> {
+    if answer.lower > answer.upper {
+        // The bounds contradict each other: round-off beyond the slack. The
+        // one case fuzzing found (NaN weights from overflowing cofactors)
+        // is handled in `solve`; this is the last line of defence. A cold
+        // start is tried first; if that too is inconsistent, the lower
+        // bound is given up (0) rather than returning an interval that
+        // cannot hold.
+        if warm {
+            return cold(workspace);
         }
         answer.lower = 0.0;
         answer.distance = answer.distance.min(answer.upper);
@@ -117,7 +129,7 @@ pub(super) fn mend_bounds_or_reject_overflow(
     Ok(answer)
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// [`solve`](Self::solve), then, when a warm start ended with a loose
     /// interval, once more cold ([`rerun_cold`](Self::rerun_cold)): single
     /// pairs and a compound's piece pairs alike. Only a run that meant to

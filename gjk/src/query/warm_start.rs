@@ -33,7 +33,13 @@ impl PieceSimplex {
         ) else {
             return false;
         };
-        let (len_a, len_b) = (convex_a.index_count(), convex_b.index_count());
+        self.fits_counts(convex_a.index_count(), convex_b.index_count())
+    }
+
+    /// Whether every index pair is below `len_a` and `len_b` (an entry with
+    /// no pairs always fits).
+    #[inline]
+    pub(super) fn fits_counts(&self, len_a: usize, len_b: usize) -> bool {
         let mut ok = self.len <= 4;
         for &[i, j] in self.pairs() {
             ok &= (i as usize) < len_a;

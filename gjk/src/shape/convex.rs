@@ -240,11 +240,6 @@ impl Convex {
         self.centroid
     }
 
-    /// `|centroid|`.
-    pub(crate) fn centroid_norm(&self) -> f64 {
-        self.centroid_norm
-    }
-
     /// How far the shape's core reaches from its body origin: `|centroid| +
     /// size`, an upper bound on every vertex's distance from it.
     #[inline]
@@ -406,6 +401,26 @@ impl SupportMap for Convex {
     #[inline(always)]
     fn rounding(&self) -> f64 {
         self.radius
+    }
+
+    #[inline(always)]
+    fn size(&self) -> f64 {
+        self.size
+    }
+
+    #[inline(always)]
+    fn index_count(&self) -> usize {
+        Convex::index_count(self)
+    }
+
+    #[inline(always)]
+    fn centre_norm(&self) -> f64 {
+        self.centroid_norm
+    }
+
+    #[inline(always)]
+    fn single_size(&self) -> f64 {
+        if self.has_single() { self.size } else { 0.0 }
     }
 
     #[inline(always)]

@@ -15,29 +15,31 @@
 
 use nalgebra::Vector3;
 
+use super::kinks::cylinder_of;
 use crate::query::pair::{ConvexPair, rotate, rotate_back};
 use crate::shape::cylinder;
+use crate::support_map::SupportMap;
 
 /// How near the rim (as a share of the radius) a projection may come and
 /// still be seeded from the cap: nearer, the answer is on the rim, and the
 /// triangle around the projection too thin to be worth it.
 const RIM_MARGIN: f64 = 1e-6;
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// The seed of an answer on cylinder `k`'s cap (0 for A, 1 for B)
     /// that faces A's support direction `u` (pair frame, any length): `None`
     /// when shape `k` is no cylinder, `u` is perpendicular to its axis, or
     /// the other shape's support point along the axis is not beyond the cap
     /// or does not project inside it.
     pub(super) fn cap_seed(&self, k: usize, u: &Vector3<f64>) -> Option<[[u32; 2]; 3]> {
-        let shape = if k == 0 { self.a } else { self.b };
-        let (r, h) = shape.cylinder_dimensions()?;
+        let shape = self.shapes()[k];
+        let (r, h) = cylinder_of(shape)?;
         let (r, h) = (r * self.scale, h * self.scale);
         let pairs = if k == 0 {
             let side = axis_sign(u.z)?;
             // B's support against A's cap: at -side·z in the pair frame.
             let d_b = rotate_back(&self.rotation, &Vector3::new(0.0, 0.0, -side));
-            let (ib, point) = self.b.support_point(&d_b);
+            let (ib, point) = self.b.local_support(&d_b);
             let q = rotate(&self.rotation, &point) * self.scale + self.centroid_gap;
             let [c, p1, p2] = cap_triangle(&q, side, r, h)?;
             let ib = ib as u32;
@@ -47,7 +49,7 @@ impl ConvexPair<'_> {
             let d_b = -rotate_back(&self.rotation, u);
             let side = axis_sign(d_b.z)?;
             let axis = rotate(&self.rotation, &Vector3::new(0.0, 0.0, side));
-            let (ia, point) = self.a.support_point(&-axis);
+            let (ia, point) = self.a.local_support(&-axis);
             let q = rotate_back(&self.rotation, &(point * self.scale - self.centroid_gap));
             let [c, p1, p2] = cap_triangle(&q, side, r, h)?;
             let ia = ia as u32;

@@ -27,9 +27,10 @@
 
 use nalgebra::Vector3;
 
-use super::kinks::{Kinks, Solve};
+use super::kinks::{Kinks, Solve, cylinder_of};
 use crate::query::pair::ConvexPair;
 use crate::shape::cylinder;
+use crate::support_map::SupportMap;
 
 /// What a warm start names as one shape's part of the answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,7 +89,7 @@ const LARGEST_STEP: f64 = 0.5;
 /// A rim's axis (unit, pair frame) and radius (scaled).
 type Rim = (Vector3<f64>, f64);
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// The direction that maximises the separation of the supports the
     /// warm start's `features` name, from `solve.u`: on the sphere when
     /// `solve` holds no kink, on the circle across its one held axis when
@@ -109,7 +110,7 @@ impl ConvexPair<'_> {
         let mut rims: [Rim; 2] = [(Vector3::zeros(), 0.0); 2];
         let mut rim_count = 0;
         let axes = self.axes();
-        for (k, (shape, feature)) in [self.a, self.b].into_iter().zip(features).enumerate() {
+        for (k, (shape, feature)) in self.shapes().into_iter().zip(features).enumerate() {
             let sign = if k == 0 { -self.scale } else { self.scale };
             match feature {
                 Feature::Side => {}
@@ -118,13 +119,14 @@ impl ConvexPair<'_> {
                     if kinks.len != 2 {
                         return None;
                     }
-                    linear += self.in_pair_frame(k, shape.point(kinks.keys[0] as usize)) * sign;
+                    linear +=
+                        self.in_pair_frame(k, shape.local_point(kinks.keys[0] as usize)) * sign;
                 }
                 Feature::Vertex(index) => {
-                    linear += self.in_pair_frame(k, shape.point(index as usize)) * sign;
+                    linear += self.in_pair_frame(k, shape.local_point(index as usize)) * sign;
                 }
                 Feature::Rim(top) => {
-                    let (r, h) = shape.cylinder_dimensions()?;
+                    let (r, h) = cylinder_of(shape)?;
                     let axis = axes[k];
                     let cap = if top { h } else { -h };
                     linear += axis * (cap * sign);
@@ -415,7 +417,7 @@ fn sphere_newton(mut u: Vector3<f64>, m: &Vector3<f64>, rims: &[Rim]) -> Option<
     None
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// Whether the supports at the solved direction name the features the
     /// closed form assumed: each shape's support index (a cylinder's code)
     /// and the unit body direction it was taken at, against its feature:
@@ -430,7 +432,7 @@ impl ConvexPair<'_> {
         supports: [(usize, Vector3<f64>); 2],
         features: [Feature; 2],
     ) -> bool {
-        [self.a, self.b]
+        self.shapes()
             .into_iter()
             .zip(supports)
             .zip(features)
@@ -442,7 +444,8 @@ impl ConvexPair<'_> {
                     Feature::Edge => kinks.has(key),
                     Feature::Face => {
                         kinks.has(key) || {
-                            let rise = shape.point(index) - shape.point(kinks.keys[0] as usize);
+                            let rise = shape.local_point(index)
+                                - shape.local_point(kinks.keys[0] as usize);
                             d.dot(&rise).abs() <= FACE_TIE * rise.norm()
                         }
                     }

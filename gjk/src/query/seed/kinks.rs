@@ -4,8 +4,8 @@
 
 use nalgebra::Vector3;
 
-use crate::shape::Convex;
 use crate::shape::cylinder;
+use crate::support_map::{SeedForm, SupportMap};
 
 /// One shape's support at a direction, in the pair frame (scaled).
 #[derive(Clone, Copy)]
@@ -104,14 +104,28 @@ impl Constraints {
     }
 }
 
+/// `(radius, half_height)` of a shape whose seed hook
+/// ([`SupportMap::seed_form`]) names a cylinder, `None` for any other: the
+/// seed's closed forms are the cylinder's, every other shape's features
+/// are its support points.
+#[inline(always)]
+pub(super) fn cylinder_of<S: SupportMap + ?Sized>(shape: &S) -> Option<(f64, f64)> {
+    match shape.seed_form()? {
+        SeedForm::Cylinder {
+            radius,
+            half_height,
+        } => Some((radius, half_height)),
+    }
+}
+
 /// The support of `shape` (a body frame's centroid-relative coordinates)
 /// at the body direction `d` (unit), by the cylinder's closed form with its
 /// curvature, or the polytope's support search. `None` at a cylinder's
 /// axis, where the curvature is unbounded.
 #[inline(always)]
-pub(super) fn body_touch(shape: &Convex, d: &Vector3<f64>) -> Option<Touch> {
-    let Some((r, h)) = shape.cylinder_dimensions() else {
-        let (index, point) = shape.support_point(d);
+pub(super) fn body_touch<S: SupportMap + ?Sized>(shape: &S, d: &Vector3<f64>) -> Option<Touch> {
+    let Some((r, h)) = cylinder_of(shape) else {
+        let (index, point) = shape.local_support(d);
         return Some(Touch {
             point,
             key: index as u32,

@@ -51,8 +51,9 @@ use nalgebra::Vector3;
 use super::pair::{ConvexPair, rotate, rotate_back};
 use crate::johnson::Vertex;
 use crate::shape::cylinder;
+use crate::support_map::SupportMap;
 use feature::Feature;
-use kinks::{Constraints, Kinks, Solve, Touch, body_touch};
+use kinks::{Constraints, Kinks, Solve, Touch, body_touch, cylinder_of};
 use steps::{
     CAP_NEAR, cap_pair, certifies, newton_step, point_sum, seed_features, span_weights,
     stop_at_side, turn_triangle,
@@ -137,7 +138,15 @@ enum Close {
     Mismatch,
 }
 
-impl ConvexPair<'_> {
+impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
+    /// The two shapes, for the steps that treat each alike: through the
+    /// trait object, as the seed's few support calls a step are not its
+    /// time, and one loop body serves both types.
+    #[inline(always)]
+    fn shapes(&self) -> [&dyn SupportMap; 2] {
+        [self.a, self.b]
+    }
+
     /// Both shapes' supports at `u` (pair frame, unit): A's at `u`, B's at
     /// `-u`, B's moved into the pair frame.
     #[inline(always)]
@@ -193,10 +202,10 @@ impl ConvexPair<'_> {
         let mean = self.difference_of((0, sum_a * share), (0, sum_b * share)).y;
         let mut solve = Solve::default();
         let mut features = [Feature::Other; 2];
-        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
+        for (k, shape) in self.shapes().into_iter().enumerate() {
             let index = |pair: &[u32; 2]| pair[k];
             let first = index(&pairs[0]);
-            if shape.cylinder_dimensions().is_some() {
+            if cylinder_of(shape).is_some() {
                 solve.side[k] = pairs.iter().any(|p| index(p) == cylinder::other_cap(first));
                 let top = cylinder::is_top(first);
                 // Several points of one cap that `warm_cap_seed` found not
@@ -219,7 +228,7 @@ impl ConvexPair<'_> {
                 if key != first && !solve.kinks[k].has(key) && solve.edge_count < 2 {
                     solve.kinks[k].add(first);
                     solve.kinks[k].add(key);
-                    let edge = shape.point(key as usize) - shape.point(first as usize);
+                    let edge = shape.local_point(key as usize) - shape.local_point(first as usize);
                     solve.edges[solve.edge_count] = self.in_pair_frame(k, edge);
                     solve.edge_count += 1;
                 }
@@ -317,8 +326,8 @@ impl ConvexPair<'_> {
     /// points of a cylinder, all on one cap (a cap's answer keeps a
     /// triangle of it).
     fn warm_cap_seed(&self, pairs: &[[u32; 2]]) -> Option<Seed> {
-        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
-            if shape.cylinder_dimensions().is_none() {
+        for (k, shape) in self.shapes().into_iter().enumerate() {
+            if cylinder_of(shape).is_none() {
                 continue;
             }
             let first = pairs[0][k];
@@ -477,7 +486,7 @@ impl ConvexPair<'_> {
     fn close_at(&self, solve: &mut Solve, stop_d: f64, features: Option<[Feature; 2]>) -> Close {
         let u = solve.u;
         let d_b = -rotate_back(&self.rotation, &u);
-        let (a, b) = (self.a.support_point(&u), self.b.support_point(&d_b));
+        let (a, b) = (self.a.local_support(&u), self.b.local_support(&d_b));
         if let Some(features) = features
             && !self.features_hold(&solve.kinks, [(a.0, u), (b.0, d_b)], features)
         {
@@ -546,8 +555,8 @@ impl ConvexPair<'_> {
         // vector in the tangent plane.
         let mut spans = [(2usize, Vector3::zeros()); 2];
         let mut count = 0;
-        for (k, shape) in [self.a, self.b].into_iter().enumerate() {
-            if let (true, Some((_, h))) = (solve.side[k], shape.cylinder_dimensions())
+        for (k, shape) in self.shapes().into_iter().enumerate() {
+            if let (true, Some((_, h))) = (solve.side[k], cylinder_of(shape))
                 && count < 2
             {
                 // y at the other cap minus y here: A's point moves down
@@ -723,10 +732,10 @@ impl ConvexPair<'_> {
             // y = a - b: A's corner moves y with it, B's against it.
             let tilt = away * FACE_TILT;
             let corner = if face == 0 {
-                self.difference_of(self.a.support_point(&(u + tilt)), other)
+                self.difference_of(self.a.local_support(&(u + tilt)), other)
             } else {
                 let d_b = -rotate_back(&self.rotation, &(u + tilt));
-                self.difference_of(other, self.b.support_point(&d_b))
+                self.difference_of(other, self.b.local_support(&d_b))
             };
             (!known.contains(&index(&corner))).then_some(corner)
         })?;
@@ -741,10 +750,10 @@ impl ConvexPair<'_> {
     /// direction turned off the face towards it (`away`, in the plane),
     /// and the face's vertex changes are no longer kinks.
     fn let_go_of_face(&self, solve: &mut Solve, face: usize, keys: [u32; 2], away: Vector3<f64>) {
-        let shape = if face == 0 { self.a } else { self.b };
+        let shape = self.shapes()[face];
         let edge = self.in_pair_frame(
             face,
-            shape.point(keys[1] as usize) - shape.point(keys[0] as usize),
+            shape.local_point(keys[1] as usize) - shape.local_point(keys[0] as usize),
         );
         solve.off_face[face] = true;
         solve.kinks[face] = Kinks {

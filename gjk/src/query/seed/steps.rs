@@ -4,10 +4,10 @@
 
 use nalgebra::Vector3;
 
-use super::kinks::{Constraints, Kinks, Solve, Touch};
+use super::kinks::{Constraints, Kinks, Solve, Touch, cylinder_of};
 use crate::johnson::{Vertex, triangle_weights};
-use crate::shape::Convex;
 use crate::shape::cylinder;
+use crate::support_map::SupportMap;
 
 /// The sine of the angle to a cylinder's axis below which a direction is
 /// tried against its cap (see [`super::cap`]): Newton's steps close in on a
@@ -18,12 +18,12 @@ pub(super) const CAP_NEAR: f64 = 0.25;
 /// index, 1 for B's), a point repeated from the pair before, or its other
 /// cap's, not decoded again; and the first of them.
 #[inline(always)]
-pub(super) fn point_sum(
-    shape: &Convex,
+pub(super) fn point_sum<S: SupportMap + ?Sized>(
+    shape: &S,
     pairs: &[[u32; 2]],
     k: usize,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let cylinder = shape.cylinder_dimensions().is_some();
+    let cylinder = cylinder_of(shape).is_some();
     let mut sum = Vector3::zeros();
     let mut first = None;
     let mut last: Option<(u32, Vector3<f64>)> = None;
@@ -34,7 +34,7 @@ pub(super) fn point_sum(
             Some((seen, point)) if cylinder && seen == cylinder::other_cap(index) => {
                 Vector3::new(point.x, point.y, -point.z)
             }
-            _ => shape.point(index as usize),
+            _ => shape.local_point(index as usize),
         };
         last = Some((index, point));
         first.get_or_insert(point);
@@ -136,14 +136,14 @@ pub(super) const HOLDS_SLACK: f64 = 1e-9;
 /// partners of its held kinks: a cylinder's other cap at the same angle,
 /// a polytope's other kink vertices. At most three.
 #[inline(always)]
-pub(super) fn seed_features(
-    shape: &Convex,
+pub(super) fn seed_features<S: SupportMap + ?Sized>(
+    shape: &S,
     support: (usize, Vector3<f64>),
     kinks: &Kinks,
     side: bool,
 ) -> ([(usize, Vector3<f64>); 3], usize) {
     let mut out = ([support; 3], 1);
-    if shape.cylinder_dimensions().is_some() {
+    if cylinder_of(shape).is_some() {
         if side {
             let (code, point) = support;
             let other = cylinder::other_cap(code as u32) as usize;
@@ -154,7 +154,7 @@ pub(super) fn seed_features(
     }
     for &key in &kinks.keys[..kinks.len] {
         if key as usize != support.0 && out.1 < 3 {
-            out.0[out.1] = (key as usize, shape.point(key as usize));
+            out.0[out.1] = (key as usize, shape.local_point(key as usize));
             out.1 += 1;
         }
     }

@@ -11,11 +11,11 @@
 //!
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
-//! | [`query_service_name`] `{service}/v2/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
-//! | [`admin_service_name`] `{service}/v2/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
-//! | [`scene_service_name`] `{service}/v2/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
-//! | [`poses_service_name`] `{service}/v2/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
-//! | [`wake_service_name`] `{service}/v2/wake` | event | | |
+//! | [`query_service_name`] `{service}/v3/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
+//! | [`admin_service_name`] `{service}/v3/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
+//! | [`scene_service_name`] `{service}/v3/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
+//! | [`poses_service_name`] `{service}/v3/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
+//! | [`wake_service_name`] `{service}/v3/wake` | event | | |
 //!
 //! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
 //! are plain `u32` on the wire, never Rust enums: any bit pattern a client
@@ -80,10 +80,14 @@ pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
 /// Protocol version, part of every service name: a client and a server of
 /// different versions never see each other's services, instead of misreading
 /// each other's bytes (a client that finds only another version's services
-/// reports a version mismatch). Version 2 names every field for what it
+/// reports a version mismatch). Version 2 named every field for what it
 /// holds: registration tokens, removed objects, lookup kinds and cylinder
-/// dimensions have fields of their own.
-pub const PROTOCOL_VERSION: u32 = 2;
+/// dimensions have fields of their own. Version 3 types the rest: an
+/// item's body is a pair view or a joints view ([`ItemBody`]), robot text
+/// travels as bytes ([`AdminChunk`]), results carry the signed distance
+/// and the gradient, scene requests the continuous mode and its bracket,
+/// and stored poses are read back on a service of their own.
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// Service name used when none is given: `"gjkd"`.
 pub const DEFAULT_SERVICE: &str = "gjkd";
@@ -105,7 +109,7 @@ pub const JOINTS_PER_ITEM: usize = 9;
 /// Longest object name in bytes (UTF-8).
 pub const MAX_NAME_LEN: usize = 64;
 
-/// Name of the query service of deployment `service`: `{service}/v2/query`.
+/// Name of the query service of deployment `service`: `{service}/v3/query`.
 pub fn query_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/query")
 }

@@ -59,12 +59,18 @@ def clearance_cost(si: Any, clearance: Any) -> Any:
     integrated along the path) over ``clearance(q)``, for the baseline;
     ``gjkd.ompl.clearance_objective`` is the same over gjkd's clearance."""
 
-    class Clearance(ob.StateCostIntegralObjective):  # type: ignore[misc]
+    class Clearance(ob.OptimizationObjective):  # type: ignore[misc]
         def __init__(self) -> None:
-            super().__init__(si, True)
+            super().__init__(si)
 
         def stateCost(self, state: Any) -> Any:  # noqa: N802 (OMPL's name)
             return ob.Cost(1.0 / (max(clearance(state[0:7]), 0.0) + 1e-9))
+
+        def motionCost(self, s1: Any, s2: Any) -> Any:  # noqa: N802 (OMPL's name)
+            # As gjkd.ompl's: the bindings call no Python override of a
+            # StateCostIntegralObjective subclass from C++.
+            a, b = self.stateCost(s1).value(), self.stateCost(s2).value()
+            return ob.Cost(0.5 * (a + b) * si.distance(s1, s2))
 
     return Clearance()
 

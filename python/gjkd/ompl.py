@@ -480,12 +480,12 @@ def _adapters() -> dict[str, Any]:
                 c.error = e
                 return False
 
-    class ClearanceObjective(ob.StateCostIntegralObjective):  # type: ignore[misc, name-defined]
+    class ClearanceObjective(ob.OptimizationObjective):  # type: ignore[misc, name-defined]
         """Cost 1 / clearance integrated along the path (OMPL's demo's
         clearance objective): lower for paths farther from everything."""
 
         def __init__(self, si: Any, checker: RobotChecker) -> None:
-            super().__init__(si, True)
+            super().__init__(si)
             self.checker = checker
             self.n = checker.dof
 
@@ -497,6 +497,17 @@ def _adapters() -> dict[str, Any]:
                 c.error = e
                 d = 0.0
             return ob.Cost(1.0 / (max(d, 0.0) + 1e-9))
+
+        def motionCost(self, s1: Any, s2: Any) -> Any:  # noqa: N802 (OMPL's name)
+            # The integral by the trapezoid rule, as OMPL's
+            # StateCostIntegralObjective computes it without interpolation:
+            # OMPL's Python bindings call neither a Python `stateCost` nor a
+            # Python `motionCost` of a subclass of that class from C++, so
+            # planners saw unit state costs (the path's length) until this
+            # objective derived from OptimizationObjective itself.
+            a = self.stateCost(s1).value()
+            b = self.stateCost(s2).value()
+            return ob.Cost(0.5 * (a + b) * self.getSpaceInformation().distance(s1, s2))
 
     _ADAPTERS.update(
         StateValidity=StateValidity, Motion=Motion, ClearanceObjective=ClearanceObjective

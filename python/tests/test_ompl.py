@@ -225,6 +225,7 @@ def ompl() -> None:
 
 @pytest.mark.usefixtures("ompl")
 def test_plans_around_the_obstacles_end_to_end(client: gjkd.Client) -> None:
+    from ompl import geometric as og
     from ompl import util as ou
 
     ou.setLogLevel(ou.LOG_WARN)
@@ -255,6 +256,21 @@ def test_plans_around_the_obstacles_end_to_end(client: gjkd.Client) -> None:
         assert obj.stateCost(state).value() == pytest.approx(1.0 / exact_clearance(start), 1e-6)
         validity = ss.getSpaceInformation().getStateValidityChecker()
         assert validity.clearance(state) == pytest.approx(exact_clearance(start), abs=1e-9)
+        # An optimising planner pays it: each motion's cost is the trapezoid
+        # of its ends' costs (the objective the planner sees, not the path
+        # length the bindings would fall back to).
+        goal_state = ss.getSpaceInformation().allocState()
+        for i, v in enumerate(goal):
+            goal_state[i] = float(v)
+        cost = obj.motionCost(state, goal_state).value()
+        length = ss.getSpaceInformation().distance(state, goal_state)
+        want = 0.5 * (1.0 / exact_clearance(start) + 1.0 / exact_clearance(goal)) * length
+        assert cost == pytest.approx(want, rel=1e-6)
+        checker.clearance_checks = 0
+        ss.setPlanner(og.RRTstar(ss.getSpaceInformation()))
+        ss.setOptimizationObjective(obj)
+        assert gjkd.ompl.plan(ss, checker, start, goal, time=0.5) is not None
+        assert checker.clearance_checks > 0, "the planner never asked the objective"
 
 
 @pytest.mark.usefixtures("ompl")

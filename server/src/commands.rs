@@ -40,8 +40,8 @@ impl From<Wait> for WaitMode {
 /// The flags of `gjkd serve`.
 #[derive(Args, Debug)]
 pub struct ServeArgs {
-    /// Deployment name: the services are NAME/v1/query, NAME/v1/admin,
-    /// NAME/v1/scene and NAME/v1/wake.
+    /// Deployment name: the services are NAME/v3/query, NAME/v3/admin,
+    /// NAME/v3/scene and NAME/v3/wake.
     #[arg(long, default_value = DEFAULT_SERVICE)]
     pub service: String,
     /// Scene file (TOML) of read-only named objects to load at start.

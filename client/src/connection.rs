@@ -186,6 +186,25 @@ impl Client {
         ClientError::ServerGone(self.service.clone())
     }
 
+    /// The error for a service opened on first use (scene questions, pose
+    /// read-back) that could not be opened: this client is connected, so a
+    /// missing one is a server of a release without `feature`, the rest as
+    /// [`Self::open_failed`]. `kind` names the service in the message.
+    pub(crate) fn later_service_failed(
+        &self,
+        service: &str,
+        kind: &str,
+        feature: &str,
+        error: iceoryx2::service::builder::request_response::RequestResponseOpenError,
+    ) -> ClientError {
+        match OpenFailure::from(error) {
+            OpenFailure::Missing => ClientError::Protocol(format!(
+                "the server has no {kind} service (a release older than {feature})"
+            )),
+            cause => self.open_failed(service, cause),
+        }
+    }
+
     /// The error for a service that could not be opened. A missing service
     /// is a server not (yet) there, unless a server of another protocol
     /// version serves the name: then waiting would never help.

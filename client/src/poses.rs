@@ -121,14 +121,7 @@ impl Client {
             .request_response::<[u64], [StoredPose]>()
             .response_user_header::<PosesReply>()
             .open()
-            .map_err(|e| match crate::open_failure::OpenFailure::from(e) {
-                // The query service is there (this client is connected):
-                // the server is of a release without pose read-back.
-                crate::open_failure::OpenFailure::Missing => ClientError::Protocol(
-                    "the server has no pose service (a release older than pose read-back)".into(),
-                ),
-                cause => self.open_failed(&name, cause),
-            })?;
+            .map_err(|e| self.later_service_failed(&name, "pose", "pose read-back", e))?;
         let port = service
             .client_builder()
             .initial_max_slice_len(64)

@@ -743,14 +743,7 @@ impl Client {
             .request_user_header::<SceneRequest>()
             .response_user_header::<SceneReply>()
             .open()
-            .map_err(|e| match crate::open_failure::OpenFailure::from(e) {
-                // The query service is there (this client is connected):
-                // the server is of a release without scene queries.
-                crate::open_failure::OpenFailure::Missing => ClientError::Protocol(
-                    "the server has no scene service (a release older than scene queries)".into(),
-                ),
-                cause => self.open_failed(&name, cause),
-            })?;
+            .map_err(|e| self.later_service_failed(&name, "scene", "scene queries", e))?;
         let port = service
             .client_builder()
             .initial_max_slice_len(64)

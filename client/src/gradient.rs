@@ -15,9 +15,9 @@
 //! twist (world frame, turning about its origin). For overlapping objects
 //! it is the signed distance's (`distance − penetration`).
 
-use gjkd_proto::{ErrorCode, Gradient, Item, ItemResult, ObjectId, QueryOptions, SceneRow};
+use gjkd_proto::{Gradient, Item, ObjectId, QueryOptions, SceneRow};
 
-use crate::{Answer, Client, ClientError};
+use crate::{Answer, Client, QueryError, op_error};
 
 impl Client {
     /// Distance between `a` and `b` at their stored poses, with its
@@ -25,7 +25,7 @@ impl Client {
     /// move `a`; `base` adds a robot base's twist.
     ///
     /// # Errors
-    /// As [`Client::distance`], and [`ErrorCode::InvalidOptions`] for a
+    /// As [`Client::distance`], and [`QueryError::InvalidOptions`] for a
     /// robot with more than [`GRADIENT_COLUMNS`](gjkd_proto::GRADIENT_COLUMNS)
     /// coordinates.
     pub fn distance_gradient(
@@ -34,13 +34,9 @@ impl Client {
         b: ObjectId,
         options: &QueryOptions,
         base: bool,
-    ) -> Result<Answer, ClientError> {
-        let mut out = [ItemResult::error(ErrorCode::Internal)];
-        self.query_batch(
-            &[Item::distance(a, b, options).with_gradient(base)],
-            &mut out,
-        )?;
-        out[0].answer().map_err(ClientError::Rejected)
+    ) -> Result<Answer, QueryError> {
+        self.single(Item::distance(a, b, options).with_gradient(base))
+            .map_err(op_error)
     }
 }
 

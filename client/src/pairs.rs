@@ -9,8 +9,8 @@ use nalgebra::Isometry3;
 #[cfg(doc)]
 use crate::ServerInfo;
 use crate::{
-    Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, QueryOptions, Waited,
-    ipc_err, reply_accepted,
+    Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, PoseError, QueryError,
+    QueryOptions, Waited, ipc_err, op_error, reply_accepted,
 };
 
 impl Client {
@@ -18,32 +18,35 @@ impl Client {
     /// that does not give its own.
     ///
     /// # Errors
-    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NonFinitePose`],
-    /// [`ErrorCode::BadQuaternion`], and the connection errors.
-    pub fn set_pose(&mut self, id: ObjectId, pose: &Isometry3<f64>) -> Result<(), ClientError> {
-        self.single(Item::set_pose(id, pose)).map(|_| ())
+    /// [`PoseError::UnknownObject`], [`PoseError::NonFinitePose`],
+    /// [`PoseError::BadQuaternion`], and the connection faults.
+    pub fn set_pose(&mut self, id: ObjectId, pose: &Isometry3<f64>) -> Result<(), PoseError> {
+        self.single(Item::set_pose(id, pose))
+            .map(|_| ())
+            .map_err(op_error)
     }
 
     /// Distance between `a` and `b` at their stored poses.
     ///
     /// # Errors
-    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownObject`] or
-    /// [`ErrorCode::InvalidOptions`], and the connection errors.
+    /// [`QueryError::UnknownObject`], [`QueryError::InvalidOptions`],
+    /// [`QueryError::NonFinitePose`] (the two objects too far apart), and
+    /// the connection faults.
     pub fn distance(
         &mut self,
         a: ObjectId,
         b: ObjectId,
         options: &QueryOptions,
-    ) -> Result<Answer, ClientError> {
-        self.single(Item::distance(a, b, options))
+    ) -> Result<Answer, QueryError> {
+        self.single(Item::distance(a, b, options)).map_err(op_error)
     }
 
     /// Distance between `a` at `pose_a` and `b` at `pose_b`; the stored poses
     /// are neither used nor changed.
     ///
     /// # Errors
-    /// As [`Client::distance`], plus [`ErrorCode::NonFinitePose`] and
-    /// [`ErrorCode::BadQuaternion`].
+    /// As [`Client::distance`], plus [`QueryError::NonFinitePose`] and
+    /// [`QueryError::BadQuaternion`] for a pose given.
     pub fn distance_at(
         &mut self,
         a: ObjectId,
@@ -51,13 +54,15 @@ impl Client {
         b: ObjectId,
         pose_b: &Isometry3<f64>,
         options: &QueryOptions,
-    ) -> Result<Answer, ClientError> {
+    ) -> Result<Answer, QueryError> {
         self.single(Item::distance_at(a, pose_a, b, pose_b, options))
+            .map_err(op_error)
     }
 
-    fn single(&mut self, item: Item) -> Result<Answer, ClientError> {
+    /// The answer to one item, its refusal as the request's.
+    pub(crate) fn single(&mut self, item: Item) -> Result<Answer, ClientError> {
         let mut out = [ItemResult::error(ErrorCode::Internal)];
-        self.query_batch(&[item], &mut out)?;
+        self.batch(&[item], &mut out)?;
         out[0].answer().map_err(ClientError::Rejected)
     }
 
@@ -69,21 +74,30 @@ impl Client {
     /// small allocation per request for its loan bookkeeping).
     ///
     /// # Errors
-    /// [`ClientError::ResultBufferTooSmall`];
-    /// [`ClientError::Rejected`] with [`ErrorCode::EmptyBatch`] or
-    /// [`ErrorCode::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
-    /// items); and the connection errors.
+    /// [`QueryError::ResultBufferTooSmall`]; [`QueryError::EmptyBatch`] or
+    /// [`QueryError::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
+    /// items); and the connection faults.
     pub fn query_batch(
         &mut self,
         items: &[Item],
         results: &mut [ItemResult],
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         if results.len() < items.len() {
-            return Err(ClientError::ResultBufferTooSmall {
+            return Err(QueryError::ResultBufferTooSmall {
                 needed: items.len(),
                 got: results.len(),
             });
         }
+        self.batch(items, results).map_err(op_error)
+    }
+
+    /// [`Client::query_batch`] for the calls built on it, which say what
+    /// its failures mean for them; `results` holds one per item.
+    pub(crate) fn batch(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+    ) -> Result<(), ClientError> {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
@@ -103,8 +117,9 @@ impl Client {
         &mut self,
         items: &[Item],
         read: impl FnOnce(&[ItemResult]),
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         self.round_trip(items.len(), Source::<fn(usize) -> Item>::Slice(items), read)
+            .map_err(op_error)
     }
 
     /// As [`Client::query_batch`], but item `i` of the `count` items is
@@ -121,8 +136,9 @@ impl Client {
         count: usize,
         item: impl FnMut(usize) -> Item,
         read: impl FnOnce(&[ItemResult]),
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         self.round_trip(count, Source::Fn(item), read)
+            .map_err(op_error)
     }
 
     /// Sends `count` items from `source` as one request and hands the

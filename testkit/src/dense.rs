@@ -68,29 +68,25 @@ pub fn first_within<P: Clone>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Point3, UnitQuaternion, Vector3};
+    use crate::sweep::Rng;
+    use nalgebra::{Point3, UnitQuaternion};
 
     #[test]
     fn displacement_bounds_every_point_it_covers() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = Rng::new(0x2545_f491_4f6c_dd1d);
         for k in 0..2_000 {
             // Small turns as often as large ones: the chord must hold at both.
-            let scale = if k % 2 == 0 { 1e-7 } else { 3.0 };
-            let pose = |next: &mut dyn FnMut() -> f64, s: f64| {
+            let angle = if k % 2 == 0 { 1e-7 } else { 3.0 };
+            let mut pose = |turn: f64| {
+                let axis = rng.direction() * rng.uniform(0.0, turn);
                 Isometry3::from_parts(
-                    Vector3::new(next(), next(), next()).into(),
-                    UnitQuaternion::from_scaled_axis(Vector3::new(next(), next(), next()) * s),
+                    (rng.direction() * rng.unit_interval()).into(),
+                    UnitQuaternion::from_scaled_axis(axis),
                 )
             };
-            let a = pose(&mut next, 3.0);
-            let b = a * pose(&mut next, scale);
-            let p = Point3::new(next(), next(), next());
+            let a = pose(3.0);
+            let b = a * pose(angle);
+            let p = Point3::from(rng.direction() * rng.uniform(0.0, 2.0));
             let reach = p.coords.norm();
             let moved = (a * p - b * p).norm();
             assert!(

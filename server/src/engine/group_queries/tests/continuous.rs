@@ -30,20 +30,12 @@ fn reach_of(shape: &Shape) -> f64 {
     super::super::broadphase::bounding_sphere(shape).2
 }
 
-/// The farthest point of a shape from its body origin, radius included,
-/// from its vertices (the motion bound of the dense sampling's skips).
-fn body_reach(shape: &Shape) -> f64 {
-    let convex: Vec<(Isometry3<f64>, &Convex)> = match shape {
-        Shape::Convex(c) => vec![(Isometry3::identity(), c)],
-        Shape::Compound(c) => c.pieces().iter().map(|(o, p)| (*o, p)).collect(),
-    };
-    convex
-        .into_iter()
-        .flat_map(|(o, c)| {
-            c.vertices()
-                .iter()
-                .map(move |v| (o * v).coords.norm() + c.radius())
-        })
+/// The farthest point of a shape's pieces from its body origin, radius
+/// included (the motion bound of the dense sampling's skips).
+fn body_reach(pieces: &Pieces) -> f64 {
+    pieces
+        .iter()
+        .flat_map(|(o, h, r)| h.points().iter().map(move |v| (o * v).coords.norm() + r))
         .fold(0.0, f64::max)
 }
 
@@ -158,7 +150,7 @@ fn check_rigid(
         })
         .collect();
     let reach = reach_of(&s.object(mover).unwrap().shape);
-    let moves = body_reach(&s.object(mover).unwrap().shape);
+    let moves = body_reach(&shape);
     let scale = waypoints
         .iter()
         .map(|p| p.translation.vector.norm())
@@ -416,10 +408,7 @@ fn robot_edges_never_miss_a_contact() {
             .filter(|(id, _)| !links.contains(id))
             .map(|(_, o)| (pieces(&o.shape), o.pose, reach_of(&o.shape)))
             .collect();
-        let moves: Vec<f64> = links
-            .iter()
-            .map(|&id| body_reach(&s.object(id).unwrap().shape))
-            .collect();
+        let moves: Vec<f64> = shapes.iter().map(body_reach).collect();
         for (k, q) in qs.windows(2).enumerate() {
             let row = rows.iter().find(|r| r.step == k as u32);
             let poses_at = |t: f64| {
@@ -583,10 +572,7 @@ fn self_pairs_find_a_robot_folding_onto_itself() {
         pieces(&s.object(links[0]).unwrap().shape),
         pieces(&s.object(links[2]).unwrap().shape),
     );
-    let moves = [
-        body_reach(&s.object(links[0]).unwrap().shape),
-        body_reach(&s.object(links[2]).unwrap().shape),
-    ];
+    let moves = [body_reach(&l0), body_reach(&l2)];
     // l1 is adjacent to both (allowed): l0 and l2 are the arm's only pair.
     let edges = [
         ([0.0, 0.0], [0.0, 3.0]),

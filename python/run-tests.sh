@@ -11,14 +11,22 @@
 # the whole test command stays short. GJKD_PY_INSTALL=pip builds it as a
 # user does, `pip install ./python` (release, from scratch the first time).
 #
+# GJKD_PY_STEPS picks the steps, in order (all three by default): `setup`
+# (the venv, its packages, ruff), `build` (the package) and `test`
+# (pytest). ./test.sh runs `setup` while cargo builds and `test` while the
+# Rust tests run.
+#
 #   python/run-tests.sh                 # venv in python/.venv
 #   GJKD_VENV=/tmp/venv python/run-tests.sh -k errors
 #   GJKD_PY_INSTALL=pip python/run-tests.sh
+#   GJKD_PY_STEPS=test python/run-tests.sh -k errors   # rerun pytest only
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 venv="${GJKD_VENV:-$here/.venv}"
 python="${PYTHON:-python3}"
+steps=" ${GJKD_PY_STEPS:-setup build test} "
 
+if [[ "$steps" == *" setup "* ]]; then
 if [ ! -x "$venv/bin/python" ]; then
   echo "== creating $venv"
   "$python" -m venv "$venv"
@@ -41,12 +49,16 @@ echo "== installing maturin, numpy, pytest, mypy, ruff and ompl"
 echo "== ruff format --check, ruff check"
 "$venv/bin/ruff" format --quiet --check "$here"
 "$venv/bin/ruff" check --quiet "$here"
+fi
+if [[ "$steps" == *" build "* ]]; then
 if [ "${GJKD_PY_INSTALL:-develop}" = pip ]; then
   "$venv/bin/python" -m pip install --quiet "$here"
 else
   echo "== maturin develop (dev profile, shared target directory)"
   (cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet)
 fi
+fi
+[[ "$steps" == *" test "* ]] || exit 0
 echo "== pytest"
 cd "$here"
 # pytest itself, not `python -m pytest`, which would put this directory on

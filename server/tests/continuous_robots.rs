@@ -5,7 +5,11 @@
 //! distance for a cylinder, whose surface no hull holds). A segment
 //! answered clear must have no sampled contact; a contact's bracket must
 //! hold the first sampled contact (allowing the sampling step), and the
-//! pose at its `s_hi` must be within the margin.
+//! pose at its `s_hi` must be within the margin. A pair is skipped at a
+//! sample where its last measured distance, less how far its link moved
+//! since, stays beyond the margin (`gjkd_testkit::dense`): the first
+//! sampled contact is the one a measure of every pair at every sample
+//! finds.
 
 // The model tests' deterministic generator (the same motions every run).
 #[path = "../../model/tests/files.rs"]
@@ -18,6 +22,7 @@ use gjkd_model::{LimitMode, PackagePath, RobotModel};
 use gjkd_proto::{Item, ObjectId, PathMode, SceneKind, SceneRequest, SceneRow, WaitMode};
 use gjkd_server::engine::robots::NewRobot;
 use gjkd_server::engine::state::{Limits, NewObject, Owner, State};
+use gjkd_testkit::dense::{displacement, first_within};
 use gjkd_testkit::reference::{Hull, distance};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
@@ -297,9 +302,36 @@ fn check_edges(s: &mut Scene, waypoints: &[Vec<f64>]) -> usize {
         };
         let (p0, p1) = (fk(&ends[0]), fk(&ends[1]));
         let moving: Vec<bool> = p0.iter().zip(&p1).map(|(a, b)| a != b).collect();
-        let first = (0..=DENSE)
-            .map(|i| i as f64 / DENSE as f64)
-            .find(|&t| least_at(s, &at(t), &moving) <= MARGIN - TOL);
+        // Pair `j` is moving link `j / n` and obstacle `j % n`: the truth
+        // when their bounding spheres come within the margin, their gap (a
+        // lower bound) when not.
+        let moving_links: Vec<&(usize, Vec<Piece>, f64)> =
+            s.links.iter().filter(|(l, _, _)| moving[*l]).collect();
+        let n = s.obstacles.len();
+        let pair_at = |j: usize, poses: &Vec<Isometry3<f64>>| {
+            let ((link, pieces, ra), (pb, b, rb)) = (moving_links[j / n], &s.obstacles[j % n]);
+            let pose = &poses[*link];
+            let gap = (pose.translation.vector - pb.translation.vector).norm() - ra - rb;
+            if gap <= MARGIN + 1e-6 {
+                least(pieces, pose, b, pb)
+            } else {
+                gap
+            }
+        };
+        let moved = |j: usize, a: &Vec<Isometry3<f64>>, b: &Vec<Isometry3<f64>>| {
+            let (link, _, reach) = moving_links[j / n];
+            displacement(&a[*link], &b[*link], *reach)
+        };
+        let first = first_within(
+            DENSE,
+            MARGIN - TOL,
+            // Twice the truth's own error (parry's, at a cylinder).
+            2.0 * TOL,
+            moving_links.len() * n,
+            |t| fk(&at(t)),
+            moved,
+            pair_at,
+        );
         match row {
             None => assert!(
                 first.is_none(),

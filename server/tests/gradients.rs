@@ -72,7 +72,6 @@ struct Scene {
     robot: u64,
     /// Per link, its object id (links without shape have none).
     links: Vec<Option<u64>>,
-    link_pieces: Vec<Vec<Piece>>,
     obstacles: Vec<(u64, Isometry3<f64>, Vec<Piece>)>,
 }
 
@@ -80,7 +79,6 @@ fn scene(model: RobotModel, base: Isometry3<f64>, rng: &mut Rng, reach: f64) -> 
     let mut state = State::new(Limits::default(), WaitMode::Spin, 7);
     let name = model.name().to_owned();
     let mut links = Vec::new();
-    let mut link_pieces = Vec::new();
     for link in &model.links {
         match &link.shape {
             Some(shape) => {
@@ -95,12 +93,8 @@ fn scene(model: RobotModel, base: Isometry3<f64>, rng: &mut Rng, reach: f64) -> 
                     )
                     .unwrap();
                 links.push(Some(id));
-                link_pieces.push(pieces(shape));
             }
-            None => {
-                links.push(None);
-                link_pieces.push(Vec::new());
-            }
+            None => links.push(None),
         }
     }
     let urdf = model_urdf(&model);
@@ -163,7 +157,6 @@ fn scene(model: RobotModel, base: Isometry3<f64>, rng: &mut Rng, reach: f64) -> 
         model,
         robot,
         links,
-        link_pieces,
         obstacles,
     }
 }
@@ -280,6 +273,15 @@ fn check_robot(model: RobotModel, seed: u64, reach: f64) -> usize {
         UnitQuaternion::from_euler_angles(0.0, 0.0, 0.3),
     );
     let mut s = scene(model, base, &mut rng, reach);
+    // The links' hulls for the reference, built here: the brute force's
+    // facet search over a mesh's vertices is the costly part of a scene,
+    // and only the finite differences need it.
+    let link_pieces: Vec<Vec<Piece>> = s
+        .model
+        .links
+        .iter()
+        .map(|l| l.shape.as_ref().map(pieces).unwrap_or_default())
+        .collect();
     let kin = s.model.kinematics.clone();
     let dof = kin.dof();
     let mut judged = 0;
@@ -299,7 +301,7 @@ fn check_robot(model: RobotModel, seed: u64, reach: f64) -> usize {
             for o in 0..s.obstacles.len() {
                 let (obstacle, pose_o) = (s.obstacles[o].0, s.obstacles[o].1);
                 let got = pair_with_gradient(&mut s.state, id, obstacle, true);
-                let lp = &s.link_pieces[link];
+                let lp = &link_pieces[link];
                 let op = &s.obstacles[o].2;
                 let mut want = Vec::with_capacity(dof + 6);
                 for k in 0..dof {
@@ -352,7 +354,7 @@ fn check_robot(model: RobotModel, seed: u64, reach: f64) -> usize {
                     continue;
                 }
                 let got = pair_with_gradient(&mut s.state, ida, idb, false);
-                let (pa, pb) = (&s.link_pieces[la], &s.link_pieces[lb]);
+                let (pa, pb) = (&link_pieces[la], &link_pieces[lb]);
                 let want: Vec<f64> = (0..dof)
                     .map(|k| {
                         let at = |dq: f64| {

@@ -9,6 +9,8 @@
 //! - [`minkowski_depth`]: the brute-force penetration depth, from the
 //!   Minkowski difference's facets, for the signed distance's tests.
 //! - [`check`]: one answer against that reference, every property at once.
+//! - [`dense`]: dense sampling of a motion for its first pose within a
+//!   distance, skipping only samples a motion bound decides.
 //! - [`paper`]: the polytopes and pairs of the paper's Section 7 and the
 //!   collision sweep of its Section 8, rebuilt deterministically.
 //! - [`sweep`]: randomised extreme cases whose distance is known by
@@ -24,6 +26,7 @@
 #![warn(missing_docs)]
 
 pub mod check;
+pub mod dense;
 pub mod input;
 pub mod minkowski_depth;
 /// The paper's test data (crate `gjkd-paper`, apart so that `gjkd demo`

@@ -96,11 +96,12 @@ fn check_robot(name: &str, seed: u64, segments: usize, step: f64) -> f64 {
             };
             let bound = link_rate(kinematics, &parent_joint, (&q0, &q1), &ends, link, &ball);
             for p in ball_points(&ball) {
-                let at = |i: usize| samples[i][link] * p;
+                // The point at every sample, placed once.
+                let at: Vec<Point3<f64>> = samples.iter().map(|poses| poses[link] * p).collect();
                 for i in 1..=DENSE {
                     // Between neighbours, and from the start.
                     for (from, ds) in [(i - 1, 1.0 / DENSE as f64), (0, i as f64 / DENSE as f64)] {
-                        let moved = (at(i) - at(from)).norm();
+                        let moved = (at[i] - at[from]).norm();
                         let allowed = bound.rate * ds;
                         assert!(
                             moved <= allowed,

@@ -2,9 +2,12 @@
 //! pair by the test kit's brute force between hulls. A segment answered
 //! clear must have no sampled contact; a contact's bracket must hold the
 //! first sampled contact (allowing the sampling step) and its `s_hi` must
-//! be within the margin.
+//! be within the margin. Samples that the last measured distance and the
+//! bodies' displacement since already put beyond the margin are skipped
+//! (`gjkd_testkit::dense`): the first sampled contact is the same.
 
 use super::*;
+use gjkd_testkit::dense::{displacement, first_within};
 use gjkd_testkit::reference::{self, Hull};
 
 /// Poses per segment of the dense truth.
@@ -25,6 +28,20 @@ fn pieces(shape: &Shape) -> Pieces {
 
 fn reach_of(shape: &Shape) -> f64 {
     super::super::broadphase::bounding_sphere(shape).2
+}
+
+/// The farthest point of a shape's pieces from its body origin, radius
+/// included (the motion bound of the dense sampling's skips).
+fn body_reach(pieces: &Pieces) -> f64 {
+    pieces
+        .iter()
+        .flat_map(|(o, h, r)| h.points().iter().map(move |v| (o * v).coords.norm() + r))
+        .fold(0.0, f64::max)
+}
+
+/// Round-off allowed the skips at coordinates of magnitude `scale`.
+fn slack(scale: f64) -> f64 {
+    1e-9 * (1.0 + scale)
 }
 
 fn brute(a: &Pieces, pa: &Isometry3<f64>, b: &Pieces, pb: &Isometry3<f64>) -> f64 {
@@ -53,19 +70,19 @@ fn rigid_at(from: &Isometry3<f64>, to: &Isometry3<f64>, s: f64, linear: bool) ->
     Isometry3::from_parts(Translation3::from(t), r)
 }
 
-/// Checks one segment's answer (`row`, `None` for clear) against the
-/// least distance over its pairs at dense `s` (`least(s)`), `tol` the
-/// agreement expected between the server's intervals and brute force.
+/// Checks one segment's answer (`row`, `None` for clear) against `first`,
+/// the first dense `s` whose least distance over the segment's pairs is at
+/// or below `margin - tol`, and that least distance at any `s`
+/// (`least(s)`); `tol` is the agreement expected between the server's
+/// intervals and brute force.
 fn check_segment(
     row: Option<&SceneRow>,
     bracket: f64,
     margin: f64,
     tol: f64,
+    first: Option<f64>,
     least: impl Fn(f64) -> f64,
 ) -> Option<f64> {
-    let first = (0..=DENSE)
-        .map(|i| i as f64 / DENSE as f64)
-        .find(|&s| least(s) <= margin - tol);
     match row {
         None => assert!(first.is_none(), "certified clear, touches at s = {first:?}"),
         Some(r) => {
@@ -133,12 +150,37 @@ fn check_rigid(
         })
         .collect();
     let reach = reach_of(&s.object(mover).unwrap().shape);
+    let moves = body_reach(&shape);
+    let scale = waypoints
+        .iter()
+        .map(|p| p.translation.vector.norm())
+        .fold(0.0, f64::max);
     let mut touching = 0;
     for (k, pair) in waypoints.windows(2).enumerate() {
         let row = rows.iter().find(|r| r.step == k as u32);
         if let Some(r) = row {
             assert_eq!(r.a, mover);
         }
+        // The brute force for a pair whose bounding spheres come within the
+        // margin, the spheres' gap (beyond it, a lower bound) for another.
+        let lower = |j: usize, p: &Isometry3<f64>| {
+            let (b, pb, r, c) = &others[j];
+            let gap = (c - Point3::from(p.translation.vector)).norm() - r - reach;
+            if gap <= margin + 1e-6 {
+                brute(&shape, p, b, pb)
+            } else {
+                gap
+            }
+        };
+        let first = first_within(
+            DENSE,
+            margin - tol,
+            slack(scale),
+            others.len(),
+            |t| rigid_at(&pair[0], &pair[1], t, linear),
+            |_, a, b| displacement(a, b, moves),
+            lower,
+        );
         let least = |t: f64| {
             let p = rigid_at(&pair[0], &pair[1], t, linear);
             others
@@ -149,7 +191,7 @@ fn check_rigid(
                 .map(|(b, pb, _, _)| brute(&shape, &p, b, pb))
                 .fold(f64::INFINITY, f64::min)
         };
-        if check_segment(row, bracket, margin, tol, least).is_some() || row.is_some() {
+        if check_segment(row, bracket, margin, tol, first, least).is_some() || row.is_some() {
             touching += 1;
         }
     }
@@ -366,25 +408,49 @@ fn robot_edges_never_miss_a_contact() {
             .filter(|(id, _)| !links.contains(id))
             .map(|(_, o)| (pieces(&o.shape), o.pose, reach_of(&o.shape)))
             .collect();
+        let moves: Vec<f64> = shapes.iter().map(body_reach).collect();
         for (k, q) in qs.windows(2).enumerate() {
             let row = rows.iter().find(|r| r.step == k as u32);
-            let least = |t: f64| {
+            let poses_at = |t: f64| {
                 let at: Vec<f64> = (0..2).map(|j| q[0][j] + (q[1][j] - q[0][j]) * t).collect();
-                let poses = kin
-                    .link_poses(&Isometry3::identity(), &at, gjkd_model::LimitMode::Clamp)
-                    .unwrap();
-                let mut best = f64::INFINITY;
-                for ((shape, pose), ra) in shapes.iter().zip(&poses).zip(&reaches) {
-                    for (b, pb, rb) in &others {
-                        let apart = (pose.translation.vector - pb.translation.vector).norm();
-                        if apart - ra - rb <= 0.02 + 1e-6 {
-                            best = best.min(brute(shape, pose, b, pb));
-                        }
-                    }
-                }
-                best
+                kin.link_poses(&Isometry3::identity(), &at, gjkd_model::LimitMode::Clamp)
+                    .unwrap()
             };
-            if check_segment(row, 1e-6, 0.02, 1e-9, least).is_some() || row.is_some() {
+            // Pair `j` is link `j / n` and obstacle `j % n`: the brute
+            // force when their bounding spheres come within the margin, the
+            // spheres' gap (a lower bound) with `gaps`, else nothing.
+            let n = others.len();
+            let measure = |j: usize, poses: &Vec<Isometry3<f64>>, gaps: bool| {
+                let (link, (b, pb, rb)) = (j / n, &others[j % n]);
+                let pose = &poses[link];
+                let apart = (pose.translation.vector - pb.translation.vector).norm();
+                if apart - reaches[link] - rb <= 0.02 + 1e-6 {
+                    brute(&shapes[link], pose, b, pb)
+                } else if gaps {
+                    apart - reaches[link] - rb
+                } else {
+                    f64::INFINITY
+                }
+            };
+            let moved = |j: usize, a: &Vec<Isometry3<f64>>, b: &Vec<Isometry3<f64>>| {
+                displacement(&a[j / n], &b[j / n], moves[j / n])
+            };
+            let first = first_within(
+                DENSE,
+                0.02 - 1e-9,
+                slack(4.0),
+                links.len() * n,
+                poses_at,
+                moved,
+                |j, p| measure(j, p, true),
+            );
+            let least = |t: f64| {
+                let poses = poses_at(t);
+                (0..links.len() * n)
+                    .map(|j| measure(j, &poses, false))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            if check_segment(row, 1e-6, 0.02, 1e-9, first, least).is_some() || row.is_some() {
                 touching += 1;
             }
         }
@@ -506,6 +572,7 @@ fn self_pairs_find_a_robot_folding_onto_itself() {
         pieces(&s.object(links[0]).unwrap().shape),
         pieces(&s.object(links[2]).unwrap().shape),
     );
+    let moves = [body_reach(&l0), body_reach(&l2)];
     // l1 is adjacent to both (allowed): l0 and l2 are the arm's only pair.
     let edges = [
         ([0.0, 0.0], [0.0, 3.0]),
@@ -520,14 +587,27 @@ fn self_pairs_find_a_robot_folding_onto_itself() {
         let items = [q0, q1]
             .map(|q| Item::set_joints(ObjectId::from_raw(robot), 0, &q, None, false).ending_step());
         let (_, rows) = ask(&mut s, 1, &request, &items);
-        let least = |t: f64| {
+        let poses_at = |t: f64| {
             let at = [q0[0] + (q1[0] - q0[0]) * t, q0[1] + (q1[1] - q0[1]) * t];
-            let poses = kin
-                .link_poses(&Isometry3::identity(), &at, gjkd_model::LimitMode::Clamp)
-                .unwrap();
-            brute(&l0, &poses[0], &l2, &poses[2])
+            kin.link_poses(&Isometry3::identity(), &at, gjkd_model::LimitMode::Clamp)
+                .unwrap()
         };
-        if check_segment(rows.first(), 1e-6, 0.02, 1e-9, least).is_some() {
+        let measure = |poses: &Vec<Isometry3<f64>>| brute(&l0, &poses[0], &l2, &poses[2]);
+        // Both links may move: their displacements add.
+        let moved = |_: usize, a: &Vec<Isometry3<f64>>, b: &Vec<Isometry3<f64>>| {
+            displacement(&a[0], &b[0], moves[0]) + displacement(&a[2], &b[2], moves[1])
+        };
+        let first = first_within(
+            DENSE,
+            0.02 - 1e-9,
+            slack(4.0),
+            1,
+            poses_at,
+            moved,
+            |_, p| measure(p),
+        );
+        let least = |t: f64| measure(&poses_at(t));
+        if check_segment(rows.first(), 1e-6, 0.02, 1e-9, first, least).is_some() {
             touching += 1;
             assert_eq!(rows.len(), 1);
             let (a, b) = (rows[0].a.min(rows[0].b), rows[0].a.max(rows[0].b));

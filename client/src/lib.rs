@@ -157,7 +157,7 @@ pub use gradient::{gradient_matrix, row_gradient};
 #[cfg(feature = "robots")]
 pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
-    RobotHandle, RobotModel,
+    RobotHandle, RobotModel, with_geometry,
 };
 pub use scene::{Contact, Group, ScenePair, SceneQuery, SceneSummary, Steps};
 

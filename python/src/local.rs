@@ -2,12 +2,15 @@
 
 use pyo3::prelude::*;
 
-use gjkd_client::{ClientError, Item, ItemResult};
-use gjkd_proto::{AdminOp, AdminRequest, Pose};
+use gjkd_client::{ClientError, Item, ItemResult, LimitMode, RobotHandle, SceneSummary};
+use gjkd_proto::{AdminOp, AdminRequest, Pose, SceneRequest, SceneRow};
+use nalgebra::Isometry3;
 
 use crate::api::{Backend, backend_methods};
+use crate::backend::{Outcome, RobotText};
 use crate::errors;
-use crate::runner::{Answerer, Buffers};
+use crate::local_calls::{self, SceneScratch};
+use crate::runner::{Answerer, Buffers, OnThisThread};
 use crate::server_lib::{Limits, Store};
 use crate::shape::{Registration, wire_registration};
 
@@ -32,6 +35,7 @@ use crate::shape::{Registration, wire_registration};
 pub struct Local {
     store: LocalStore,
     buffers: Buffers,
+    scene: SceneScratch,
 }
 
 /// The store as the answerer of batches.
@@ -60,11 +64,26 @@ impl Local {
     ) -> PyResult<u64> {
         self.store
             .store
-            .admin(request, vertices)
+            .admin(request, gjkd_proto::AdminChunk::from_vertices(vertices))
             .map_err(|code| errors::refused(py, code, field, None))
     }
 
     fn close(&mut self) {}
+
+    /// Runs `call` on the store with the GIL released (a robot's meshes
+    /// load, a path is answered), as a `Client` waits for its server.
+    fn detached<R>(
+        &mut self,
+        py: Python<'_>,
+        call: impl FnOnce(&mut Store, &mut SceneScratch) -> R,
+    ) -> R {
+        let parts = OnThisThread::new((&mut self.store.store, &mut self.scene, call));
+        py.detach(move || {
+            let (store, scratch, call) = parts.into_inner();
+            OnThisThread::new(call(store, scratch))
+        })
+        .into_inner()
+    }
 }
 
 impl Backend for Local {
@@ -107,6 +126,44 @@ impl Backend for Local {
         self.store.store.poses(ids, &mut out);
         Ok(out.iter().map(gjkd_proto::StoredPose::pose).collect())
     }
+
+    fn register_robot(&mut self, py: Python<'_>, robot: &RobotText<'_>) -> Outcome<RobotHandle> {
+        Ok(self.detached(py, |store, _| local_calls::register_robot(store, robot)))
+    }
+
+    fn open_robot(&mut self, py: Python<'_>, name: &str, urdf: &str) -> Outcome<RobotHandle> {
+        Ok(self.detached(py, |store, _| local_calls::open_robot(store, name, urdf)))
+    }
+
+    fn remove_robot(&mut self, py: Python<'_>, name: &str) -> Outcome<()> {
+        Ok(self.detached(py, |store, _| local_calls::remove_robot(store, name)))
+    }
+
+    fn set_joints(
+        &mut self,
+        py: Python<'_>,
+        robot: &mut RobotHandle,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        mode: LimitMode,
+    ) -> Outcome<()> {
+        Ok(self.detached(py, |store, scratch| {
+            local_calls::set_joints(store, scratch, robot, positions, base, mode)
+        }))
+    }
+
+    fn scene(
+        &mut self,
+        py: Python<'_>,
+        request: &SceneRequest,
+        count: usize,
+        item: &mut dyn FnMut(usize) -> Item,
+        read: &mut dyn FnMut(&[SceneRow]),
+    ) -> Outcome<SceneSummary> {
+        Ok(self.detached(py, |store, scratch| {
+            local_calls::scene(store, scratch, request, count, item, read)
+        }))
+    }
 }
 
 backend_methods!(Local, {
@@ -123,6 +180,7 @@ backend_methods!(Local, {
                 store: Store::new(limits),
             },
             buffers: Buffers::default(),
+            scene: SceneScratch::default(),
         }
     }
 
@@ -148,3 +206,6 @@ backend_methods!(Local, {
         format!("gjkd.Local(<{} objects>)", self.store.store.len())
     }
 });
+
+crate::robot_api::robot_methods!(Local);
+crate::scene_api::scene_methods!(Local);

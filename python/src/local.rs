@@ -14,9 +14,14 @@ use crate::runner::{Answerer, Buffers, OnThisThread};
 use crate::server_lib::{Limits, Store};
 use crate::shape::{Registration, wire_registration};
 
-/// Objects held in this Python process and the distances between them,
-/// with no server: the same methods as `gjkd.Client`, the same arrays, the
-/// same errors.
+/// Objects and robots held in this Python process, and the distances
+/// between them, with no server: the same methods as `gjkd.Client` (but
+/// the server's own: `service`, `timeout`, `connected`, `server_info`,
+/// `stats`), the same arrays, the same errors. A robot script runs
+/// unchanged with `gjkd.Local()` in place of `gjkd.Client()`:
+/// `register_robot`, `open_robot`, `remove_robot`, `set_joints`, pose
+/// read-back, and the scene questions (`clearance`, `within`, `nearest`,
+/// `path`, `path_joints`, continuous paths, gradient and signed rows).
 ///
 /// `Local(max_vertices=100000, cache_capacity=65536)`. The queries run the
 /// server's own request handlers over the same `gjk` algorithm, so for the
@@ -27,9 +32,13 @@ use crate::shape::{Registration, wire_registration};
 /// least recently used dropped first), and the next warm query of the pair
 /// starts from it. (A server keeps one such cache per client: a second
 /// `Client` querying the same pairs starts cold where `Local` starts warm.)
-/// `forget_warm_starts()` empties it.
+/// `forget_warm_starts()` empties it (and the scene questions' warm starts
+/// and motion bounds, kept apart as a server keeps them per client port).
+/// A path of any length is answered whole, as a `Client` splits a long
+/// path into requests the server takes and joins the answers.
 ///
-/// The GIL is released while a batch is answered. A `Local` belongs to the
+/// The GIL is released while a batch, a robot registration or a scene
+/// question is answered. A `Local` belongs to the
 /// thread that created it.
 #[pyclass(unsendable, module = "gjkd", name = "Local")]
 pub struct Local {

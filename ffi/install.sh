@@ -36,9 +36,20 @@ fi
 prefix="${1:?usage: ffi/install.sh [--no-robots] [--from DIR] PREFIX}"
 
 if [[ -z "$from" ]]; then
-  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib "${features[@]}")
   target="$(cd "$here/.." && cargo metadata --format-version 1 --no-deps \
     | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')"
+  # Two installs at once (one with robots, one without) build the same
+  # target/dist/libgjkd_c.so: each holds this lock from its build to the
+  # end of its copy, so that neither installs the other's library. (The
+  # dist profile keeps installs apart from `cargo build --release` and
+  # `cargo run --example`, which build into target/release and
+  # target/debug.)
+  mkdir -p "$target"
+  if command -v flock >/dev/null; then
+    exec 9>"$target/.gjkd-install.lock"
+    flock 9
+  fi
+  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib "${features[@]}")
   from="$target/dist"
 fi
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$here/../Cargo.toml" | head -n1)"

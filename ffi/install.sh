@@ -70,9 +70,12 @@ if [[ "$soname" != libgjkd_c.so ]]; then
 fi
 install -m 644 "$from/libgjkd_c.a" "$prefix/lib/"
 # The static library carries the debug info of the Rust standard library
-# it bundles, whatever the profile: of no use to a C program's build.
+# it bundles, whatever the profile, and the LLVM bitcode rustc embeds in
+# every crate's objects for its own link-time optimisation: of no use to a
+# C program's build (together more than half the archive).
 if command -v strip >/dev/null; then
-  strip --strip-debug "$prefix/lib/libgjkd_c.a"
+  strip --strip-debug --remove-section=.llvmbc --remove-section=.llvmcmd \
+    "$prefix/lib/libgjkd_c.a"
 fi
 defines=""
 cmake_defines=""

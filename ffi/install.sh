@@ -36,9 +36,20 @@ fi
 prefix="${1:?usage: ffi/install.sh [--no-robots] [--from DIR] PREFIX}"
 
 if [[ -z "$from" ]]; then
-  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib "${features[@]}")
   target="$(cd "$here/.." && cargo metadata --format-version 1 --no-deps \
     | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')"
+  # Two installs at once (one with robots, one without) build the same
+  # target/dist/libgjkd_c.so: each holds this lock from its build to the
+  # end of its copy, so that neither installs the other's library. (The
+  # dist profile keeps installs apart from `cargo build --release` and
+  # `cargo run --example`, which build into target/release and
+  # target/debug.)
+  mkdir -p "$target"
+  if command -v flock >/dev/null; then
+    exec 9>"$target/.gjkd-install.lock"
+    flock 9
+  fi
+  (cd "$here/.." && cargo build --profile dist -p gjkd-c --lib "${features[@]}")
   from="$target/dist"
 fi
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$here/../Cargo.toml" | head -n1)"
@@ -59,9 +70,12 @@ if [[ "$soname" != libgjkd_c.so ]]; then
 fi
 install -m 644 "$from/libgjkd_c.a" "$prefix/lib/"
 # The static library carries the debug info of the Rust standard library
-# it bundles, whatever the profile: of no use to a C program's build.
+# it bundles, whatever the profile, and the LLVM bitcode rustc embeds in
+# every crate's objects for its own link-time optimisation: of no use to a
+# C program's build (together more than half the archive).
 if command -v strip >/dev/null; then
-  strip --strip-debug "$prefix/lib/libgjkd_c.a"
+  strip --strip-debug --remove-section=.llvmbc --remove-section=.llvmcmd \
+    "$prefix/lib/libgjkd_c.a"
 fi
 defines=""
 cmake_defines=""

@@ -194,7 +194,7 @@ pub use op_error::{
 #[cfg(feature = "robots")]
 pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
-    RobotHandle, RobotModel,
+    RobotHandle, RobotModel, with_geometry,
 };
 pub use scene::{Contact, Group, ScenePair, SceneQuery, SceneSummary, Steps};
 

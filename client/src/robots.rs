@@ -127,6 +127,67 @@ impl RobotHandle {
             })
             .collect()
     }
+
+    /// The items of [`Client::set_joints_with`], for whoever answers them
+    /// (a server, or Python's `gjkd.Local` in process): the
+    /// [`RobotHandle::joint_items`] of one position per moving joint.
+    ///
+    /// # Errors
+    /// [`RobotError::WrongJointCount`] for the wrong number of positions.
+    pub fn set_joints_items(
+        &self,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        mode: LimitMode,
+    ) -> Result<Vec<Item>, RobotError> {
+        if positions.len() != self.positions.len() {
+            return Err(RobotError::WrongJointCount);
+        }
+        Ok(self.joint_items(positions, base, mode == LimitMode::Clamp))
+    }
+
+    /// Takes the results of [`RobotHandle::set_joints_items`]: the first
+    /// refusal, or `positions` become [`RobotHandle::positions`] (clamped
+    /// into the limits, as the server clamped them).
+    ///
+    /// # Errors
+    /// The [`RobotError`] of the first item's refusal; the handle is
+    /// unchanged then.
+    pub fn joints_answered(
+        &mut self,
+        positions: &[f64],
+        results: &[ItemResult],
+    ) -> Result<(), RobotError> {
+        if let Some(r) = results.iter().find(|r| r.error != 0) {
+            return Err(op_error(ClientError::Rejected(r.error_code())));
+        }
+        self.positions.copy_from_slice(positions);
+        // The server accepted them, so they are finite: clamping cannot
+        // fail.
+        let _ = self
+            .kinematics
+            .check_positions(&mut self.positions, LimitMode::Clamp);
+        Ok(())
+    }
+}
+
+/// Calls `with` with the wire geometry of `shape` (a link's, or a mesh's):
+/// a convex shape as it is, a compound as its pieces.
+pub fn with_geometry<R>(shape: &Shape, with: impl FnOnce(&Geometry<'_>) -> R) -> R {
+    match shape {
+        Shape::Convex(c) => with(&Geometry::of_convex(c)),
+        Shape::Compound(c) => {
+            let pieces: Vec<Piece<'_>> = c
+                .pieces()
+                .iter()
+                .map(|(offset, p)| Piece {
+                    offset: *offset,
+                    geometry: Geometry::of_convex(p),
+                })
+                .collect();
+            with(&Geometry::Compound(&pieces))
+        }
+    }
 }
 
 /// A robot that cannot be read, with the model's words.
@@ -292,26 +353,9 @@ impl Client {
         for link in &model.links {
             let Some(shape) = &link.shape else { continue };
             let object = format!("{name}/{}", link.name);
-            let id = match shape {
-                Shape::Convex(c) => {
-                    self.register_named(&object, &Geometry::of_convex(c), &Isometry3::identity())?
-                }
-                Shape::Compound(c) => {
-                    let pieces: Vec<Piece<'_>> = c
-                        .pieces()
-                        .iter()
-                        .map(|(offset, p)| Piece {
-                            offset: *offset,
-                            geometry: Geometry::of_convex(p),
-                        })
-                        .collect();
-                    self.register_named(
-                        &object,
-                        &Geometry::Compound(&pieces),
-                        &Isometry3::identity(),
-                    )?
-                }
-            };
+            let id = with_geometry(shape, |g| {
+                self.register_named(&object, g, &Isometry3::identity())
+            })?;
             registered.push(id);
         }
         Ok(())
@@ -434,23 +478,11 @@ impl Client {
         base: Option<&Isometry3<f64>>,
         mode: LimitMode,
     ) -> Result<(), RobotError> {
-        if positions.len() != robot.positions.len() {
-            return Err(RobotError::WrongJointCount);
-        }
-        let items = robot.joint_items(positions, base, mode == LimitMode::Clamp);
+        let items = robot.set_joints_items(positions, base, mode)?;
         let mut results = vec![ItemResult::default(); items.len()];
         self.batch(&items, &mut results)
             .map_err(op_error::<RobotError>)?;
-        if let Some(r) = results.iter().find(|r| r.error != 0) {
-            return Err(op_error(ClientError::Rejected(r.error_code())));
-        }
-        robot.positions.copy_from_slice(positions);
-        // The server accepted them, so they are finite: clamping cannot
-        // fail.
-        let _ = robot
-            .kinematics
-            .check_positions(&mut robot.positions, LimitMode::Clamp);
-        Ok(())
+        robot.joints_answered(positions, &results)
     }
 
     /// [`Client::set_joints`] by joint name; joints not named keep their

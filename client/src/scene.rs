@@ -239,7 +239,10 @@ pub struct SceneSummary {
 }
 
 impl SceneSummary {
-    pub(crate) fn new(reply: &SceneReply, written: usize) -> Self {
+    /// The summary of a reply of which `written` rows were read: for
+    /// bindings that answer a [`SceneRequest`] without a server (Python's
+    /// `gjkd.Local` runs the server's engine in process).
+    pub fn new(reply: &SceneReply, written: usize) -> Self {
         SceneSummary {
             written,
             total: reply.total,

@@ -4,8 +4,9 @@ Three ways to the same answers, all on numpy arrays:
 
 - :class:`Client` talks to a gjkd server on this host over shared memory
   (start one with :class:`Server` or ``python -m gjkd serve``);
-- :class:`Local` (also ``gjkd.local.Local``) holds the shapes in this
-  process and answers the same calls, bit for bit, with no server;
+- :class:`Local` (also ``gjkd.local.Local``) holds the shapes and robots
+  in this process and answers the same calls (robots and scene questions
+  included), bit for bit, with no server;
 - :class:`Server` runs a server in a child process.
 
 Latency on a busy host: ``gjkd.Server(wait=..., cpu=..., priority=...)``
@@ -22,7 +23,8 @@ qw]`` rows or 4x4 matrices), then ask ``distance(a, b)`` for one pair or
 bounds ``lower <= distance <= upper``, nearest points and a normal.
 
 Scene queries ask about a group of objects against everything the server
-holds, in one round trip, into a :class:`SceneRows` you own:
+(or the :class:`Local`) holds, in one round trip, into a :class:`SceneRows`
+you own:
 ``client.clearance(group, out=rows)`` (each member's nearest other object),
 ``client.within(group, margin, out=rows)`` (every pair within a margin),
 ``client.nearest(object, k, out=rows)``, ``client.path(group, objects,

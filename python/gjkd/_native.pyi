@@ -373,7 +373,9 @@ class MeshInfo:
         """A decomposition's largest deviation found from the mesh; 0 for a hull."""
 
 class _Objects:
-    """The methods ``Client`` and ``Local`` share."""
+    """The methods ``Client`` and ``Local`` share: the same signatures,
+    answers and errors, whether a server or this process holds the
+    objects."""
 
     def register(
         self, shape: Shape, *, name: Optional[str] = None, pose: Optional[_Pose] = None
@@ -508,39 +510,6 @@ class _Objects:
         ``signed_distance=True`` also answers each pair's signed distance
         with its certified interval (``Distances.signed_distance``,
         ``signed_lower``, ``signed_upper``)."""
-    def close(self) -> None:
-        """Closes (a no-op for ``Local``)."""
-
-@final
-class Client(_Objects):
-    """A connection to a gjkd server on this host.
-
-    Objects outlive the client that registered them (a server with
-    persistence keeps them across restarts); with ``remove_on_close=True``
-    the objects and robots this client registers are removed when it closes
-    (best effort: a server gone then keeps them).
-    """
-
-    def __new__(
-        cls,
-        service: str = "gjkd",
-        timeout: float = 1.0,
-        connect_timeout: Optional[float] = None,
-        remove_on_close: bool = False,
-    ) -> Self: ...
-    @property
-    def service(self) -> str:
-        """The service name."""
-    @property
-    def timeout(self) -> float:
-        """The timeout of every call, in seconds."""
-    @property
-    def connected(self) -> bool:
-        """Whether the client holds a connection."""
-    def server_info(self) -> Optional[dict[str, int]]:
-        """The server's limits, wait mode and pid."""
-    def stats(self) -> dict[str, int]:
-        """The server's counters."""
     def register_robot(
         self,
         name: str,
@@ -559,10 +528,11 @@ class Client(_Objects):
         folder of each ``$AMENT_PREFIX_PATH`` prefix, as ROS searches them
         (see the README's robot section)."""
     def open_robot(self, name: str, urdf_text: str) -> Robot:
-        """The robot ``name`` already on the server, its joints and links read
-        from ``urdf_text``. Raises :class:`gjkd.InvalidInput` with ``code``
-        ``INVALID_ROBOT`` (``field`` ``"urdf"``) for text that cannot be read,
-        :class:`gjkd.NotFound` with ``UNKNOWN_NAME`` for no robot of that name."""
+        """The robot ``name`` already held (by the server, or this ``Local``),
+        its joints and links read from ``urdf_text``. Raises
+        :class:`gjkd.InvalidInput` with ``code`` ``INVALID_ROBOT`` (``field``
+        ``"urdf"``) for text that cannot be read, :class:`gjkd.NotFound` with
+        ``UNKNOWN_NAME`` for no robot of that name."""
     def remove_robot(self, robot: Union[Robot, str]) -> None:
         """Removes a robot (or the robot named so) with every link."""
     def set_joints(
@@ -672,6 +642,39 @@ class Client(_Objects):
         exact: bool = False,
     ) -> SceneSummary:
         """A question at every step of a robot's motion given as ``(S, dof)`` joint positions."""
+    def close(self) -> None:
+        """Closes (a no-op for ``Local``)."""
+
+@final
+class Client(_Objects):
+    """A connection to a gjkd server on this host.
+
+    Objects outlive the client that registered them (a server with
+    persistence keeps them across restarts); with ``remove_on_close=True``
+    the objects and robots this client registers are removed when it closes
+    (best effort: a server gone then keeps them).
+    """
+
+    def __new__(
+        cls,
+        service: str = "gjkd",
+        timeout: float = 1.0,
+        connect_timeout: Optional[float] = None,
+        remove_on_close: bool = False,
+    ) -> Self: ...
+    @property
+    def service(self) -> str:
+        """The service name."""
+    @property
+    def timeout(self) -> float:
+        """The timeout of every call, in seconds."""
+    @property
+    def connected(self) -> bool:
+        """Whether the client holds a connection."""
+    def server_info(self) -> Optional[dict[str, int]]:
+        """The server's limits, wait mode and pid."""
+    def stats(self) -> dict[str, int]:
+        """The server's counters."""
     def __enter__(self) -> Client: ...
     def __exit__(
         self,
@@ -682,7 +685,10 @@ class Client(_Objects):
 
 @final
 class Local(_Objects):
-    """Shapes held in this process, answered with no server."""
+    """Shapes and robots held in this process, answered with no server:
+    every method of :class:`Client` but the server's own (``service``,
+    ``timeout``, ``connected``, ``server_info``, ``stats``), with the same
+    answers, bit for bit, and the same errors."""
 
     def __new__(cls, max_vertices: int = 100000, cache_capacity: int = 65536) -> Self: ...
     def __len__(self) -> int: ...

@@ -7,10 +7,12 @@ use pyo3::types::PyDict;
 
 use gjkd_client::{ClientError, Item, ItemResult};
 
-use crate::call::RustCall;
-use gjkd_proto::Pose;
+use gjkd_client::{LimitMode, RobotHandle, SceneSummary};
+use gjkd_proto::{Pose, SceneRequest, SceneRow};
+use nalgebra::Isometry3;
 
 use crate::api::{Backend, backend_methods};
+use crate::backend::{Outcome, RobotText};
 use crate::errors::{self, invalid};
 use crate::runner::{Answerer, Buffers, OnThisThread};
 use crate::shape::{Registration, isometry, wire_registration};
@@ -114,23 +116,6 @@ fn seconds(py: Python<'_>, field: &str, s: f64) -> PyResult<Duration> {
         })
 }
 
-impl RustCall for Client {
-    fn call<R, E: Into<ClientError>>(
-        &mut self,
-        py: Python<'_>,
-        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, E>,
-    ) -> PyResult<Result<R, ClientError>> {
-        let client = OnThisThread::new(self.inner_client(py)?);
-        let call = OnThisThread::new(call);
-        Ok(py
-            .detach(move || {
-                let (client, call) = (client.into_inner(), call.into_inner());
-                OnThisThread::new(call(client).map_err(Into::into))
-            })
-            .into_inner())
-    }
-}
-
 /// Registers `g`, named at `pose` (the identity without one), or unnamed
 /// and then moved to `pose` if there is one.
 fn register_at(
@@ -153,6 +138,26 @@ fn register_at(
 }
 
 impl Client {
+    /// Runs `call` on the Rust client with the GIL released; the outer
+    /// error is this class's own (a closed client), the inner one the
+    /// call's, whichever operation's error it was (`RegisterError`,
+    /// `QueryError`, ...), read as the umbrella [`ClientError`]: one fault,
+    /// one Python exception and code (`errors::client`).
+    fn call<R, E: Into<ClientError>>(
+        &mut self,
+        py: Python<'_>,
+        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, E>,
+    ) -> PyResult<Result<R, ClientError>> {
+        let client = OnThisThread::new(self.inner_client(py)?);
+        let call = OnThisThread::new(call);
+        Ok(py
+            .detach(move || {
+                let (client, call) = (client.into_inner(), call.into_inner());
+                OnThisThread::new(call(client).map_err(Into::into))
+            })
+            .into_inner())
+    }
+
     fn inner_client(&mut self, py: Python<'_>) -> PyResult<&mut gjkd_client::Client> {
         self.conn.inner.as_mut().ok_or_else(|| closed(py))
     }
@@ -226,6 +231,49 @@ impl Backend for Client {
             .map(|r| r.as_ref().map(Pose::from_isometry).map_err(|c| *c))
             .collect())
     }
+
+    fn register_robot(&mut self, py: Python<'_>, robot: &RobotText<'_>) -> Outcome<RobotHandle> {
+        self.call(py, |c| {
+            c.register_robot_text(
+                robot.name,
+                robot.urdf,
+                robot.srdf,
+                robot.mesh_base,
+                robot.packages,
+                robot.base,
+            )
+        })
+    }
+
+    fn open_robot(&mut self, py: Python<'_>, name: &str, urdf: &str) -> Outcome<RobotHandle> {
+        self.call(py, |c| c.open_robot(name, urdf))
+    }
+
+    fn remove_robot(&mut self, py: Python<'_>, name: &str) -> Outcome<()> {
+        self.call(py, |c| c.remove_robot(name))
+    }
+
+    fn set_joints(
+        &mut self,
+        py: Python<'_>,
+        robot: &mut RobotHandle,
+        positions: &[f64],
+        base: Option<&Isometry3<f64>>,
+        mode: LimitMode,
+    ) -> Outcome<()> {
+        self.call(py, |c| c.set_joints_with(robot, positions, base, mode))
+    }
+
+    fn scene(
+        &mut self,
+        py: Python<'_>,
+        request: &SceneRequest,
+        count: usize,
+        item: &mut dyn FnMut(usize) -> Item,
+        read: &mut dyn FnMut(&[SceneRow]),
+    ) -> Outcome<SceneSummary> {
+        self.call(py, |c| c.scene_with(request, count, item, read))
+    }
 }
 
 backend_methods!(Client, {
@@ -264,122 +312,6 @@ backend_methods!(Client, {
             service: service.to_owned(),
             timeout,
         })
-    }
-
-    /// Registers a robot from URDF: each link with collision geometry
-    /// (boxes, spheres, cylinders, meshes; several elements make a
-    /// compound) becomes an object named `<name>/<link>`, then the server
-    /// holds the robot's kinematics and puts it at `base` (`(7,)` or
-    /// `(4, 4)`, default identity) with every joint at zero (within its
-    /// limits). `urdf` is a file path, `srdf` an optional SRDF file (its
-    /// `disable_collisions` pairs); `urdf_text` / `srdf_text` give the
-    /// text instead (then relative mesh paths are relative to the working
-    /// folder). `package://NAME/...` mesh URLs are searched in
-    /// `package_path`, then `$GJKD_PACKAGE_PATH`, `$ROS_PACKAGE_PATH` and
-    /// the `share` folder of each `$AMENT_PREFIX_PATH` prefix, as ROS
-    /// searches them (`DIR/NAME/...` or a `DIR` named `NAME` first, then
-    /// the shallowest folder below a `DIR` whose `package.xml` names
-    /// `NAME`, up to six levels down). Returns a
-    /// `gjkd.Robot`. Raises `InvalidInput` (`INVALID_ROBOT`,
-    /// `field="urdf"`) for a URDF, SRDF or mesh that cannot be read (the
-    /// message names the file, link or joint), `Refused` (`NAME_TAKEN`) when a link object of that name
-    /// exists; links registered before a failure are removed again.
-    #[pyo3(signature = (name, urdf = None, *, srdf = None, urdf_text = None,
-        srdf_text = None, package_path = Vec::new(), base = None))]
-    #[allow(clippy::too_many_arguments)]
-    fn register_robot(
-        &mut self,
-        py: Python<'_>,
-        name: &str,
-        urdf: Option<std::path::PathBuf>,
-        srdf: Option<std::path::PathBuf>,
-        urdf_text: Option<String>,
-        srdf_text: Option<String>,
-        package_path: Vec<std::path::PathBuf>,
-        base: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<crate::robots::Robot> {
-        use crate::robots::{RobotSource, Text};
-        let urdf = match (urdf, urdf_text) {
-            (Some(p), None) => Text::File(p),
-            (None, Some(t)) => Text::Inline(t),
-            _ => {
-                return Err(invalid(
-                    py,
-                    "urdf",
-                    None,
-                    "give urdf (a path) or urdf_text".into(),
-                ));
-            }
-        };
-        let srdf = match (srdf, srdf_text) {
-            (Some(p), None) => Some(Text::File(p)),
-            (None, Some(t)) => Some(Text::Inline(t)),
-            (None, None) => None,
-            _ => {
-                return Err(invalid(
-                    py,
-                    "srdf",
-                    None,
-                    "give srdf or srdf_text, not both".into(),
-                ));
-            }
-        };
-        let source = RobotSource {
-            urdf,
-            srdf,
-            package_path,
-        };
-        crate::robots::register_robot(self, py, name, &source, base)
-    }
-
-    /// The robot named `name` already on the server (one the server's
-    /// scene file loaded, or another client registered), given its URDF
-    /// text for the joint order and link names. Returns a `gjkd.Robot`;
-    /// raises `NotFound` (`UNKNOWN_NAME`) when there is none.
-    fn open_robot(
-        &mut self,
-        py: Python<'_>,
-        name: &str,
-        urdf_text: &str,
-    ) -> PyResult<crate::robots::Robot> {
-        crate::robots::open_robot(self, py, name, urdf_text)
-    }
-
-    /// Removes the robot named `name` (or the `gjkd.Robot` given) as a
-    /// whole: its kinematics and every link object, all or nothing
-    /// (`remove` of one link would leave the robot with a hole; the
-    /// robot's `id` is no object id). Raises `NotFound` (`UNKNOWN_NAME`)
-    /// when there is no such robot, and the server's refusals
-    /// (`NOT_OWNER`, `READ_ONLY`) as `remove` does.
-    fn remove_robot(&mut self, py: Python<'_>, robot: &Bound<'_, PyAny>) -> PyResult<()> {
-        let name = match robot.cast::<crate::robots::Robot>() {
-            Ok(r) => r.borrow().handle.name.clone(),
-            Err(_) => robot.extract::<String>()?,
-        };
-        self.call(py, |c| c.remove_robot(&name))?
-            .map_err(|e| errors::client(py, e, Some("robot")))
-    }
-
-    /// Sets every joint of `robot` in one round trip, and its base pose
-    /// when `base` is given: the server places every link by forward
-    /// kinematics. `positions` is a `(dof,)` float64 array in
-    /// `robot.joint_names` order, or a `{joint name: position}` dict
-    /// (joints not named keep their last positions); a robot without
-    /// moving joints takes `[]` and moves by `base` alone. A position outside
-    /// its limits raises `InvalidInput` (`OUT_OF_LIMITS`, `index` the
-    /// joint) unless `clamp=True` moves it to the nearest limit; NaN
-    /// raises `InvalidInput` (`NON_FINITE_POSE`); an unknown joint name
-    /// `NotFound` (`UNKNOWN_NAME`). Nothing moves on error.
-    #[pyo3(signature = (robot, positions, *, base = None, clamp = false))]
-    fn set_joints(
-        &mut self,
-        py: Python<'_>,
-        mut robot: PyRefMut<'_, crate::robots::Robot>,
-        positions: &Bound<'_, PyAny>,
-        base: Option<&Bound<'_, PyAny>>,
-        clamp: bool,
-    ) -> PyResult<()> {
-        crate::robots::set_joints(self, py, &mut robot, positions, base, clamp)
     }
 
     /// The service name.
@@ -457,3 +389,6 @@ backend_methods!(Client, {
         )
     }
 });
+
+crate::robot_api::robot_methods!(Client);
+crate::scene_api::scene_methods!(Client);

@@ -1,6 +1,7 @@
-//! `gjkd.Robot`: a robot registered from URDF on a server, its links and
-//! joints, and the calls of `gjkd.Client` that register, find and move
-//! robots (the client's methods forward here).
+//! `gjkd.Robot`: a robot registered from URDF on a server or in a
+//! `gjkd.Local`, its links and joints, and the calls that register, find
+//! and move robots, written once over a [`Backend`] (the methods of both
+//! classes, `robot_api.rs`, forward here).
 
 use std::path::{Path, PathBuf};
 
@@ -12,20 +13,19 @@ use gjkd_client::{ErrorCode, JointError, LimitMode, PackagePath, RobotHandle, St
 use nalgebra::Isometry3;
 
 use crate::arrays::{f64_array, slice};
-use crate::backend::checked_pose;
-use crate::call::RustCall;
+use crate::backend::{Backend, RobotText, checked_pose};
 use crate::errors::{self, Kind, Raise, invalid};
 use crate::shape::isometry;
 
-/// A robot on a gjkd server, registered from URDF by
-/// `Client.register_robot` (or found by `Client.open_robot`).
+/// A robot on a gjkd server or in a `gjkd.Local`, registered from URDF by
+/// `register_robot` (or found by `open_robot`) of either.
 ///
 /// Each link with collision geometry is an object of its own, named
 /// `<robot>/<link>`: `link(name)` gives its id, to query like any other
 /// object (`client.distance(robot.link("hand"), table)`). Move the robot
-/// with `Client.set_joints`: one round trip sets every joint (and
-/// optionally the base pose), and the server places every link by forward
-/// kinematics.
+/// with `set_joints` of the `Client` or `Local` that holds it: one round
+/// trip sets every joint (and optionally the base pose), and the server
+/// (or `Local`) places every link by forward kinematics.
 #[pyclass(unsendable, module = "gjkd", name = "Robot")]
 pub struct Robot {
     pub(crate) handle: RobotHandle,
@@ -365,7 +365,7 @@ impl Text {
 /// Registers a robot on `client` (GIL released while its meshes load and
 /// its links register).
 pub fn register_robot(
-    client: &mut impl RustCall,
+    client: &mut dyn Backend,
     py: Python<'_>,
     name: &str,
     source: &RobotSource,
@@ -383,17 +383,16 @@ pub fn register_robot(
         Text::Inline(_) => None,
     };
     let packages = PackagePath::with_env(source.package_path.clone());
+    let text = RobotText {
+        name,
+        urdf: &urdf,
+        srdf: srdf.as_deref(),
+        mesh_base: mesh_base.as_deref(),
+        packages: &packages,
+        base: &base,
+    };
     let handle = client
-        .call(py, |c| {
-            c.register_robot_text(
-                name,
-                &urdf,
-                srdf.as_deref(),
-                mesh_base.as_deref(),
-                &packages,
-                &base,
-            )
-        })?
+        .register_robot(py, &text)?
         // A robot the client cannot read carries the code the server gives
         // a robot it cannot attach (docs/errors.md): `ClientError::code`.
         .map_err(|e| errors::client(py, e, Some("urdf")))?;
@@ -402,26 +401,24 @@ pub fn register_robot(
 
 /// Finds a robot on the server by name, given its URDF text.
 pub fn open_robot(
-    client: &mut impl RustCall,
+    client: &mut dyn Backend,
     py: Python<'_>,
     name: &str,
     urdf: &str,
 ) -> PyResult<Robot> {
-    let handle = client
-        .call(py, |c| c.open_robot(name, urdf))?
-        .map_err(|e| {
-            let field = match e {
-                gjkd_client::ClientError::InvalidRobot(_) => "urdf",
-                _ => "name",
-            };
-            errors::client(py, e, Some(field))
-        })?;
+    let handle = client.open_robot(py, name, urdf)?.map_err(|e| {
+        let field = match e {
+            gjkd_client::ClientError::InvalidRobot(_) => "urdf",
+            _ => "name",
+        };
+        errors::client(py, e, Some(field))
+    })?;
     Ok(Robot::new(handle, Isometry3::identity()))
 }
 
 /// Sets `robot`'s joints (and base) in one round trip.
 pub fn set_joints(
-    client: &mut impl RustCall,
+    client: &mut dyn Backend,
     py: Python<'_>,
     robot: &mut Robot,
     positions: &Bound<'_, PyAny>,
@@ -444,7 +441,7 @@ pub fn set_joints(
         .check_positions(&mut checked, mode)
         .map_err(|e| joint_error(py, &robot.handle, e))?;
     let handle = &mut robot.handle;
-    let outcome = client.call(py, |c| c.set_joints_with(handle, &q, base.as_ref(), mode))?;
+    let outcome = client.set_joints(py, handle, &q, base.as_ref(), mode)?;
     outcome.map_err(|e| match e {
         gjkd_client::ClientError::Rejected(ErrorCode::UnknownObject) => {
             errors::refused(py, ErrorCode::UnknownObject, Some("robot"), None)

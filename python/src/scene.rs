@@ -9,14 +9,13 @@ use pyo3::types::PyAnyMethods;
 use gjkd_client::{ClientError, Item, ObjectId, SceneRow, Steps};
 use gjkd_proto::{GRADIENT_COLUMNS, PathMode, SceneKind, SceneRequest, scene_flags};
 
-use crate::arrays::{IdArray, Ids, PoseArray, Poses, f64_array, id_array, pose_array, slice};
+use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array};
+use crate::backend::Backend;
 use crate::batch::Distances;
-use crate::call::RustCall;
-use crate::client::Client;
 use crate::errors::{self, invalid};
-use crate::robots::{Robot, path_steps};
+use crate::robots::Robot;
 
-/// Room for the rows of scene answers (`Client.clearance`, `within`,
+/// Room for the rows of scene answers (`clearance`, `within`,
 /// `nearest`, `path`): `SceneRows(n)` holds `n` rows, reused from call to
 /// call (nothing is allocated per call). A call writes its rows from the
 /// start and returns a `SceneSummary` whose `written` says how many.
@@ -303,18 +302,18 @@ impl Summary {
 }
 
 /// The keyword options every scene call takes.
-struct Options {
-    tolerance: f64,
-    max_iterations: u32,
-    warm_start: bool,
-    motion_bounds: bool,
-    accept_absolute: f64,
-    accept_relative: f64,
+pub(crate) struct Options {
+    pub(crate) tolerance: f64,
+    pub(crate) max_iterations: u32,
+    pub(crate) warm_start: bool,
+    pub(crate) motion_bounds: bool,
+    pub(crate) accept_absolute: f64,
+    pub(crate) accept_relative: f64,
     /// Exact distances on every reported row.
-    exact: bool,
-    cutoff: Option<f64>,
+    pub(crate) exact: bool,
+    pub(crate) cutoff: Option<f64>,
     /// Clamp a path's joint positions to their limits.
-    clamp: bool,
+    pub(crate) clamp: bool,
 }
 
 impl Options {
@@ -555,7 +554,7 @@ impl SceneRows {
 /// Sends `request` with `inputs` from `client`, rows into `out`.
 fn run(
     py: Python<'_>,
-    client: &mut Client,
+    client: &mut dyn Backend,
     mut request: SceneRequest,
     inputs: Inputs<'_>,
     out: &Bound<'_, SceneRows>,
@@ -565,9 +564,7 @@ fn run(
     request.flags |= rows.gradient_request_flags(py);
     let count = inputs.len();
     let outcome = rows.with_rows(py, |write| {
-        client.call(py, move |c: &mut gjkd_client::Client| {
-            c.scene_with(&request, count, |i| inputs.item(i), |got| write(got))
-        })
+        client.scene(py, &request, count, &mut |i| inputs.item(i), write)
     })?;
     outcome
         .map(|inner| Summary { inner })
@@ -575,7 +572,7 @@ fn run(
 }
 
 /// The scene question and path mode of a path's `question` argument.
-fn path_question(py: Python<'_>, question: &str) -> PyResult<(SceneKind, PathMode)> {
+pub(crate) fn path_question(py: Python<'_>, question: &str) -> PyResult<(SceneKind, PathMode)> {
     match question {
         "clearance" => Ok((SceneKind::Clearance, PathMode::EveryStep)),
         "within" => Ok((SceneKind::Within, PathMode::EveryStep)),
@@ -593,7 +590,7 @@ fn path_question(py: Python<'_>, question: &str) -> PyResult<(SceneKind, PathMod
 }
 
 /// The motion of a path question, if any.
-enum PathArg<'a, 'py> {
+pub(crate) enum PathArg<'a, 'py> {
     /// Not a path.
     None,
     /// Poses of the moving objects, step after step.
@@ -604,9 +601,9 @@ enum PathArg<'a, 'py> {
 
 /// Reads the group and allowed pairs, then runs.
 #[allow(clippy::too_many_arguments)]
-fn ask<'py>(
+pub(crate) fn ask<'py>(
     py: Python<'py>,
-    client: &mut Client,
+    client: &mut dyn Backend,
     kind: SceneKind,
     group: &Bound<'py, PyAny>,
     allow: Option<&Bound<'py, PyAny>>,
@@ -657,323 +654,4 @@ fn ask<'py>(
         joints,
     };
     run(py, client, request, inputs, out)
-}
-
-#[pymethods]
-impl Client {
-    /// For each member of `group`, the nearest object outside the group:
-    /// one row per member into `out` (a `gjkd.SceneRows`); returns a
-    /// `gjkd.SceneSummary`.
-    ///
-    /// `group` is a robot id (its links, with its allowed pairs), an object
-    /// id, or a 1-D array of object ids. `allow`: `(K, 2)` ids of pairs
-    /// never to report. `cutoff`: ignore objects farther than this (a
-    /// member with nothing that near may get `b == 0`). `warm_start`,
-    /// `motion_bounds`, `accept_absolute`, `accept_relative`: see the
-    /// README's "Scene queries"; `exact=True` runs every reported row to
-    /// convergence (no `BOUNDED` or `CLOSER` row: `distance` exact for
-    /// all). Raises `InvalidInput` (`UNKNOWN_OBJECT`,
-    /// `INVALID_OPTIONS`, `MALFORMED`, ...) when the server refuses the
-    /// whole request; nothing changes then.
-    #[pyo3(signature = (group, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn clearance<'py>(
-        &mut self,
-        py: Python<'py>,
-        group: &Bound<'py, PyAny>,
-        out: &Bound<'py, SceneRows>,
-        allow: Option<&Bound<'py, PyAny>>,
-        cutoff: Option<f64>,
-        tolerance: f64,
-        max_iterations: u32,
-        warm_start: bool,
-        motion_bounds: bool,
-        accept_absolute: f64,
-        accept_relative: f64,
-        exact: bool,
-    ) -> PyResult<Summary> {
-        let options = Options {
-            tolerance,
-            max_iterations,
-            warm_start,
-            motion_bounds,
-            accept_absolute,
-            accept_relative,
-            exact,
-            cutoff,
-            clamp: false,
-        };
-        ask(
-            py,
-            self,
-            SceneKind::Clearance,
-            group,
-            allow,
-            PathArg::None,
-            &options,
-            |_| {},
-            out,
-        )
-    }
-
-    /// Every pair, `group` against the rest (or all against all with
-    /// `all_pairs=True`), whose distance is at most `margin`, into `out`.
-    /// With `self_pairs=True`, also the group's members against each other
-    /// but the allowed pairs (a robot's self-collisions: not its adjacent
-    /// links nor the SRDF's disabled pairs). Other arguments as `clearance`.
-    #[pyo3(signature = (group, margin, *, out, all_pairs=false, self_pairs=false, allow=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn within<'py>(
-        &mut self,
-        py: Python<'py>,
-        group: &Bound<'py, PyAny>,
-        margin: f64,
-        out: &Bound<'py, SceneRows>,
-        all_pairs: bool,
-        self_pairs: bool,
-        allow: Option<&Bound<'py, PyAny>>,
-        tolerance: f64,
-        max_iterations: u32,
-        warm_start: bool,
-        motion_bounds: bool,
-        accept_absolute: f64,
-        accept_relative: f64,
-        exact: bool,
-    ) -> PyResult<Summary> {
-        let options = Options {
-            tolerance,
-            max_iterations,
-            warm_start,
-            motion_bounds,
-            accept_absolute,
-            accept_relative,
-            exact,
-            cutoff: None,
-            clamp: false,
-        };
-        let edit = |r: &mut SceneRequest| {
-            r.margin = margin;
-            if all_pairs {
-                r.flags |= scene_flags::ALL_PAIRS;
-            }
-            if self_pairs {
-                r.flags |= scene_flags::SELF_PAIRS;
-            }
-        };
-        ask(
-            py,
-            self,
-            SceneKind::Within,
-            group,
-            allow,
-            PathArg::None,
-            &options,
-            edit,
-            out,
-        )
-    }
-
-    /// The `k` objects nearest to `object`, nearest first, into `out`.
-    /// Other arguments as `clearance`.
-    #[pyo3(signature = (object, k, *, out, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn nearest<'py>(
-        &mut self,
-        py: Python<'py>,
-        object: &Bound<'py, PyAny>,
-        k: u32,
-        out: &Bound<'py, SceneRows>,
-        allow: Option<&Bound<'py, PyAny>>,
-        cutoff: Option<f64>,
-        tolerance: f64,
-        max_iterations: u32,
-        warm_start: bool,
-        motion_bounds: bool,
-        accept_absolute: f64,
-        accept_relative: f64,
-        exact: bool,
-    ) -> PyResult<Summary> {
-        if object.extract::<u64>().is_err() {
-            return Err(invalid(py, "object", None, "object must be an id".into()));
-        }
-        let options = Options {
-            tolerance,
-            max_iterations,
-            warm_start,
-            motion_bounds,
-            accept_absolute,
-            accept_relative,
-            exact,
-            cutoff,
-            clamp: false,
-        };
-        let edit = |r: &mut SceneRequest| r.k = k;
-        ask(
-            py,
-            self,
-            SceneKind::Nearest,
-            object,
-            allow,
-            PathArg::None,
-            &options,
-            edit,
-            out,
-        )
-    }
-
-    /// A question asked at every step of a candidate motion, nothing moved
-    /// on the server: `poses` holds `S * len(objects)` poses (`(S*n, 7)`
-    /// rows or `(S*n, 4, 4)` matrices), row `s * n + i` the pose of
-    /// `objects[i]` at step `s`. `question` is `"clearance"` (each member's
-    /// clearance at every step), `"within"` (the pairs within `margin` at
-    /// every step) or `"first_hit"` (only the first step with a pair within
-    /// `margin`, its index in the summary's `first_hit`) or `"continuous"`
-    /// (every pose of the motion between consecutive steps, not samples:
-    /// translations linear, rotations along the shortest arc, or with
-    /// `linear_quaternions` the quaternions' components linear as the GJK
-    /// paper's Section 8; a row per segment that comes within `margin`, its
-    /// first contact bracketed in `[out.s_lo, out.s_hi]` at most `bracket`
-    /// wide, everything before `s_lo` certified clear; no row for a segment
-    /// certified clear; `out.step` is the segment). Rows carry their step in
-    /// `out.step`. `self_pairs` as `within` (a clearance row's nearest
-    /// object may then be another member). Other arguments as `clearance`.
-    #[pyo3(signature = (group, objects, poses, *, out, question="clearance", margin=0.0, self_pairs=false, bracket=gjkd_proto::DEFAULT_BRACKET, linear_quaternions=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn path<'py>(
-        &mut self,
-        py: Python<'py>,
-        group: &Bound<'py, PyAny>,
-        objects: &Bound<'py, PyAny>,
-        poses: &Bound<'py, PyAny>,
-        out: &Bound<'py, SceneRows>,
-        question: &str,
-        margin: f64,
-        self_pairs: bool,
-        bracket: f64,
-        linear_quaternions: bool,
-        allow: Option<&Bound<'py, PyAny>>,
-        cutoff: Option<f64>,
-        tolerance: f64,
-        max_iterations: u32,
-        warm_start: bool,
-        motion_bounds: bool,
-        accept_absolute: f64,
-        accept_relative: f64,
-        exact: bool,
-    ) -> PyResult<Summary> {
-        let (kind, mode) = path_question(py, question)?;
-        let moving = id_array(objects, "objects")?;
-        if moving.shape().len() != 1 {
-            return Err(invalid(
-                py,
-                "objects",
-                None,
-                "objects must be a 1-D array of ids".into(),
-            ));
-        }
-        let poses = pose_array(poses, "poses")?;
-        let options = Options {
-            tolerance,
-            max_iterations,
-            warm_start,
-            motion_bounds,
-            accept_absolute,
-            accept_relative,
-            exact,
-            cutoff,
-            clamp: false,
-        };
-        let edit = |r: &mut SceneRequest| {
-            if kind == SceneKind::Within {
-                r.margin = margin;
-            }
-            if self_pairs {
-                r.flags |= scene_flags::SELF_PAIRS;
-            }
-            r.bracket = bracket;
-            if linear_quaternions {
-                r.flags |= scene_flags::LINEAR_QUATERNION;
-            }
-        };
-        let path = PathArg::Poses(mode, moving, poses);
-        ask(py, self, kind, group, allow, path, &options, edit, out)
-    }
-
-    /// `path` along a motion of `robot` given as joint positions: `positions`
-    /// is `(S, dof)` float64 (or `(dof,)` for one step), row `s` the moving
-    /// joints' positions (in `robot.joint_names` order) at step `s`. The
-    /// server places the links by forward kinematics at each step and
-    /// answers there; nothing moves on the server (the robot keeps its
-    /// joints). A position outside its limits raises `InvalidInput`
-    /// (`OUT_OF_LIMITS`, `index` its step) unless `clamp`, which moves it
-    /// to the nearest limit; a NaN raises (`NON_FINITE_POSE`). `group` is
-    /// usually the robot (`robot.id`, or the `Robot` itself, so that its
-    /// allowed pairs apply). `question="continuous"` checks every pose of
-    /// the motion between consecutive steps, joints linear between them: a
-    /// planner's edge check is two rows of `positions`. Other arguments as
-    /// `path`.
-    #[pyo3(signature = (group, robot, positions, *, out, question="clearance", margin=0.0, self_pairs=false, bracket=gjkd_proto::DEFAULT_BRACKET, clamp=false, allow=None, cutoff=None, tolerance=gjkd_proto::DEFAULT_TOLERANCE, max_iterations=gjkd_proto::DEFAULT_MAX_ITERATIONS, warm_start=true, motion_bounds=true, accept_absolute=0.0, accept_relative=0.0, exact=false))]
-    #[allow(clippy::too_many_arguments)]
-    fn path_joints<'py>(
-        &mut self,
-        py: Python<'py>,
-        group: &Bound<'py, PyAny>,
-        robot: PyRef<'py, Robot>,
-        positions: &Bound<'py, PyAny>,
-        out: &Bound<'py, SceneRows>,
-        question: &str,
-        margin: f64,
-        self_pairs: bool,
-        bracket: f64,
-        clamp: bool,
-        allow: Option<&Bound<'py, PyAny>>,
-        cutoff: Option<f64>,
-        tolerance: f64,
-        max_iterations: u32,
-        warm_start: bool,
-        motion_bounds: bool,
-        accept_absolute: f64,
-        accept_relative: f64,
-        exact: bool,
-    ) -> PyResult<Summary> {
-        let (kind, mode) = path_question(py, question)?;
-        let array = f64_array(positions, "positions")?;
-        let dof = robot.handle.positions.len();
-        let shape = array.shape().to_vec();
-        if !matches!(shape.as_slice(), [d] | [_, d] if *d == dof) || shape.contains(&0) {
-            return Err(invalid(
-                py,
-                "positions",
-                None,
-                format!(
-                    "positions must have shape (S, {dof}) (a row of the robot's {dof} moving \
-                     joints per step, at least one step), got {:?}",
-                    shape
-                ),
-            ));
-        }
-        let steps = path_steps(py, &robot, slice(&array)?, clamp)?;
-        let options = Options {
-            tolerance,
-            max_iterations,
-            warm_start,
-            motion_bounds,
-            accept_absolute,
-            accept_relative,
-            exact,
-            cutoff,
-            clamp,
-        };
-        let edit = |r: &mut SceneRequest| {
-            if kind == SceneKind::Within {
-                r.margin = margin;
-            }
-            if self_pairs {
-                r.flags |= scene_flags::SELF_PAIRS;
-            }
-            r.bracket = bracket;
-        };
-        let path = PathArg::Joints(mode, steps);
-        ask(py, self, kind, group, allow, path, &options, edit, out)
-    }
 }

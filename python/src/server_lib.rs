@@ -3,7 +3,10 @@
 //! code a server runs, so the answers are the same bit for bit), and the
 //! serving command (`python -m gjkd serve`).
 
-use gjkd_proto::{AdminChunk, AdminRequest, ErrorCode, Item, ItemResult, Pose, Vertex, WaitMode};
+use gjkd_proto::{
+    AdminChunk, AdminRequest, ErrorCode, Item, ItemResult, Pose, SceneReply, SceneRequest,
+    SceneRow, WaitMode,
+};
 use nalgebra::Isometry3;
 
 /// The server's check of a wire pose (finite, unit quaternion within its
@@ -24,8 +27,14 @@ pub struct Store {
 }
 
 /// The client identity `gjkd.Local` uses with the handlers: the owner of
-/// every object and the key of every warm start.
+/// every object and the key of the pair queries' warm starts.
 const LOCAL_CLIENT: u128 = 1;
+
+/// The key of the scene questions' warm starts and motion bounds: apart
+/// from the pair queries', as a server keeps a client's scene port apart
+/// from its query port, so that a `Local` starts each pair as warm as a
+/// `Client` does.
+const LOCAL_SCENES: u128 = 2;
 
 impl Store {
     /// An empty store.
@@ -40,11 +49,15 @@ impl Store {
         self.state.limits()
     }
 
-    /// Answers a registration, removal or look-up: the id, or the error.
-    pub fn admin(&mut self, request: &AdminRequest, vertices: &[Vertex]) -> Result<u64, ErrorCode> {
-        let reply =
-            self.state
-                .handle_admin(LOCAL_CLIENT, request, AdminChunk::from_vertices(vertices));
+    /// Answers an admin request (a registration, removal, look-up or
+    /// robot) with its payload (vertices or robot text): the id, or the
+    /// error.
+    pub fn admin(
+        &mut self,
+        request: &AdminRequest,
+        payload: &[AdminChunk],
+    ) -> Result<u64, ErrorCode> {
+        let reply = self.state.handle_admin(LOCAL_CLIENT, request, payload);
         match reply.error_code() {
             ErrorCode::Ok => Ok(reply.id),
             code => Err(code),
@@ -61,6 +74,22 @@ impl Store {
         self.state.handle(LOCAL_CLIENT, items, results);
     }
 
+    /// Answers a scene request as a server does, rows into `rows` (its
+    /// length is the most rows written).
+    pub fn scene(
+        &mut self,
+        request: &SceneRequest,
+        items: &[Item],
+        rows: &mut [SceneRow],
+    ) -> SceneReply {
+        self.state.scene(LOCAL_SCENES, request, items, rows)
+    }
+
+    /// The id of the object named `name`.
+    pub fn lookup(&self, name: &str) -> Option<u64> {
+        self.state.lookup(name)
+    }
+
     /// Objects held.
     pub fn len(&self) -> usize {
         self.state.len()
@@ -68,7 +97,8 @@ impl Store {
 
     /// Forgets every warm start.
     pub fn forget_warm_starts(&mut self) {
-        self.state.forget_client(LOCAL_CLIENT);
+        // The scene questions' motion bounds too: every client is gone.
+        self.state.retain_clients(|_| false);
     }
 }
 

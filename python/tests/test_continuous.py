@@ -1,5 +1,6 @@
 """Continuous paths from Python: every pose of the motion between steps,
-certified clear or its first contact bracketed, against the closed form."""
+certified clear or its first contact bracketed, against the closed form;
+on a ``gjkd.Client`` and on a ``gjkd.Local``."""
 
 from __future__ import annotations
 
@@ -16,8 +17,12 @@ def at(x: float, y: float = 0.0, z: float = 0.0) -> list[float]:
     return [x, y, z, 0.0, 0.0, 0.0, 1.0]
 
 
-@pytest.fixture()
-def client() -> Iterator[gjkd.Client]:
+@pytest.fixture(params=["client", "local"])
+def client(request: pytest.FixtureRequest) -> Iterator[gjkd.Client]:
+    if request.param == "local":
+        with gjkd.Local() as local:
+            yield local  # type: ignore[misc]
+        return
     with gjkd.Server(service=unique_service("continuous"), wait="spin") as server:
         with gjkd.Client(server.service) as c:
             yield c

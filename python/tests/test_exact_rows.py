@@ -1,7 +1,8 @@
 """``exact=True``: every reported scene row carries its converged distance,
 where without it rows proved inside a margin early (``CLOSER``) or answered
 from motion bounds (``BOUNDED``) carry estimates; against the closed-form
-distance between a ball and boxes."""
+distance between a ball and boxes; on a ``gjkd.Client`` and on a
+``gjkd.Local``."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import numpy as np
 import gjkd
 
 
-def test_exact_rows_carry_converged_distances(client: gjkd.Client) -> None:
+def test_exact_rows_carry_converged_distances(objects: gjkd.Client) -> None:
+    client = objects
     radius, half = 0.1, np.array([0.2, 0.3, 0.25])
     ball = client.register_sphere(radius)
     centres = [

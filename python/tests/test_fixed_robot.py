@@ -1,10 +1,12 @@
 """A robot without moving joints moves by its base alone: ``set_joints``
 with no positions places its link where the base puts it, against the
-closed-form distance to a ball."""
+closed-form distance to a ball. Each test runs on a ``gjkd.Client`` and on
+a ``gjkd.Local``."""
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -14,6 +16,13 @@ from conftest import unique_service
 TABLE = """<robot name="table">
   <link name="top"><collision><geometry><box size="1.0 0.5 0.2"/></geometry></collision></link>
 </robot>"""
+
+
+@pytest.fixture()
+def client(objects: Any) -> Any:
+    """A Client of the module's server, then a Local (conftest's
+    ``objects``)."""
+    return objects
 
 
 def test_a_robot_without_moving_joints_moves_by_its_base(client: gjkd.Client) -> None:

@@ -26,11 +26,17 @@ EXAMPLE = ROOT / "python" / "examples" / "trajopt_panda.py"
 _names = itertools.count()
 
 
-@pytest.fixture(scope="module")
-def panda(server: gjkd.Server) -> Iterator[tuple[gjkd.Client, Any, list[int]]]:
+@pytest.fixture(scope="module", params=["client", "local"])
+def panda(
+    request: pytest.FixtureRequest, server: gjkd.Server
+) -> Iterator[tuple[gjkd.Client, Any, list[int]]]:
     """One Panda among obstacles for the module (a second robot at the same
-    base would overlap the first everywhere)."""
-    client = gjkd.Client(server.service, timeout=30.0)
+    base would overlap the first everywhere), on the module's server, then
+    on a Local."""
+    if request.param == "local":
+        client: Any = gjkd.Local()
+    else:
+        client = gjkd.Client(server.service, timeout=30.0)
     robot = client.register_robot(f"panda{next(_names)}", PANDA, package_path=[DATA])
     rng = np.random.default_rng(5)
     obstacles = []

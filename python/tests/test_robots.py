@@ -1,7 +1,9 @@
 """Robots from a URDF the test writes (box, sphere and mesh links, a
 revolute, a second revolute, a prismatic and a fixed joint): forward
 kinematics against transforms computed here by hand, link distances
-through the server against analytic answers, and every bad input."""
+through the server against analytic answers, and every bad input. Every
+test that takes ``client`` runs on a ``gjkd.Client`` and on a
+``gjkd.Local``: the in-process store offers the same robot calls."""
 
 from __future__ import annotations
 
@@ -98,6 +100,13 @@ def arm_dir(tmp_path_factory: pytest.TempPathFactory) -> pathlib.Path:
 
 def robot_name() -> str:
     return f"arm{next(_robots)}"
+
+
+@pytest.fixture()
+def client(objects: Any) -> Any:
+    """A Client of the module's server, then a Local (conftest's
+    ``objects``)."""
+    return objects
 
 
 @pytest.fixture()
@@ -307,8 +316,12 @@ def test_robot_registration_errors(client: gjkd.Client, arm_dir: pathlib.Path) -
     with pytest.raises(gjkd.Refused) as e:
         client.register_robot(name, arm_dir / "arm.urdf")
     assert e.value.code == gjkd.ErrorCode.NAME_TAKEN
-    # Another client finds it by name.
-    with gjkd.Client(client.service) as other:
+    # Another client finds it by name (a Local, itself).
+    if isinstance(client, gjkd.Client):
+        other = gjkd.Client(client.service)
+    else:
+        other = client
+    with other:
         found = other.open_robot(name, ARM_URDF)
         assert found.id == robot.id and list(found.link_ids) == list(robot.link_ids)
         with pytest.raises(gjkd.NotFound) as e:

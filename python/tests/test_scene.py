@@ -1,5 +1,7 @@
 """Scene queries from Python: clearance, within, nearest and paths into a
-caller-owned ``SceneRows``, against the same server's per-pair answers."""
+caller-owned ``SceneRows``, against the same server's per-pair answers and
+closed forms. Every test runs on a ``gjkd.Client`` of a server of its own
+and on a ``gjkd.Local``."""
 
 from __future__ import annotations
 
@@ -18,9 +20,14 @@ def at(x: float, y: float = 0.0, z: float = 0.0) -> list[float]:
     return [x, y, z, 0.0, 0.0, 0.0, 1.0]
 
 
-@pytest.fixture()
-def client() -> Iterator[gjkd.Client]:
-    """A server of the test's own: scene queries see every object."""
+@pytest.fixture(params=["client", "local"])
+def client(request: pytest.FixtureRequest) -> Iterator[gjkd.Client]:
+    """A server of the test's own (scene queries see every object), then a
+    Local."""
+    if request.param == "local":
+        with gjkd.Local() as local:
+            yield local  # type: ignore[misc]
+        return
     with gjkd.Server(service=unique_service("scene"), wait="spin") as server:
         with gjkd.Client(server.service) as c:
             yield c

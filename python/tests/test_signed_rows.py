@@ -25,10 +25,14 @@ def expected(x: float) -> float:
     return abs(x) - 1.5
 
 
-@pytest.fixture()
-def alone() -> Iterator[gjkd.Client]:
-    """A client of a server of its own: a scene question sees every object
-    stored, so no other test's may be there."""
+@pytest.fixture(params=["client", "local"])
+def alone(request: pytest.FixtureRequest) -> Iterator[gjkd.Client]:
+    """A client of a server of its own (a scene question sees every object
+    stored, so no other test's may be there), then a Local."""
+    if request.param == "local":
+        with gjkd.Local() as local:
+            yield local  # type: ignore[misc]
+        return
     with gjkd.Server(service=unique_service("signed"), wait="spin") as server:
         with gjkd.Client(server.service) as client:
             yield client

@@ -8,10 +8,20 @@ use nalgebra::Isometry3;
 
 #[cfg(doc)]
 use crate::ServerInfo;
+use gjkd_proto::{Gradient, GradientRow, ReplyEntry, item_flags};
+
 use crate::{
     Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, QueryOptions, Waited,
     ipc_err, reply_accepted,
 };
+
+/// Why a call without a gradient buffer refuses an item that asks for one.
+const NO_GRADIENT_BUFFER: &str = "an item asks for a gradient (item_flags::GRADIENT) but the call \
+     has no gradient buffer: use query_batch_gradients";
+
+/// Why [`Client::query_batch_gradients`] refuses a short gradient buffer.
+const SHORT_GRADIENT_BUFFER: &str =
+    "the gradient buffer is shorter than the items that ask for a gradient";
 
 impl Client {
     /// Stores a new pose for `id`, used by every later query (of any client)
@@ -66,10 +76,13 @@ impl Client {
     /// queries after it. Each result has its own error code (see
     /// [`ItemResult::answer`]); the call itself fails only if the whole
     /// request does. Allocates nothing of its own (iceoryx2 0.10 makes one
-    /// small allocation per request for its loan bookkeeping).
+    /// small allocation per request for its loan bookkeeping). Items that
+    /// ask for a gradient go through [`Client::query_batch_gradients`].
     ///
     /// # Errors
     /// [`ClientError::ResultBufferTooSmall`];
+    /// [`ClientError::InvalidArgument`] when an item asks for a gradient
+    /// (nothing is sent);
     /// [`ClientError::Rejected`] with [`ErrorCode::EmptyBatch`] or
     /// [`ErrorCode::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
     /// items); and the connection errors.
@@ -87,8 +100,50 @@ impl Client {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
-            |payload| results[..payload.len()].copy_from_slice(payload),
+            Gradients::Refused,
+            |payload, _| results[..payload.len()].copy_from_slice(payload),
         )
+    }
+
+    /// As [`Client::query_batch`], and the gradient of the `k`-th item that
+    /// asks for one ([`Item::with_gradient`], see [`Gradient`]) into
+    /// `gradients[k]`, a buffer the caller owns and keeps from call to
+    /// call ([`Gradient::NONE`] for an item that failed). Only the items
+    /// that ask carry a gradient, in the reply too. Returns how many
+    /// gradients were written.
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`], and [`ClientError::InvalidArgument`]
+    /// when `gradients` is shorter than the items that ask for one
+    /// (nothing is sent).
+    pub fn query_batch_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<usize, ClientError> {
+        if results.len() < items.len() {
+            return Err(ClientError::ResultBufferTooSmall {
+                needed: items.len(),
+                got: results.len(),
+            });
+        }
+        let asked = ReplyEntry::gradients_asked(items);
+        if asked > gradients.len() {
+            return Err(ClientError::InvalidArgument(SHORT_GRADIENT_BUFFER));
+        }
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Taken,
+            |payload, rows| {
+                results[..payload.len()].copy_from_slice(payload);
+                for (out, row) in gradients.iter_mut().zip(rows) {
+                    *out = row.gradient;
+                }
+            },
+        )?;
+        Ok(asked)
     }
 
     /// As [`Client::query_batch`], but the results are handed to `read`
@@ -104,7 +159,32 @@ impl Client {
         items: &[Item],
         read: impl FnOnce(&[ItemResult]),
     ) -> Result<(), ClientError> {
-        self.round_trip(items.len(), Source::<fn(usize) -> Item>::Slice(items), read)
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Refused,
+            |results, _| read(results),
+        )
+    }
+
+    /// As [`Client::query_batch_read`], for items that may ask for
+    /// gradients: `read` gets the results and, straight from the
+    /// response's shared memory too, the gradient rows, one per item that
+    /// asked, in item order ([`GradientRow::item`] names it).
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`], but for gradients.
+    pub fn query_batch_read_gradients(
+        &mut self,
+        items: &[Item],
+        read: impl FnOnce(&[ItemResult], &[GradientRow]),
+    ) -> Result<(), ClientError> {
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Taken,
+            read,
+        )
     }
 
     /// As [`Client::query_batch`], but item `i` of the `count` items is
@@ -122,16 +202,19 @@ impl Client {
         item: impl FnMut(usize) -> Item,
         read: impl FnOnce(&[ItemResult]),
     ) -> Result<(), ClientError> {
-        self.round_trip(count, Source::Fn(item), read)
+        self.round_trip(count, Source::Fn(item), Gradients::Refused, |results, _| {
+            read(results)
+        })
     }
 
     /// Sends `count` items from `source` as one request and hands the
-    /// results to `read`.
+    /// results and the gradient rows to `read`.
     fn round_trip<F: FnMut(usize) -> Item>(
         &mut self,
         count: usize,
         source: Source<'_, F>,
-        read: impl FnOnce(&[ItemResult]),
+        gradients: Gradients,
+        read: impl FnOnce(&[ItemResult], &[GradientRow]),
     ) -> Result<(), ClientError> {
         let deadline = Instant::now() + self.timeout;
         self.ensure_connected(deadline)?;
@@ -149,6 +232,16 @@ impl Client {
                 Source::Slice(items) => loan.write_from_slice(items),
                 Source::Fn(item) => loan.write_from_fn(item),
             };
+            // A gradient asked with nowhere to go is refused before anything
+            // is sent (one pass over the flags, branch-free).
+            if matches!(gradients, Gradients::Refused)
+                && request.payload().iter().fold(0, |acc, i| acc | i.flags) & item_flags::GRADIENT
+                    != 0
+            {
+                return Err(Waited::Failed(ClientError::InvalidArgument(
+                    NO_GRADIENT_BUFFER,
+                )));
+            }
             let pending = request
                 .send()
                 .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
@@ -162,21 +255,35 @@ impl Client {
                 let header = *response.user_header();
                 reply_accepted(header.error)?;
                 let payload = response.payload();
-                if payload.len() != count {
+                let rows = header.gradients as usize;
+                let split = ReplyEntry::split(payload, count)
+                    .filter(|_| header.count as usize == count && payload.len() == count + rows);
+                let Some((results, gradient_rows)) = split else {
                     return Err(ClientError::Protocol(format!(
-                        "{} results for {} items",
+                        "{} entries ({} results, {} gradients) for {} items",
                         payload.len(),
+                        header.count,
+                        rows,
                         count
                     )));
-                }
+                };
                 if let Some(read) = read.take() {
-                    read(payload);
+                    read(results, gradient_rows);
                 }
                 Ok(Some(()))
             })
         })();
         self.settle(outcome)
     }
+}
+
+/// Whether a call takes the gradients its items ask for.
+#[derive(Clone, Copy)]
+enum Gradients {
+    /// It has nowhere to put them: an item that asks is refused.
+    Refused,
+    /// It hands them to its reader.
+    Taken,
 }
 
 /// Where the items of a request come from.

@@ -837,6 +837,7 @@ mod tests {
             step: 4,
             reserved: 0,
             result: ItemResult::default(),
+            gradient: gjkd_proto::Gradient::NONE,
             s_lo: 0.0,
             s_hi: 0.0,
         };

@@ -5,7 +5,7 @@ use std::time::Duration;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gjkd_client::{ClientError, Item, ItemResult};
+use gjkd_client::{ClientError, Gradient, Item, ItemResult};
 
 use crate::call::RustCall;
 use gjkd_proto::Pose;
@@ -71,6 +71,22 @@ impl Answerer for Connection {
             self.max_batch = info.max_batch as usize;
         }
         outcome
+    }
+
+    fn answer_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
+        let Some(client) = self.inner.as_mut() else {
+            return Err(ClientError::Protocol("the client is closed".into()));
+        };
+        let outcome = client.query_batch_gradients(items, results, gradients);
+        if let Some(info) = client.server_info() {
+            self.max_batch = info.max_batch as usize;
+        }
+        outcome.map(|_| ())
     }
 
     fn refresh_limit(&mut self) -> bool {

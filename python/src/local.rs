@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 
-use gjkd_client::{ClientError, Item, ItemResult};
+use gjkd_client::{ClientError, Gradient, Item, ItemResult};
 use gjkd_proto::{AdminOp, AdminRequest, Pose};
 
 use crate::api::{Backend, backend_methods};
@@ -46,6 +46,16 @@ impl Answerer for LocalStore {
 
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
         self.store.handle(items, results);
+        Ok(())
+    }
+
+    fn answer_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
+        self.store.handle_gradients(items, results, gradients);
         Ok(())
     }
 }

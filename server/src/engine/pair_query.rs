@@ -53,7 +53,6 @@ pub(crate) fn run_pair(
         signed_distance: 0.0,
         signed_lower: 0.0,
         signed_upper: 0.0,
-        gradient: gjkd_proto::Gradient::NONE,
     };
     Ok((result, answer.warm_start))
 }

@@ -1,7 +1,7 @@
 //! The query service's handler: pair distances, pose and joint updates, in
 //! the order the client sent them.
 
-use gjkd_proto::{ErrorCode, Item, ItemKind, ItemResult, item_flags};
+use gjkd_proto::{ErrorCode, Gradient, GradientRow, Item, ItemKind, ItemResult, item_flags};
 
 use crate::engine::checks::check_pose;
 use crate::engine::gradient::{self, Side, Stance};
@@ -15,10 +15,43 @@ impl State {
     /// which keys its warm-start cache): `results[i]` answers `items[i]`,
     /// items applied in order. `results` must be as long as `items`; extra
     /// results are left alone and a short buffer answers only what fits.
+    /// With no room for gradients, an item that asks for one
+    /// ([`item_flags::GRADIENT`]) fails with [`ErrorCode::InvalidOptions`];
+    /// [`State::handle_with_gradients`] answers it.
     pub fn handle(&mut self, client: u128, items: &[Item], results: &mut [ItemResult]) {
+        self.handle_with_gradients(client, items, results, &mut []);
+    }
+
+    /// As [`State::handle`], and the gradient of the `k`-th item that asks
+    /// for one ([`item_flags::GRADIENT`]) into `gradients[k]`, with the
+    /// item's index ([`Gradient::NONE`] when the item failed): the query
+    /// reply's gradient section ([`gjkd_proto::ReplyEntry`]), sized by
+    /// [`gjkd_proto::ReplyEntry::gradients_asked`]. An item asking beyond
+    /// `gradients` fails with [`ErrorCode::InvalidOptions`].
+    pub fn handle_with_gradients(
+        &mut self,
+        client: u128,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [GradientRow],
+    ) {
         self.stats.requests += 1;
-        for (item, out) in items.iter().zip(results.iter_mut()) {
-            *out = self.item(client, item);
+        let mut rows = gradients.iter_mut();
+        for (index, (item, out)) in items.iter().zip(results.iter_mut()).enumerate() {
+            // Only items that ask take a row, so the section holds exactly
+            // the gradients asked, whatever became of their items.
+            let row = if item.flags & item_flags::GRADIENT != 0 {
+                rows.next().map(|row| {
+                    *row = GradientRow {
+                        item: index as u32,
+                        ..GradientRow::default()
+                    };
+                    &mut row.gradient
+                })
+            } else {
+                None
+            };
+            *out = self.item(client, item, row);
             self.stats.items += 1;
             if out.error != 0 {
                 self.stats.item_errors += 1;
@@ -37,7 +70,9 @@ impl State {
         }
     }
 
-    fn item(&mut self, client: u128, item: &Item) -> ItemResult {
+    /// One item's answer; `gradient` is its row's gradient when it asks
+    /// for one and there is room.
+    fn item(&mut self, client: u128, item: &Item, gradient: Option<&mut Gradient>) -> ItemResult {
         // Unknown flag bits and a non-zero reserved word are refused rather
         // than ignored, so that a later protocol version can give them a
         // meaning without old servers silently answering something else.
@@ -57,7 +92,7 @@ impl State {
                 Err(e) => ItemResult::error(e),
             },
             Some(ItemKind::Distance) => self
-                .distance(client, item)
+                .distance(client, item, gradient)
                 .unwrap_or_else(ItemResult::error),
             Some(ItemKind::SetJoints) => match self.robots.set_joints(&mut self.store, item) {
                 Ok(()) => ItemResult::default(),
@@ -78,7 +113,12 @@ impl State {
         self.store.set_pose(item.a, check_pose(&item.pose_a)?)
     }
 
-    fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
+    fn distance(
+        &mut self,
+        client: u128,
+        item: &Item,
+        gradient: Option<&mut Gradient>,
+    ) -> Result<ItemResult, ErrorCode> {
         let warm_on = item.flags & item_flags::WARM_START != 0;
         let pair = item.pair();
         let options = gjk::Options {
@@ -118,6 +158,9 @@ impl State {
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
         let wants_gradient = item.flags & item_flags::GRADIENT != 0;
+        if wants_gradient && gradient.is_none() {
+            return Err(ErrorCode::InvalidOptions);
+        }
         // A link's gradient is taken at its robot's configuration: a pose
         // of this query only would not be where its joints put it.
         let overridden =
@@ -146,10 +189,11 @@ impl State {
         } else {
             None
         };
-        if wants_gradient {
+        if let Some(out) = gradient {
             self.gradient_poses.reset();
             gradient::fill(
                 &mut result,
+                out,
                 Side {
                     id: item.a,
                     shape: &a.shape,

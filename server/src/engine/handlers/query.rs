@@ -5,7 +5,7 @@ use gjkd_proto::{ErrorCode, Gradient, GradientRow, Item, ItemKind, ItemResult, i
 
 use crate::engine::checks::check_pose;
 use crate::engine::gradient::{self, Side, Stance};
-use crate::engine::pair_query::run_pair;
+use crate::engine::pair_query::run_pair_into;
 use crate::engine::signed_pair::add_signed_distance;
 use crate::engine::state::State;
 use crate::engine::warm_cache::PairKey;
@@ -51,7 +51,7 @@ impl State {
             } else {
                 None
             };
-            *out = self.item(client, item, row);
+            self.item(client, item, out, row);
             self.stats.items += 1;
             if out.error != 0 {
                 self.stats.item_errors += 1;
@@ -70,9 +70,16 @@ impl State {
         }
     }
 
-    /// One item's answer; `gradient` is its row's gradient when it asks
-    /// for one and there is room.
-    fn item(&mut self, client: u128, item: &Item, gradient: Option<&mut Gradient>) -> ItemResult {
+    /// Writes one item's answer into `out`, and its gradient into
+    /// `gradient` (its row's, when it asks for one and there is room).
+    /// Written in place: a result moved by value costs a `memcpy` a pair.
+    fn item(
+        &mut self,
+        client: u128,
+        item: &Item,
+        out: &mut ItemResult,
+        gradient: Option<&mut Gradient>,
+    ) {
         // Unknown flag bits and a non-zero reserved word are refused rather
         // than ignored, so that a later protocol version can give them a
         // meaning without old servers silently answering something else.
@@ -81,28 +88,27 @@ impl State {
         // so a joint item's body is never read as a pair's.
         let known = item_flags::ALL & !item_flags::END_STEP;
         if item.flags & !known != 0 {
-            return ItemResult::error(ErrorCode::Malformed);
+            *out = ItemResult::error(ErrorCode::Malformed);
+            return;
         }
-        match ItemKind::from_raw(item.kind) {
+        let outcome = match ItemKind::from_raw(item.kind) {
             Some(ItemKind::SetPose | ItemKind::Distance) if item.pair().reserved != 0 => {
-                ItemResult::error(ErrorCode::Malformed)
+                Err(ErrorCode::Malformed)
             }
-            Some(ItemKind::SetPose) => match self.set_pose(item) {
-                Ok(()) => ItemResult::default(),
-                Err(e) => ItemResult::error(e),
-            },
-            Some(ItemKind::Distance) => self
-                .distance(client, item, gradient)
-                .unwrap_or_else(ItemResult::error),
-            Some(ItemKind::SetJoints) => match self.robots.set_joints(&mut self.store, item) {
-                Ok(()) => ItemResult::default(),
-                Err(e) => ItemResult::error(e),
-            },
+            Some(ItemKind::SetPose) => self.set_pose(item).map(|()| *out = ItemResult::default()),
+            Some(ItemKind::Distance) => self.distance(client, item, out, gradient),
+            Some(ItemKind::SetJoints) => self
+                .robots
+                .set_joints(&mut self.store, item)
+                .map(|()| *out = ItemResult::default()),
             // Group members, allowed pairs and path steps mean something
             // only in a scene request.
             Some(ItemKind::Member | ItemKind::Allow | ItemKind::Step) | None => {
-                ItemResult::error(ErrorCode::Malformed)
+                Err(ErrorCode::Malformed)
             }
+        };
+        if let Err(code) = outcome {
+            *out = ItemResult::error(code);
         }
     }
 
@@ -113,12 +119,15 @@ impl State {
         self.store.set_pose(item.a, check_pose(&item.pose_a)?)
     }
 
+    /// Answers a pair item into `out` (left partly written on an error,
+    /// which the caller overwrites).
     fn distance(
         &mut self,
         client: u128,
         item: &Item,
+        out: &mut ItemResult,
         gradient: Option<&mut Gradient>,
-    ) -> Result<ItemResult, ErrorCode> {
+    ) -> Result<(), ErrorCode> {
         let warm_on = item.flags & item_flags::WARM_START != 0;
         let pair = item.pair();
         let options = gjk::Options {
@@ -170,30 +179,26 @@ impl State {
         {
             return Err(ErrorCode::InvalidOptions);
         }
-        let (mut result, next) = run_pair(
+        let next = run_pair_into(
             &mut self.workspace,
             (&a.shape, &pose_a),
             (&b.shape, &pose_b),
             &options,
             warm.as_ref(),
+            out,
         )?;
         // The signed distance first: a gradient of a pair that may
         // overlap reads its direction from the same depth, computed once.
         let depth = if item.flags & item_flags::SIGNED_DISTANCE != 0 {
-            add_signed_distance(
-                &mut result,
-                (&a.shape, &pose_a),
-                (&b.shape, &pose_b),
-                &options,
-            )?
+            add_signed_distance(out, (&a.shape, &pose_a), (&b.shape, &pose_b), &options)?
         } else {
             None
         };
-        if let Some(out) = gradient {
+        if let Some(gradient) = gradient {
             self.gradient_poses.reset();
             gradient::fill(
-                &mut result,
                 out,
+                gradient,
                 Side {
                     id: item.a,
                     shape: &a.shape,
@@ -217,7 +222,7 @@ impl State {
         if warm_on {
             self.cache.put(key, next);
         }
-        Ok(result)
+        Ok(())
     }
 }
 

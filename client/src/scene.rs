@@ -382,7 +382,7 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     }
 
     /// Every row also carries its distance's gradient
-    /// ([`SceneRow`]'s `result.gradient`, [`Answer::gradient`]) with respect
+    /// ([`SceneRow::gradient`], [`Answer::gradient`]) with respect
     /// to the coordinates that move its `a` (see [`crate::gradient_matrix`]);
     /// `base` adds a robot base's twist. Rows the server would answer
     /// from a motion bound or an early exit are asked to convergence.

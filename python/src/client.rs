@@ -57,20 +57,31 @@ struct Connection {
     max_batch: usize,
 }
 
+impl Connection {
+    /// Runs `call` on the client, then learns the server's batch limit as
+    /// last heard (a reconnect may have changed it).
+    fn run<R>(
+        &mut self,
+        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,
+    ) -> Result<R, ClientError> {
+        let Some(client) = self.inner.as_mut() else {
+            return Err(ClientError::Protocol("the client is closed".into()));
+        };
+        let outcome = call(client);
+        if let Some(info) = client.server_info() {
+            self.max_batch = info.max_batch as usize;
+        }
+        outcome
+    }
+}
+
 impl Answerer for Connection {
     fn max_batch(&self) -> usize {
         self.max_batch
     }
 
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
-        let Some(client) = self.inner.as_mut() else {
-            return Err(ClientError::Protocol("the client is closed".into()));
-        };
-        let outcome = client.query_batch(items, results);
-        if let Some(info) = client.server_info() {
-            self.max_batch = info.max_batch as usize;
-        }
-        outcome
+        self.run(|client| client.query_batch(items, results))
     }
 
     fn answer_gradients(
@@ -79,14 +90,8 @@ impl Answerer for Connection {
         results: &mut [ItemResult],
         gradients: &mut [Gradient],
     ) -> Result<(), ClientError> {
-        let Some(client) = self.inner.as_mut() else {
-            return Err(ClientError::Protocol("the client is closed".into()));
-        };
-        let outcome = client.query_batch_gradients(items, results, gradients);
-        if let Some(info) = client.server_info() {
-            self.max_batch = info.max_batch as usize;
-        }
-        outcome.map(|_| ())
+        self.run(|client| client.query_batch_gradients(items, results, gradients))
+            .map(|_| ())
     }
 
     fn refresh_limit(&mut self) -> bool {

@@ -657,13 +657,12 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
                 },
                 || false,
             );
-            if !answered {
-                if let Some((results, rows)) =
+            if !answered
+                && let Some((results, rows)) =
                     ReplyEntry::split_mut(reply.payload_mut(), items.len())
-                {
-                    results.fill(ItemResult::error(ErrorCode::Internal));
-                    rows.fill(gjkd_proto::GradientRow::default());
-                }
+            {
+                results.fill(ItemResult::error(ErrorCode::Internal));
+                rows.fill(gjkd_proto::GradientRow::default());
             }
             delivered("query", reply.send());
         },

@@ -554,7 +554,6 @@ fn gradients_that_cannot_be_given_are_refused() {
     assert_eq!(rows[0].gradient, Gradient::NONE);
     // Without room for its gradient, a pair that asks is refused too,
     // where the same pair without the pose is answered with room.
-    let mut item = item;
     item.flags &= !item_flags::POSE_A;
     s.state.handle(1, &[item], &mut out);
     assert_eq!(out[0].error, gjkd_proto::ErrorCode::InvalidOptions as u32);

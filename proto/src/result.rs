@@ -234,7 +234,7 @@ pub struct SignedDistance {
 }
 
 /// Response header of the query service: whole-request errors, and how
-/// the reply's slice of [`ReplyEntry`]s divides. When `error` is not
+/// the reply's slice of [`ReplyEntry`](crate::ReplyEntry)s divides. When `error` is not
 /// [`ErrorCode::Ok`] the slice is empty.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]

@@ -167,6 +167,26 @@ pub enum BenchError {
     Other(String),
 }
 
+/// `From` each client operation's error (`RegisterError`, `QueryError`,
+/// ...) for an error that takes a [`gjkd_client::ClientError`], read as
+/// that umbrella, so that `?` on any client call converts.
+macro_rules! from_client_operations {
+    ($target:ty) => {
+        $crate::from_client_operations!($target: RegisterError, RemoveError, LookupError,
+            PoseError, QueryError, PoseReadError, StatsError, SceneError, RobotError);
+    };
+    ($target:ty: $($op:ident),*) => {
+        $(impl From<gjkd_client::$op> for $target {
+            fn from(e: gjkd_client::$op) -> Self {
+                Self::from(gjkd_client::ClientError::from(e))
+            }
+        })*
+    };
+}
+pub(crate) use from_client_operations;
+
+from_client_operations!(BenchError);
+
 #[cfg(feature = "measure")]
 impl BenchError {
     /// An item's or a scene request's error code.

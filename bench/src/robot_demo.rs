@@ -6,7 +6,8 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use gjkd_client::{
-    Client, ClientError, Geometry, Item, ItemResult, ObjectId, QueryOptions, RobotHandle,
+    Client, ClientError, Geometry, Item, ItemResult, ObjectId, QueryOptions, RegisterError,
+    RobotError, RobotHandle,
 };
 use nalgebra::{Isometry3, Vector3};
 
@@ -60,10 +61,10 @@ pub fn joint_path(t: f64) -> [f64; 7] {
 /// as `name`; the folder is removed again.
 ///
 /// # Errors
-/// The client's, or [`ClientError::InvalidRobot`] for the temporary file.
-pub fn register_arm(client: &mut Client, name: &str) -> Result<RobotHandle, ClientError> {
+/// The client's, or [`RobotError::InvalidRobot`] for the temporary file.
+pub fn register_arm(client: &mut Client, name: &str) -> Result<RobotHandle, RobotError> {
     let dir: PathBuf = std::env::temp_dir().join(format!("gjkd-arm-{}-{name}", std::process::id()));
-    let io = |e: std::io::Error| ClientError::InvalidRobot(format!("{}: {e}", dir.display()));
+    let io = |e: std::io::Error| RobotError::InvalidRobot(format!("{}: {e}", dir.display()));
     std::fs::create_dir_all(&dir).map_err(io)?;
     let urdf = dir.join("gjkd_arm.urdf");
     std::fs::write(&urdf, ARM_URDF).map_err(io)?;
@@ -87,7 +88,7 @@ pub fn register_obstacles(
     client: &mut Client,
     prefix: &str,
     count: usize,
-) -> Result<Vec<ObjectId>, ClientError> {
+) -> Result<Vec<ObjectId>, RegisterError> {
     (0..count)
         .map(|i| {
             let angle = i as f64 * std::f64::consts::TAU / count as f64;

@@ -36,6 +36,8 @@ pub enum DemoError {
     Check(String),
 }
 
+crate::from_client_operations!(DemoError);
+
 /// The scene as registered with the server.
 pub(crate) struct Registered {
     pub(crate) moving: ObjectId,

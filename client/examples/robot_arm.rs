@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use gjkd_client::{Client, ClientError, DEFAULT_SERVICE, MeshMode, PackagePath, QueryOptions};
+use gjkd_client::{Client, DEFAULT_SERVICE, MeshMode, PackagePath, QueryOptions, RobotError};
 use nalgebra::Isometry3;
 
 /// A two-joint arm: a post turning about z, an arm on an elbow about y,
@@ -102,7 +102,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Out of its limits: refused, and nothing moves.
     match client.set_joints(&mut robot, &[0.0, 0.9], None) {
-        Err(ClientError::Rejected(code)) => println!("reach 0.9 refused: {code}"),
+        Err(e @ RobotError::OutOfLimits) => println!("reach 0.9 refused: {e}"),
         other => panic!("expected a refusal, got {other:?}"),
     }
     std::fs::remove_dir_all(&dir)?;

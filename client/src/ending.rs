@@ -6,7 +6,7 @@
 
 use gjkd_proto::ObjectId;
 
-use crate::{Client, ClientError};
+use crate::{Client, ConnectError, RemoveError, RobotError};
 
 /// What this client registered to end with it.
 #[derive(Debug, Default)]
@@ -63,16 +63,16 @@ impl Drop for Client {
         let robots = std::mem::take(&mut self.ending.robots);
         let objects = std::mem::take(&mut self.ending.objects);
         let gone =
-            |e: &ClientError| matches!(e, ClientError::ServerGone(_) | ClientError::Timeout(_));
+            |e: &ConnectError| matches!(e, ConnectError::ServerGone(_) | ConnectError::Timeout(_));
         for name in robots {
-            if let Err(e) = self.remove_robot(&name)
+            if let Err(RobotError::Connection(e)) = self.remove_robot(&name)
                 && gone(&e)
             {
                 return;
             }
         }
         for id in objects {
-            if let Err(e) = self.remove(id)
+            if let Err(RemoveError::Connection(e)) = self.remove(id)
                 && gone(&e)
             {
                 return;

@@ -1,5 +1,7 @@
-//! What can go wrong with a call, and how replies and iceoryx2 failures
-//! become [`ClientError`]s.
+//! The umbrella of every call's faults, [`ClientError`], the connection
+//! faults every call shares, [`ConnectError`], and how replies and
+//! iceoryx2 failures become them (each operation's own error is in
+//! `op_error.rs`).
 
 use std::time::Duration;
 
@@ -7,7 +9,12 @@ use std::time::Duration;
 use crate::{Client, PROTOCOL_VERSION};
 use gjkd_proto::ErrorCode;
 
-/// What can go wrong with a call.
+/// What can go wrong with any call: the umbrella of the errors per
+/// operation ([`RegisterError`](crate::RegisterError),
+/// [`QueryError`](crate::QueryError), ...), each of which converts into it,
+/// so that `?` into one type works on every call. A refusal by the server
+/// is [`ClientError::Rejected`] with its code; Python and C report every
+/// fault as its `ClientError` (`docs/errors.md`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ClientError {
     /// No server answers on this service: it was never started, it stopped,
@@ -112,18 +119,22 @@ impl ClientError {
     }
 }
 
-/// Why [`ClientBuilder::connect`](crate::ClientBuilder::connect) (and
-/// [`Client::connect`]) found no server it can use: the first of the
-/// errors per operation (the other calls still return [`ClientError`],
-/// into which this converts, so `?` into one type keeps working).
+/// Why a call found no server it can use: the error of
+/// [`ClientBuilder::connect`](crate::ClientBuilder::connect) (and
+/// [`Client::connect`]), and the `Connection` variant of every other
+/// operation's error ([`RegisterError`](crate::RegisterError),
+/// [`QueryError`](crate::QueryError), ...), since every call reconnects to
+/// a server that went away and so can meet every fault of a connect. Each
+/// converts into [`ClientError`], the same fault there.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConnectError {
-    /// No gjkd server served the name within the connect timeout: none was
-    /// started, it stopped, or it died.
+    /// No gjkd server serves the name (within the connect timeout, for a
+    /// connect): none was started, it stopped, or it died. The next call
+    /// tries to reconnect.
     #[error("no gjkd server is serving `{0}`")]
     ServerGone(String),
-    /// A server serves the name but did not answer this client's greeting
-    /// within the timeout.
+    /// A server serves the name but did not answer (the greeting, or the
+    /// call) within the timeout.
     #[error("the server did not answer within {0:?}")]
     Timeout(Duration),
     /// A server serves this name with another protocol version than this
@@ -155,9 +166,9 @@ pub enum ConnectError {
     /// The server already has as many client processes as it admits.
     #[error("the service `{0}` admits no more clients")]
     TooManyClients(String),
-    /// The server answered the greeting with something this client does
-    /// not understand (a broken server).
-    #[error("the server's greeting is not understood: {0}")]
+    /// The server answered something this client does not understand (a
+    /// broken server, or a refusal the operation never gets).
+    #[error("the server's answer is not understood: {0}")]
     Protocol(String),
     /// iceoryx2 could not set up this process (shared memory, limits).
     #[error("iceoryx2: {0}")]

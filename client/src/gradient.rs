@@ -20,7 +20,7 @@
 
 use gjkd_proto::{ErrorCode, Gradient, Item, ItemResult, ObjectId, QueryOptions, SceneRow};
 
-use crate::{Answer, Client, ClientError};
+use crate::{Answer, Client, ClientError, QueryError, op_error};
 
 impl Client {
     /// Distance between `a` and `b` at their stored poses, with its
@@ -28,7 +28,7 @@ impl Client {
     /// move `a`; `base` adds a robot base's twist.
     ///
     /// # Errors
-    /// As [`Client::distance`], and [`ErrorCode::InvalidOptions`] for a
+    /// As [`Client::distance`], and [`QueryError::InvalidOptions`] for a
     /// robot with more than [`GRADIENT_COLUMNS`](gjkd_proto::GRADIENT_COLUMNS)
     /// coordinates.
     pub fn distance_gradient(
@@ -37,17 +37,20 @@ impl Client {
         b: ObjectId,
         options: &QueryOptions,
         base: bool,
-    ) -> Result<Answer, ClientError> {
+    ) -> Result<Answer, QueryError> {
         let mut out = [ItemResult::error(ErrorCode::Internal)];
         let mut gradient = [Gradient::NONE];
-        self.query_batch_gradients(
+        self.batch_gradients(
             &[Item::distance(a, b, options).with_gradient(base)],
             &mut out,
             &mut gradient,
-        )?;
-        out[0]
-            .answer_with(Some(&gradient[0]))
-            .map_err(ClientError::Rejected)
+        )
+        .and_then(|()| {
+            out[0]
+                .answer_with(Some(&gradient[0]))
+                .map_err(ClientError::Rejected)
+        })
+        .map_err(op_error)
     }
 }
 

@@ -101,9 +101,40 @@
 //!
 //! ## Errors, timeouts and a server that goes away
 //!
+//! Each call returns the error of its operation, as iceoryx2 does:
+//! [`RegisterError`], [`RemoveError`], [`LookupError`], [`PoseError`],
+//! [`QueryError`], [`PoseReadError`], [`StatsError`], [`SceneError`],
+//! [`RobotError`] (and [`ConnectError`] for connecting). Each holds the
+//! server's refusals that call can meet as variants of their own, the
+//! faults found before sending, and the connection faults as its
+//! `Connection(`[`ConnectError`]`)` variant; each converts into
+//! [`ClientError`], so `?` into one type works on every call, and each
+//! variant's `code()` is the [`ErrorCode`] Python and C report for the same
+//! fault (`docs/errors.md` has the table per operation).
+//!
+//! ```no_run
+//! use gjkd_client::{Client, Geometry, QueryError, QueryOptions, RegisterError};
+//! use nalgebra::Isometry3;
+//!
+//! # fn main() -> Result<(), gjkd_client::ClientError> {
+//! let mut client = Client::connect("gjkd")?;
+//! let ball = Geometry::Sphere { radius: 0.5 };
+//! let id = match client.register_named("ball", &ball, &Isometry3::identity()) {
+//!     Err(RegisterError::NameTaken) => client.lookup("ball")?,
+//!     other => other?,
+//! };
+//! match client.distance(id, id, &QueryOptions::default()) {
+//!     Err(QueryError::UnknownObject) => println!("removed meanwhile"),
+//!     other => println!("{:?}", other?.distance),
+//! }
+//! # Ok(())
+//! # }
+//! ```
+//!
 //! Every call returns within the client's timeout (default one second, see
 //! [`ClientBuilder::timeout`]). If the server has died or stopped, the call
-//! fails with [`ClientError::ServerGone`]; later calls reconnect by themselves
+//! fails with [`ConnectError::ServerGone`] (in its `Connection` variant;
+//! [`ClientError::ServerGone`] in the umbrella); later calls reconnect by themselves
 //! once a server serves the name again. A server started with persistence
 //! (the default of `gjkd serve`) reloads every object whose registration it
 //! acknowledged, with the same id, geometry, name, owner and latest stored
@@ -141,10 +172,12 @@ mod ending;
 mod error;
 mod gradient;
 mod objects;
+mod op_error;
 mod open_failure;
 mod pairs;
 mod path_split;
 mod poses;
+mod refusals;
 mod reuse;
 #[cfg(feature = "robots")]
 mod robots;
@@ -154,6 +187,10 @@ pub use builder::{ClientBuilder, DEFAULT_TIMEOUT};
 pub use connection::Client;
 pub use error::{ClientError, ConnectError};
 pub use gradient::{gradient_matrix, row_gradient};
+pub use op_error::{
+    LookupError, PoseError, PoseReadError, QueryError, RegisterError, RemoveError, RobotError,
+    SceneError, StatsError,
+};
 #[cfg(feature = "robots")]
 pub use robots::{
     JointError, Kinematics, LimitMode, Mesh, MeshError, MeshMode, PackagePath, RegisteredMesh,
@@ -187,3 +224,4 @@ pub use gjkd_proto::GradientRow;
 // The crate's own plumbing, shared by the files that make up `Client`.
 pub(crate) use connection::Waited;
 pub(crate) use error::{ipc_err, reply_accepted};
+pub(crate) use refusals::op_error;

@@ -7,31 +7,36 @@ use gjkd_proto::{AdminChunk, AdminOp, AdminReply, AdminRequest, Vertex};
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::connection::RETRY_PAUSE;
-use crate::{Client, ClientError, Geometry, ObjectId, Piece, Pose, ServerStats};
+use crate::{
+    Client, ClientError, Geometry, LookupError, ObjectId, Piece, Pose, RegisterError, RemoveError,
+    ServerStats, StatsError, op_error,
+};
 #[cfg(doc)]
-use crate::{ErrorCode, MAX_NAME_LEN, MAX_PIECES};
+use crate::{ConnectError, ErrorCode, MAX_NAME_LEN, MAX_PIECES};
 
 impl Client {
     /// Registers an object at the identity pose, without a name.
     ///
     /// # Errors
-    /// - [`ClientError::InvalidArgument`], before anything is sent: a
+    /// - [`RegisterError::InvalidShape`], before anything is sent: a
     ///   negative half extent, a compound inside a compound, more than
     ///   [`MAX_PIECES`] pieces, more than `u32::MAX` vertices.
-    /// - [`ClientError::Rejected`], and nothing is stored:
-    ///   [`ErrorCode::EmptyVertices`], [`ErrorCode::InvalidRadius`] (negative,
-    ///   NaN, infinite, or above 2^999, about 5e300),
-    ///   [`ErrorCode::NonFiniteVertex`] (NaN, infinite, or the shape, its
-    ///   vertices plus its radius, reaching beyond 2^999 from its body
-    ///   origin),
-    ///   [`ErrorCode::TooManyVertices`] (over the server's `--max-vertices`),
-    ///   [`ErrorCode::EmptyCompound`], [`ErrorCode::TooManyPieces`],
-    ///   [`ErrorCode::NonFinitePose`] or [`ErrorCode::BadQuaternion`] (a
-    ///   piece offset), [`ErrorCode::TooManyObjects`] (the server's
-    ///   `--max-objects`), [`ErrorCode::StorageFull`] (the server's disk
-    ///   has no room to store the object; the same call succeeds once there
-    ///   is room), [`ErrorCode::Internal`] (the store failed otherwise).
-    /// - [`ClientError::ServerGone`] or [`ClientError::Timeout`], after
+    /// - A refusal by the server, and nothing is stored:
+    ///   [`RegisterError::EmptyVertices`], [`RegisterError::InvalidRadius`]
+    ///   (negative, NaN, infinite, or above 2^999, about 5e300),
+    ///   [`RegisterError::NonFiniteVertex`] (NaN, infinite, or the shape,
+    ///   its vertices plus its radius, reaching beyond 2^999 from its body
+    ///   origin), [`RegisterError::TooManyVertices`] (over the server's
+    ///   `--max-vertices`), [`RegisterError::EmptyCompound`],
+    ///   [`RegisterError::TooManyPieces`], [`RegisterError::NonFinitePose`]
+    ///   or [`RegisterError::BadQuaternion`] (a piece offset),
+    ///   [`RegisterError::TooManyObjects`] (the server's `--max-objects`),
+    ///   [`RegisterError::StorageFull`] (the server's disk has no room to
+    ///   store the object; the same call succeeds once there is room),
+    ///   [`RegisterError::Internal`] (the store failed otherwise). Each
+    ///   has its [`ErrorCode`] ([`RegisterError::code`]).
+    /// - [`RegisterError::Connection`] with [`ConnectError::ServerGone`] or
+    ///   [`ConnectError::Timeout`](crate::ConnectError::Timeout), after
     ///   the retries below. **The registration may then have happened**:
     ///   the request may have reached the server and been stored before
     ///   the server died or the answer came too late, and no retry reached
@@ -47,13 +52,13 @@ impl Client {
     /// answers the retry with that object's id (it keeps the tokens of each
     /// client's last 64 registrations with the objects, across restarts),
     /// so a retry never stores a second object. So a server restarted
-    /// within the timeout costs no orphan. A [`ClientError::Timeout`] from
+    /// within the timeout costs no orphan. A timeout from
     /// a server that is alive is not retried (the deadline has passed). No
     /// other call retries by itself: a pose update or query that failed is
     /// simply sent again by the caller, and [`Client::remove`] retried
     /// after a lost reply answers [`ErrorCode::UnknownObject`] if the first
     /// attempt removed the object.
-    pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, ClientError> {
+    pub fn register(&mut self, geometry: &Geometry<'_>) -> Result<ObjectId, RegisterError> {
         self.register_with(geometry, None, &Isometry3::identity())
     }
 
@@ -61,15 +66,15 @@ impl Client {
     /// [`lookup`](Client::lookup) it) and an initial pose.
     ///
     /// # Errors
-    /// As [`Client::register`], plus [`ErrorCode::NameTaken`] and
-    /// [`ClientError::InvalidArgument`] for a name over [`MAX_NAME_LEN`]
+    /// As [`Client::register`], plus [`RegisterError::NameTaken`] and
+    /// [`RegisterError::NameTooLong`] for a name over [`MAX_NAME_LEN`]
     /// bytes.
     pub fn register_named(
         &mut self,
         name: &str,
         geometry: &Geometry<'_>,
         pose: &Isometry3<f64>,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         self.register_with(geometry, Some(name), pose)
     }
 
@@ -78,21 +83,22 @@ impl Client {
         geometry: &Geometry<'_>,
         name: Option<&str>,
         pose: &Isometry3<f64>,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         let mut request = AdminRequest::new(AdminOp::Register);
         request.pose = Pose::from_isometry(pose);
         if let Some(name) = name
             && !request.set_name(name)
         {
-            return Err(ClientError::InvalidArgument(
-                "name longer than MAX_NAME_LEN",
-            ));
+            return Err(RegisterError::NameTooLong);
         }
         request.token = self.tokens.next();
         let mut vertices = std::mem::take(&mut self.vertex_scratch);
         vertices.clear();
         let built = Self::encode(geometry, &mut request, &mut vertices);
-        let result = built.and_then(|()| self.register_retrying(&request, &vertices));
+        let result = built.and_then(|()| {
+            self.register_retrying(&request, &vertices)
+                .map_err(op_error)
+        });
         self.vertex_scratch = vertices;
         let id = result.map(|r| ObjectId::from_raw(r.id))?;
         self.ending.object(id);
@@ -124,17 +130,17 @@ impl Client {
         geometry: &Geometry<'_>,
         request: &mut AdminRequest,
         vertices: &mut Vec<Vertex>,
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), RegisterError> {
         geometry
             .encode(request, vertices)
-            .map_err(|e| ClientError::InvalidArgument(e.describe()))
+            .map_err(RegisterError::InvalidShape)
     }
 
     /// Registers a ball of `radius` about the body origin.
     ///
     /// # Errors
     /// As [`Client::register`].
-    pub fn register_sphere(&mut self, radius: f64) -> Result<ObjectId, ClientError> {
+    pub fn register_sphere(&mut self, radius: f64) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Sphere { radius })
     }
 
@@ -147,7 +153,7 @@ impl Client {
         a: Point3<f64>,
         b: Point3<f64>,
         radius: f64,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Capsule { a, b, radius })
     }
 
@@ -160,7 +166,7 @@ impl Client {
         &mut self,
         half_extents: Vector3<f64>,
         radius: f64,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Cuboid {
             half_extents,
             radius,
@@ -191,16 +197,15 @@ impl Client {
     /// ```
     ///
     /// # Errors
-    /// As [`Client::register`]: [`ErrorCode::InvalidRadius`] for a
+    /// As [`Client::register`]: [`RegisterError::InvalidRadius`] for a
     /// negative, NaN or infinite radius, half-height or rounding (or a
-    /// cylinder reaching beyond 2^999), and [`ErrorCode::Malformed`] from
-    /// a server older than cylinders.
+    /// cylinder reaching beyond 2^999).
     pub fn register_cylinder(
         &mut self,
         radius: f64,
         half_height: f64,
         rounding: f64,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Cylinder {
             radius,
             half_height,
@@ -216,7 +221,7 @@ impl Client {
         &mut self,
         vertices: &[Point3<f64>],
         radius: f64,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Polytope { vertices, radius })
     }
 
@@ -244,25 +249,25 @@ impl Client {
     /// ```
     ///
     /// # Errors
-    /// As [`Client::register`], plus [`ErrorCode::EmptyCompound`] and
-    /// [`ClientError::InvalidArgument`] for a nested compound or more than
+    /// As [`Client::register`], plus [`RegisterError::EmptyCompound`] and
+    /// [`RegisterError::InvalidShape`] for a nested compound or more than
     /// [`MAX_PIECES`] pieces.
-    pub fn register_compound(&mut self, pieces: &[Piece<'_>]) -> Result<ObjectId, ClientError> {
+    pub fn register_compound(&mut self, pieces: &[Piece<'_>]) -> Result<ObjectId, RegisterError> {
         self.register(&Geometry::Compound(pieces))
     }
 
     /// Removes an object this client registered. Its id is never reused.
     ///
     /// # Errors
-    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NotOwner`] for another
-    /// client's object, [`ErrorCode::ReadOnly`] for a scene object,
-    /// [`ErrorCode::StorageFull`] when the server's disk has no room to
-    /// store the removal (the object stays; the same call succeeds once
-    /// there is room).
-    pub fn remove(&mut self, id: ObjectId) -> Result<(), ClientError> {
+    /// [`RemoveError::UnknownObject`], [`RemoveError::NotOwner`] for
+    /// another client's object, [`RemoveError::ReadOnly`] for a scene
+    /// object, [`RemoveError::StorageFull`] when the server's disk has no
+    /// room to store the removal (the object stays; the same call succeeds
+    /// once there is room); the connection faults.
+    pub fn remove(&mut self, id: ObjectId) -> Result<(), RemoveError> {
         let mut request = AdminRequest::new(AdminOp::Remove);
         request.object = id.raw();
-        self.admin(&request, &[])?;
+        self.admin(&request, &[]).map_err(op_error::<RemoveError>)?;
         self.ending.removed(id);
         Ok(())
     }
@@ -271,25 +276,26 @@ impl Client {
     /// registered with [`Client::register_named`]).
     ///
     /// # Errors
-    /// [`ErrorCode::UnknownName`], [`ClientError::InvalidArgument`] for a name
-    /// over [`MAX_NAME_LEN`] bytes.
-    pub fn lookup(&mut self, name: &str) -> Result<ObjectId, ClientError> {
+    /// [`LookupError::UnknownName`], [`LookupError::NameTooLong`] for a
+    /// name over [`MAX_NAME_LEN`] bytes; the connection faults.
+    pub fn lookup(&mut self, name: &str) -> Result<ObjectId, LookupError> {
         let mut request = AdminRequest::new(AdminOp::Lookup);
         if !request.set_name(name) {
-            return Err(ClientError::InvalidArgument(
-                "name longer than MAX_NAME_LEN",
-            ));
+            return Err(LookupError::NameTooLong);
         }
-        self.admin(&request, &[]).map(|r| ObjectId::from_raw(r.id))
+        self.admin(&request, &[])
+            .map(|r| ObjectId::from_raw(r.id))
+            .map_err(op_error)
     }
 
     /// The server's counters: objects, requests, warm-start cache use.
     ///
     /// # Errors
-    /// The connection errors of every call.
-    pub fn stats(&mut self) -> Result<ServerStats, ClientError> {
+    /// The connection faults of every call ([`StatsError`]).
+    pub fn stats(&mut self) -> Result<ServerStats, StatsError> {
         self.admin(&AdminRequest::new(AdminOp::Stats), &[])
             .map(|r| r.stats)
+            .map_err(op_error)
     }
 }
 
@@ -299,7 +305,7 @@ mod tests {
     use gjkd_proto::{piece_kind, shape_kind};
 
     /// Vertices, radius and piece kind of a convex geometry's wire form.
-    fn push_convex(g: &Geometry<'_>, v: &mut Vec<Vertex>) -> Result<(f64, u32), ClientError> {
+    fn push_convex(g: &Geometry<'_>, v: &mut Vec<Vertex>) -> Result<(f64, u32), RegisterError> {
         let mut req = AdminRequest::new(AdminOp::Register);
         Client::encode(g, &mut req, v)?;
         Ok((req.pieces[0].rounding, req.pieces[0].kind))
@@ -319,7 +325,9 @@ mod tests {
             };
             assert_eq!(
                 push_convex(&g, &mut v),
-                Err(ClientError::InvalidArgument("a half extent is negative")),
+                Err(RegisterError::InvalidShape(
+                    gjkd_proto::ShapeError::HalfExtentIsNegative
+                )),
                 "{h:?}"
             );
             assert!(v.is_empty(), "nothing encoded for {h:?}");
@@ -393,7 +401,9 @@ mod tests {
         }];
         assert!(matches!(
             Client::encode(&Geometry::Compound(&nested), &mut req, &mut v),
-            Err(ClientError::InvalidArgument(_))
+            Err(RegisterError::InvalidShape(
+                gjkd_proto::ShapeError::CompoundIsNested
+            ))
         ));
     }
 

@@ -10,50 +10,55 @@ use nalgebra::Isometry3;
 use crate::ServerInfo;
 use gjkd_proto::{Gradient, GradientRow, ReplyEntry, item_flags};
 
+use crate::op_error::NO_GRADIENT_BUFFER;
 use crate::{
-    Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, QueryOptions, Waited,
-    ipc_err, reply_accepted,
+    Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, PoseError, QueryError,
+    QueryOptions, Waited, ipc_err, op_error, reply_accepted,
 };
 
-/// Why a call without a gradient buffer refuses an item that asks for one.
-const NO_GRADIENT_BUFFER: &str = "an item asks for a gradient (item_flags::GRADIENT) but the call \
-     has no gradient buffer: use query_batch_gradients";
-
-/// Why [`Client::query_batch_gradients`] refuses a short gradient buffer.
-const SHORT_GRADIENT_BUFFER: &str =
-    "the gradient buffer is shorter than the items that ask for a gradient";
+/// The query error of a failure of the shared plumbing: a gradient asked
+/// with no room for it is the caller's, the rest as [`op_error`] says.
+fn query_error(e: ClientError) -> QueryError {
+    match e {
+        ClientError::InvalidArgument(NO_GRADIENT_BUFFER) => QueryError::NoRoomForGradient,
+        e => op_error(e),
+    }
+}
 
 impl Client {
     /// Stores a new pose for `id`, used by every later query (of any client)
     /// that does not give its own.
     ///
     /// # Errors
-    /// [`ErrorCode::UnknownObject`], [`ErrorCode::NonFinitePose`],
-    /// [`ErrorCode::BadQuaternion`], and the connection errors.
-    pub fn set_pose(&mut self, id: ObjectId, pose: &Isometry3<f64>) -> Result<(), ClientError> {
-        self.single(Item::set_pose(id, pose)).map(|_| ())
+    /// [`PoseError::UnknownObject`], [`PoseError::NonFinitePose`],
+    /// [`PoseError::BadQuaternion`], and the connection faults.
+    pub fn set_pose(&mut self, id: ObjectId, pose: &Isometry3<f64>) -> Result<(), PoseError> {
+        self.single(Item::set_pose(id, pose))
+            .map(|_| ())
+            .map_err(op_error)
     }
 
     /// Distance between `a` and `b` at their stored poses.
     ///
     /// # Errors
-    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownObject`] or
-    /// [`ErrorCode::InvalidOptions`], and the connection errors.
+    /// [`QueryError::UnknownObject`], [`QueryError::InvalidOptions`],
+    /// [`QueryError::NonFinitePose`] (the two objects too far apart), and
+    /// the connection faults.
     pub fn distance(
         &mut self,
         a: ObjectId,
         b: ObjectId,
         options: &QueryOptions,
-    ) -> Result<Answer, ClientError> {
-        self.single(Item::distance(a, b, options))
+    ) -> Result<Answer, QueryError> {
+        self.single(Item::distance(a, b, options)).map_err(op_error)
     }
 
     /// Distance between `a` at `pose_a` and `b` at `pose_b`; the stored poses
     /// are neither used nor changed.
     ///
     /// # Errors
-    /// As [`Client::distance`], plus [`ErrorCode::NonFinitePose`] and
-    /// [`ErrorCode::BadQuaternion`].
+    /// As [`Client::distance`], plus [`QueryError::NonFinitePose`] and
+    /// [`QueryError::BadQuaternion`] for a pose given.
     pub fn distance_at(
         &mut self,
         a: ObjectId,
@@ -61,13 +66,15 @@ impl Client {
         b: ObjectId,
         pose_b: &Isometry3<f64>,
         options: &QueryOptions,
-    ) -> Result<Answer, ClientError> {
+    ) -> Result<Answer, QueryError> {
         self.single(Item::distance_at(a, pose_a, b, pose_b, options))
+            .map_err(op_error)
     }
 
-    fn single(&mut self, item: Item) -> Result<Answer, ClientError> {
+    /// The answer to one item, its refusal as the request's.
+    pub(crate) fn single(&mut self, item: Item) -> Result<Answer, ClientError> {
         let mut out = [ItemResult::error(ErrorCode::Internal)];
-        self.query_batch(&[item], &mut out)?;
+        self.batch(&[item], &mut out)?;
         out[0].answer().map_err(ClientError::Rejected)
     }
 
@@ -80,29 +87,23 @@ impl Client {
     /// ask for a gradient go through [`Client::query_batch_gradients`].
     ///
     /// # Errors
-    /// [`ClientError::ResultBufferTooSmall`];
-    /// [`ClientError::InvalidArgument`] when an item asks for a gradient
-    /// (nothing is sent);
-    /// [`ClientError::Rejected`] with [`ErrorCode::EmptyBatch`] or
-    /// [`ErrorCode::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
-    /// items); and the connection errors.
+    /// [`QueryError::ResultBufferTooSmall`];
+    /// [`QueryError::NoRoomForGradient`] when an item asks for a gradient
+    /// (nothing is sent); [`QueryError::EmptyBatch`] or
+    /// [`QueryError::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
+    /// items); and the connection faults.
     pub fn query_batch(
         &mut self,
         items: &[Item],
         results: &mut [ItemResult],
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         if results.len() < items.len() {
-            return Err(ClientError::ResultBufferTooSmall {
+            return Err(QueryError::ResultBufferTooSmall {
                 needed: items.len(),
                 got: results.len(),
             });
         }
-        self.round_trip(
-            items.len(),
-            Source::<fn(usize) -> Item>::Slice(items),
-            Gradients::Refused,
-            |payload, _| results[..payload.len()].copy_from_slice(payload),
-        )
+        self.batch(items, results).map_err(query_error)
     }
 
     /// As [`Client::query_batch`], and the gradient of the `k`-th item that
@@ -113,7 +114,7 @@ impl Client {
     /// gradients were written.
     ///
     /// # Errors
-    /// As [`Client::query_batch`], and [`ClientError::InvalidArgument`]
+    /// As [`Client::query_batch`], and [`QueryError::NoRoomForGradient`]
     /// when `gradients` is shorter than the items that ask for one
     /// (nothing is sent).
     pub fn query_batch_gradients(
@@ -121,17 +122,30 @@ impl Client {
         items: &[Item],
         results: &mut [ItemResult],
         gradients: &mut [Gradient],
-    ) -> Result<usize, ClientError> {
+    ) -> Result<usize, QueryError> {
         if results.len() < items.len() {
-            return Err(ClientError::ResultBufferTooSmall {
+            return Err(QueryError::ResultBufferTooSmall {
                 needed: items.len(),
                 got: results.len(),
             });
         }
         let asked = ReplyEntry::gradients_asked(items);
         if asked > gradients.len() {
-            return Err(ClientError::InvalidArgument(SHORT_GRADIENT_BUFFER));
+            return Err(QueryError::NoRoomForGradient);
         }
+        self.batch_gradients(items, results, gradients)
+            .map_err(query_error)?;
+        Ok(asked)
+    }
+
+    /// [`Client::query_batch_gradients`] for the calls built on it
+    /// (`gradients` has room for every gradient asked).
+    pub(crate) fn batch_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
@@ -142,8 +156,22 @@ impl Client {
                     *out = row.gradient;
                 }
             },
-        )?;
-        Ok(asked)
+        )
+    }
+
+    /// [`Client::query_batch`] for the calls built on it, which say what
+    /// its failures mean for them; `results` holds one per item.
+    pub(crate) fn batch(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+    ) -> Result<(), ClientError> {
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Refused,
+            |payload, _| results[..payload.len()].copy_from_slice(payload),
+        )
     }
 
     /// As [`Client::query_batch`], but the results are handed to `read`
@@ -158,13 +186,14 @@ impl Client {
         &mut self,
         items: &[Item],
         read: impl FnOnce(&[ItemResult]),
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
             Gradients::Refused,
             |results, _| read(results),
         )
+        .map_err(query_error)
     }
 
     /// As [`Client::query_batch_read`], for items that may ask for
@@ -178,13 +207,14 @@ impl Client {
         &mut self,
         items: &[Item],
         read: impl FnOnce(&[ItemResult], &[GradientRow]),
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
             Gradients::Taken,
             read,
         )
+        .map_err(query_error)
     }
 
     /// As [`Client::query_batch`], but item `i` of the `count` items is
@@ -201,10 +231,11 @@ impl Client {
         count: usize,
         item: impl FnMut(usize) -> Item,
         read: impl FnOnce(&[ItemResult]),
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), QueryError> {
         self.round_trip(count, Source::Fn(item), Gradients::Refused, |results, _| {
             read(results)
         })
+        .map_err(query_error)
     }
 
     /// Sends `count` items from `source` as one request and hands the

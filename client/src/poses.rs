@@ -8,7 +8,7 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::request_response;
 use nalgebra::Isometry3;
 
-use crate::{Client, ClientError, Waited, ipc_err};
+use crate::{Client, ClientError, PoseReadError, Waited, ipc_err, op_error};
 
 type PosesPort = IoxClient<ipc::Service, [u64], (), [StoredPose], PosesReply>;
 type PosesService =
@@ -35,21 +35,25 @@ impl Client {
     /// answer, sent nowhere.
     ///
     /// # Errors
-    /// [`ClientError::ServerGone`], [`ClientError::Timeout`] and the other
-    /// transport errors of a round trip.
+    /// [`PoseReadError::Connection`] (a server gone, a timeout and the
+    /// other faults of a round trip); [`PoseReadError::BatchTooLarge`] from
+    /// a server restarted with a smaller limit since this client split the
+    /// ids.
     pub fn poses(
         &mut self,
         ids: &[ObjectId],
-    ) -> Result<Vec<Result<Isometry3<f64>, ErrorCode>>, ClientError> {
+    ) -> Result<Vec<Result<Isometry3<f64>, ErrorCode>>, PoseReadError> {
         let mut out = Vec::with_capacity(ids.len());
         if ids.is_empty() {
             return Ok(out);
         }
         let deadline = Instant::now() + self.timeout;
-        self.ensure_connected(deadline)?;
+        self.ensure_connected(deadline)
+            .map_err(op_error::<PoseReadError>)?;
         let per_request = self.request_limits().map_or(ids.len(), |l| l.items.max(1));
         for chunk in ids.chunks(per_request) {
-            self.poses_once(chunk, &mut out)?;
+            self.poses_once(chunk, &mut out)
+                .map_err(op_error::<PoseReadError>)?;
         }
         Ok(out)
     }

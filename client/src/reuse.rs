@@ -5,12 +5,12 @@
 #[cfg(feature = "robots")]
 use std::path::Path;
 
-use gjkd_proto::{AdminOp, AdminRequest, ErrorCode, Geometry, ObjectId, lookup_kind};
+use gjkd_proto::{AdminOp, AdminRequest, Geometry, ObjectId, lookup_kind};
 use nalgebra::Isometry3;
 
 #[cfg(feature = "robots")]
 use crate::robots::{PackagePath, RobotHandle};
-use crate::{Client, ClientError};
+use crate::{Client, LookupError, RegisterError, RobotError, op_error};
 
 impl Client {
     /// The object named `name`: registered as [`Client::register_named`]
@@ -18,26 +18,31 @@ impl Client {
     /// before by this program's previous run, or by anyone), that object's
     /// id, as it is: its shape is not compared and its pose not changed.
     /// So a node restarted under the same names gets its objects back
-    /// instead of [`ErrorCode::NameTaken`]. (An object found so keeps its
-    /// owner: only the client that registered it may remove it.)
+    /// instead of [`RegisterError::NameTaken`]. (An object found so keeps
+    /// its owner: only the client that registered it may remove it.)
     ///
     /// # Errors
-    /// As [`Client::register_named`], without [`ErrorCode::NameTaken`].
+    /// As [`Client::register_named`], without [`RegisterError::NameTaken`].
     pub fn register_named_or_get(
         &mut self,
         name: &str,
         geometry: &Geometry<'_>,
         pose: &Isometry3<f64>,
-    ) -> Result<ObjectId, ClientError> {
+    ) -> Result<ObjectId, RegisterError> {
         loop {
             match self.register_named(name, geometry, pose) {
-                Err(ClientError::Rejected(ErrorCode::NameTaken)) => {}
+                Err(RegisterError::NameTaken) => {}
                 other => return other,
             }
             match self.lookup(name) {
+                Ok(id) => return Ok(id),
                 // Removed between the two calls: register again.
-                Err(ClientError::Rejected(ErrorCode::UnknownName)) => {}
-                other => return other,
+                Err(LookupError::UnknownName) => {}
+                // The name fitted the registration, so only the server
+                // can fail here.
+                Err(LookupError::NameTooLong) => return Err(RegisterError::NameTooLong),
+                Err(LookupError::Internal) => return Err(RegisterError::Internal),
+                Err(LookupError::Connection(e)) => return Err(e.into()),
             }
         }
     }
@@ -48,12 +53,12 @@ impl Client {
     /// with the robot attached to them again ([`Client::attach_robot`]);
     /// else registered from `urdf` as [`Client::register_robot_text`]
     /// does. So a node restarted under the same name gets its robot back
-    /// instead of [`ErrorCode::NameTaken`]. A robot found is not moved;
-    /// one attached or registered is put at `base`.
+    /// instead of a link's [`RegisterError::NameTaken`]. A robot found is
+    /// not moved; one attached or registered is put at `base`.
     ///
     /// # Errors
-    /// As [`Client::register_robot_text`], without
-    /// [`ErrorCode::NameTaken`].
+    /// As [`Client::register_robot_text`], without a link's
+    /// [`RegisterError::NameTaken`] ([`RobotError::Link`]).
     #[cfg(feature = "robots")]
     pub fn register_robot_text_or_get(
         &mut self,
@@ -63,13 +68,13 @@ impl Client {
         mesh_base: Option<&Path>,
         packages: &PackagePath,
         base: &Isometry3<f64>,
-    ) -> Result<RobotHandle, ClientError> {
+    ) -> Result<RobotHandle, RobotError> {
         match self.open_robot(name, urdf) {
-            Err(ClientError::Rejected(ErrorCode::UnknownName)) => {}
+            Err(RobotError::UnknownRobot) => {}
             other => return other,
         }
         match self.register_robot_text(name, urdf, srdf, mesh_base, packages, base) {
-            Err(ClientError::Rejected(ErrorCode::NameTaken)) => {
+            Err(RobotError::Link(RegisterError::NameTaken)) => {
                 self.attach_robot(name, urdf, srdf, base)
             }
             other => other,
@@ -81,16 +86,20 @@ impl Client {
     /// one link with [`Client::remove`] would leave a robot with a hole.
     ///
     /// # Errors
-    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`] (no robot
-    /// of that name: never registered, removed, or a server restarted
-    /// since, which keeps the link objects but not the robot: attach it
-    /// again first), [`ErrorCode::NotOwner`] (another client's robot or
-    /// link), [`ErrorCode::ReadOnly`] (a robot of the server's scene file),
-    /// [`ErrorCode::StorageFull`]; [`ClientError::InvalidArgument`] for a
-    /// name over [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the
-    /// connection errors.
-    pub fn remove_robot(&mut self, name: &str) -> Result<(), ClientError> {
-        self.robot_request(AdminOp::RemoveRobot, name)?;
+    /// [`RobotError::UnknownRobot`] (no robot of that name: never
+    /// registered, removed, or a server restarted since, which keeps the
+    /// link objects but not the robot: attach it again first),
+    /// [`RobotError::NotOwner`] (another client's robot or link),
+    /// [`RobotError::ReadOnly`] (a robot of the server's scene file),
+    /// [`RobotError::StorageFull`]; [`RobotError::NameTooLong`] for a name
+    /// over [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the connection
+    /// faults.
+    pub fn remove_robot(&mut self, name: &str) -> Result<(), RobotError> {
+        let mut request = AdminRequest::new(AdminOp::RemoveRobot);
+        if !request.set_name(name) {
+            return Err(RobotError::NameTooLong);
+        }
+        self.admin(&request, &[]).map_err(op_error::<RobotError>)?;
         self.ending.removed_robot(name);
         Ok(())
     }
@@ -103,25 +112,18 @@ impl Client {
     /// feature) gives a handle that also knows the joints and links.
     ///
     /// # Errors
-    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`] (no robot
-    /// of that name); [`ClientError::InvalidArgument`] for a name over
-    /// [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the connection errors.
-    pub fn robot_id(&mut self, name: &str) -> Result<ObjectId, ClientError> {
-        self.robot_request(AdminOp::Lookup, name)
-    }
-
-    /// Sends a robot's admin request by name: a lookup asks for a robot,
-    /// not an object.
-    fn robot_request(&mut self, op: AdminOp, name: &str) -> Result<ObjectId, ClientError> {
-        let mut request = AdminRequest::new(op);
+    /// [`LookupError::UnknownName`] (no robot of that name);
+    /// [`LookupError::NameTooLong`] for a name over
+    /// [`MAX_NAME_LEN`](crate::MAX_NAME_LEN) bytes; the connection faults.
+    pub fn robot_id(&mut self, name: &str) -> Result<ObjectId, LookupError> {
+        let mut request = AdminRequest::new(AdminOp::Lookup);
         if !request.set_name(name) {
-            return Err(ClientError::InvalidArgument(
-                "name longer than MAX_NAME_LEN",
-            ));
+            return Err(LookupError::NameTooLong);
         }
-        if op == AdminOp::Lookup {
-            request.lookup = lookup_kind::ROBOT;
-        }
-        self.admin(&request, &[]).map(|r| ObjectId::from_raw(r.id))
+        // A look-up of a robot, not of an object.
+        request.lookup = lookup_kind::ROBOT;
+        self.admin(&request, &[])
+            .map(|r| ObjectId::from_raw(r.id))
+            .map_err(op_error)
     }
 }

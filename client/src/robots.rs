@@ -28,12 +28,15 @@ use std::path::Path;
 use gjk::Shape;
 pub use gjkd_model::{JointError, Kinematics, LimitMode, Mesh, MeshError, PackagePath, RobotModel};
 use gjkd_proto::{
-    AdminChunk, AdminOp, AdminRequest, ErrorCode, Item, ItemResult, JOINTS_PER_ITEM, ObjectId,
-    Pose, lookup_kind,
+    AdminChunk, AdminOp, AdminRequest, Item, ItemResult, JOINTS_PER_ITEM, ObjectId, Pose,
 };
 use nalgebra::Isometry3;
 
-use crate::{Client, ClientError, Geometry, Piece};
+#[cfg(doc)]
+use crate::ErrorCode;
+use crate::{
+    Client, ClientError, Geometry, LookupError, Piece, RegisterError, RobotError, op_error,
+};
 
 /// How a mesh becomes a shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,21 +130,21 @@ impl RobotHandle {
 }
 
 /// A robot that cannot be read, with the model's words.
-fn robot_err(e: impl std::fmt::Display) -> ClientError {
-    ClientError::InvalidRobot(e.to_string())
+fn robot_err(e: impl std::fmt::Display) -> RobotError {
+    RobotError::InvalidRobot(e.to_string())
 }
 
 /// A mesh that cannot be used, with the model's words.
-fn mesh_err(e: impl std::fmt::Display) -> ClientError {
-    ClientError::InvalidMesh(e.to_string())
+fn mesh_err(e: impl std::fmt::Display) -> RegisterError {
+    RegisterError::InvalidMesh(e.to_string())
 }
 
 /// Positions by name refused before sending: an unknown joint carries the
 /// code of an unknown name, as in Python and C.
-fn named_joint_err(e: JointError) -> ClientError {
+fn named_joint_err(e: JointError) -> RobotError {
     match e {
-        JointError::UnknownJoint(name) => ClientError::UnknownJoint(name),
-        _ => ClientError::InvalidArgument("one position per moving joint of the robot"),
+        JointError::UnknownJoint(name) => RobotError::UnknownJoint(name),
+        _ => RobotError::WrongJointCount,
     }
 }
 
@@ -150,7 +153,7 @@ impl Client {
     /// axis, as its hull or decomposed, named and at `pose`.
     ///
     /// # Errors
-    /// [`ClientError::InvalidMesh`] for a file that is missing or not a
+    /// [`RegisterError::InvalidMesh`] for a file that is missing or not a
     /// mesh, or a bad scale; as [`Client::register_named`] otherwise.
     pub fn register_mesh_file(
         &mut self,
@@ -159,7 +162,7 @@ impl Client {
         scale: [f64; 3],
         mode: MeshMode,
         pose: &Isometry3<f64>,
-    ) -> Result<RegisteredMesh, ClientError> {
+    ) -> Result<RegisteredMesh, RegisterError> {
         let mesh = Mesh::load(path, scale).map_err(mesh_err)?;
         self.register_mesh(name, &mesh, mode, pose)
     }
@@ -168,15 +171,15 @@ impl Client {
     /// or decomposed, named and at `pose`.
     ///
     /// # Errors
-    /// [`ClientError::InvalidMesh`] when the decomposition finds no pieces; as
-    /// [`Client::register_named`] otherwise.
+    /// [`RegisterError::InvalidMesh`] when the decomposition finds no
+    /// pieces; as [`Client::register_named`] otherwise.
     pub fn register_mesh(
         &mut self,
         name: &str,
         mesh: &Mesh,
         mode: MeshMode,
         pose: &Isometry3<f64>,
-    ) -> Result<RegisteredMesh, ClientError> {
+    ) -> Result<RegisteredMesh, RegisterError> {
         match mode {
             MeshMode::Hull => {
                 let hull = mesh.hull();
@@ -222,14 +225,14 @@ impl Client {
     /// relative to the URDF's folder.
     ///
     /// # Errors
-    /// [`ClientError::InvalidRobot`] (code [`ErrorCode::InvalidRobot`]) for
+    /// [`RobotError::InvalidRobot`] (code [`ErrorCode::InvalidRobot`]) for
     /// a URDF, SRDF or mesh that cannot be loaded (the message names the
-    /// file, link or joint);
-    /// [`ClientError::Rejected`] with [`ErrorCode::NameTaken`] (a link
-    /// object of that name exists: after a server restart, use
-    /// [`Client::attach_robot`]), [`ErrorCode::InvalidRobot`], and the codes
-    /// of [`Client::register`]. Link objects registered before a failure
-    /// are removed again.
+    /// file, link or joint); [`RobotError::Link`] with the
+    /// [`RegisterError`] of a link object ([`RegisterError::NameTaken`]: a
+    /// link object of that name exists; after a server restart, use
+    /// [`Client::attach_robot`]); [`RobotError::RobotRefused`] and the
+    /// faults of [`Client::attach_robot`]. Link objects registered before a
+    /// failure are removed again.
     pub fn register_robot(
         &mut self,
         name: &str,
@@ -237,13 +240,13 @@ impl Client {
         srdf: Option<&Path>,
         packages: &PackagePath,
         base: &Isometry3<f64>,
-    ) -> Result<RobotHandle, ClientError> {
+    ) -> Result<RobotHandle, RobotError> {
         let text = std::fs::read_to_string(urdf)
-            .map_err(|e| ClientError::InvalidRobot(format!("{}: {e}", urdf.display())))?;
+            .map_err(|e| RobotError::InvalidRobot(format!("{}: {e}", urdf.display())))?;
         let srdf = srdf
             .map(|p| {
                 std::fs::read_to_string(p)
-                    .map_err(|e| ClientError::InvalidRobot(format!("{}: {e}", p.display())))
+                    .map_err(|e| RobotError::InvalidRobot(format!("{}: {e}", p.display())))
             })
             .transpose()?;
         self.register_robot_text(name, &text, srdf.as_deref(), urdf.parent(), packages, base)
@@ -264,11 +267,13 @@ impl Client {
         mesh_base: Option<&Path>,
         packages: &PackagePath,
         base: &Isometry3<f64>,
-    ) -> Result<RobotHandle, ClientError> {
+    ) -> Result<RobotHandle, RobotError> {
         let model = RobotModel::from_urdf_str(urdf, mesh_base, packages).map_err(robot_err)?;
         gjkd_model::disabled_pairs(srdf, &model.kinematics, true).map_err(robot_err)?;
         let mut registered = Vec::new();
-        let outcome = self.register_links(name, &model, &mut registered);
+        let outcome = self
+            .register_links(name, &model, &mut registered)
+            .map_err(RobotError::from);
         let outcome = outcome.and_then(|()| self.attach_robot(name, urdf, srdf, base));
         if outcome.is_err() {
             for id in registered {
@@ -283,7 +288,7 @@ impl Client {
         name: &str,
         model: &RobotModel,
         registered: &mut Vec<ObjectId>,
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), RegisterError> {
         for link in &model.links {
             let Some(shape) = &link.shape else { continue };
             let object = format!("{name}/{}", link.name);
@@ -318,16 +323,20 @@ impl Client {
     /// robot is put at `base`, joints at zero within their limits.
     ///
     /// # Errors
-    /// [`ClientError::InvalidRobot`] for URDF text this client cannot read;
-    /// [`ClientError::Rejected`] with [`ErrorCode::InvalidRobot`] or
-    /// [`ErrorCode::NotOwner`] (another client's robot has that name).
+    /// [`RobotError::InvalidRobot`] for URDF text this client cannot read;
+    /// [`RobotError::NameTooLong`], [`RobotError::TextTooLong`];
+    /// [`RobotError::RobotRefused`] (the server cannot use the URDF or
+    /// SRDF), [`RobotError::NotOwner`] (another client's robot has that
+    /// name), [`RobotError::NonFinitePose`] or
+    /// [`RobotError::BadQuaternion`] (the base), [`RobotError::OutOfLimits`];
+    /// the connection faults.
     pub fn attach_robot(
         &mut self,
         name: &str,
         urdf: &str,
         srdf: Option<&str>,
         base: &Isometry3<f64>,
-    ) -> Result<RobotHandle, ClientError> {
+    ) -> Result<RobotHandle, RobotError> {
         let kinematics = Kinematics::from_urdf_str(urdf).map_err(robot_err)?;
         let text = match srdf {
             Some(srdf) => format!("{urdf}\0{srdf}"),
@@ -335,14 +344,13 @@ impl Client {
         };
         let mut request = AdminRequest::new(AdminOp::AttachRobot);
         if !request.set_name(name) {
-            return Err(ClientError::InvalidArgument(
-                "name longer than MAX_NAME_LEN",
-            ));
+            return Err(RobotError::NameTooLong);
         }
-        request.text_len = u32::try_from(text.len())
-            .map_err(|_| ClientError::InvalidArgument("robot text longer than 4 GiB"))?;
+        request.text_len = u32::try_from(text.len()).map_err(|_| RobotError::TextTooLong)?;
         request.pose = Pose::from_isometry(base);
-        let reply = self.admin(&request, &AdminChunk::pack_text(&text))?;
+        let reply = self
+            .admin(&request, &AdminChunk::pack_text(&text))
+            .map_err(op_error::<RobotError>)?;
         self.ending.robot(name);
         self.handle(ObjectId::from_raw(reply.id), name, kinematics)
     }
@@ -352,19 +360,13 @@ impl Client {
     /// and link names.
     ///
     /// # Errors
-    /// [`ClientError::InvalidRobot`] for URDF text this client cannot read;
-    /// [`ClientError::Rejected`] with [`ErrorCode::UnknownName`].
-    pub fn open_robot(&mut self, name: &str, urdf: &str) -> Result<RobotHandle, ClientError> {
+    /// [`RobotError::InvalidRobot`] for URDF text this client cannot read;
+    /// [`RobotError::UnknownRobot`]; [`RobotError::NameTooLong`]; the
+    /// connection faults.
+    pub fn open_robot(&mut self, name: &str, urdf: &str) -> Result<RobotHandle, RobotError> {
         let kinematics = Kinematics::from_urdf_str(urdf).map_err(robot_err)?;
-        let mut request = AdminRequest::new(AdminOp::Lookup);
-        if !request.set_name(name) {
-            return Err(ClientError::InvalidArgument(
-                "name longer than MAX_NAME_LEN",
-            ));
-        }
-        request.lookup = lookup_kind::ROBOT;
-        let reply = self.admin(&request, &[])?;
-        self.handle(ObjectId::from_raw(reply.id), name, kinematics)
+        let id = self.robot_id(name)?;
+        self.handle(id, name, kinematics)
     }
 
     fn handle(
@@ -372,13 +374,14 @@ impl Client {
         id: ObjectId,
         name: &str,
         kinematics: Kinematics,
-    ) -> Result<RobotHandle, ClientError> {
+    ) -> Result<RobotHandle, RobotError> {
         let mut links = Vec::with_capacity(kinematics.link_names().len());
         for link in kinematics.link_names() {
             links.push(match self.lookup(&format!("{name}/{link}")) {
                 Ok(id) => Some(id),
-                Err(ClientError::Rejected(ErrorCode::UnknownName)) => None,
-                Err(e) => return Err(e),
+                // A link without collision geometry has no object.
+                Err(LookupError::UnknownName) => None,
+                Err(e) => return Err(e.into()),
             });
         }
         let mut positions = vec![0.0; kinematics.dof()];
@@ -402,17 +405,17 @@ impl Client {
     /// alone.
     ///
     /// # Errors
-    /// [`ClientError::InvalidArgument`] for the wrong number of positions;
-    /// [`ClientError::Rejected`] with [`ErrorCode::OutOfLimits`],
-    /// [`ErrorCode::NonFinitePose`] (a NaN position or base),
-    /// [`ErrorCode::UnknownObject`] (robot or link gone); nothing moves
-    /// then.
+    /// [`RobotError::WrongJointCount`] for the wrong number of positions;
+    /// [`RobotError::OutOfLimits`], [`RobotError::NonFinitePose`] (a NaN
+    /// position or base), [`RobotError::BadQuaternion`] (the base),
+    /// [`RobotError::UnknownObject`] (robot or link gone); the connection
+    /// faults. Nothing moves then.
     pub fn set_joints(
         &mut self,
         robot: &mut RobotHandle,
         positions: &[f64],
         base: Option<&Isometry3<f64>>,
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), RobotError> {
         self.set_joints_with(robot, positions, base, LimitMode::Reject)
     }
 
@@ -422,7 +425,7 @@ impl Client {
     /// positions afterwards.
     ///
     /// # Errors
-    /// As [`Client::set_joints`] ([`ErrorCode::OutOfLimits`] only with
+    /// As [`Client::set_joints`] ([`RobotError::OutOfLimits`] only with
     /// [`LimitMode::Reject`]).
     pub fn set_joints_with(
         &mut self,
@@ -430,17 +433,16 @@ impl Client {
         positions: &[f64],
         base: Option<&Isometry3<f64>>,
         mode: LimitMode,
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), RobotError> {
         if positions.len() != robot.positions.len() {
-            return Err(ClientError::InvalidArgument(
-                "one position per moving joint of the robot",
-            ));
+            return Err(RobotError::WrongJointCount);
         }
         let items = robot.joint_items(positions, base, mode == LimitMode::Clamp);
         let mut results = vec![ItemResult::default(); items.len()];
-        self.query_batch(&items, &mut results)?;
+        self.batch(&items, &mut results)
+            .map_err(op_error::<RobotError>)?;
         if let Some(r) = results.iter().find(|r| r.error != 0) {
-            return Err(ClientError::Rejected(r.error_code()));
+            return Err(op_error(ClientError::Rejected(r.error_code())));
         }
         robot.positions.copy_from_slice(positions);
         // The server accepted them, so they are finite: clamping cannot
@@ -455,14 +457,14 @@ impl Client {
     /// last positions.
     ///
     /// # Errors
-    /// [`ClientError::UnknownJoint`] (code [`ErrorCode::UnknownName`]) for
+    /// [`RobotError::UnknownJoint`] (code [`ErrorCode::UnknownName`]) for
     /// a name that is no moving joint, before anything is sent; as
     /// [`Client::set_joints`].
     pub fn set_joints_by_name(
         &mut self,
         robot: &mut RobotHandle,
         named: &[(&str, f64)],
-    ) -> Result<(), ClientError> {
+    ) -> Result<(), RobotError> {
         let q = robot
             .kinematics
             .positions_by_name(named, &robot.positions)

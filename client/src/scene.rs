@@ -60,7 +60,7 @@ use nalgebra::Isometry3;
 
 #[cfg(feature = "robots")]
 use crate::RobotHandle;
-use crate::{Answer, Client, ClientError, Waited, ipc_err};
+use crate::{Answer, Client, ClientError, SceneError, Waited, ipc_err, op_error};
 
 mod continuous;
 pub use continuous::Contact;
@@ -163,9 +163,9 @@ impl<'a> Steps<'a> {
     /// Number of steps, or why the slices do not make whole steps.
     ///
     /// # Errors
-    /// [`ClientError::InvalidArgument`] when there is no moving object or
+    /// [`SceneError::PartialSteps`] when there is no moving object or
     /// joint, or the slices do not make whole steps.
-    pub fn count(&self) -> Result<usize, ClientError> {
+    pub fn count(&self) -> Result<usize, SceneError> {
         let (per, len) = match *self {
             Steps::Poses { objects, poses } => (objects.len(), poses.len()),
             Steps::Joints {
@@ -173,9 +173,7 @@ impl<'a> Steps<'a> {
             } => (joints, positions.len()),
         };
         if per == 0 || !len.is_multiple_of(per) {
-            return Err(ClientError::InvalidArgument(
-                "a path's poses or positions do not make whole steps",
-            ));
+            return Err(SceneError::PartialSteps);
         }
         Ok(len / per)
     }
@@ -516,21 +514,21 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     /// `rows.len()` of them, from its start).
     ///
     /// # Errors
-    /// [`ClientError::InvalidArgument`] for a path whose slices do not make
-    /// whole steps, before anything is sent; [`ClientError::Rejected`] when
-    /// the server refuses the whole request (nothing changes then):
-    /// [`ErrorCode::UnknownObject`] (the group, a member, an object of an
-    /// allowed pair, a moving object), [`ErrorCode::InvalidOptions`] (a
+    /// [`SceneError::PartialSteps`] for a path whose slices do not make
+    /// whole steps, before anything is sent; a refusal of the whole
+    /// request by the server (nothing changes then):
+    /// [`SceneError::UnknownObject`] (the group, a member, an object of an
+    /// allowed pair, a moving object), [`SceneError::InvalidOptions`] (a
     /// tolerance, iteration cap, margin, cut-off, accepted accuracy or `k`
     /// out of its domain: negative, NaN, infinite, zero iterations, `k` 0),
-    /// [`ErrorCode::Malformed`] ([`Client::nearest`] of a group of more
+    /// [`SceneError::Malformed`] ([`Client::nearest`] of a group of more
     /// than one, [`SceneQuery::until_hit`] of another question than
-    /// [`Client::within`]), [`ErrorCode::BatchTooLarge`]
-    /// (more poses, members, allowed pairs and steps together than the
-    /// server's [`ServerInfo::max_batch`](crate::ServerInfo::max_batch)),
-    /// [`ErrorCode::NonFinitePose`], [`ErrorCode::BadQuaternion`],
-    /// [`ErrorCode::OutOfLimits`]; and the connection errors of every call.
-    pub fn into_rows(self, rows: &mut [SceneRow]) -> Result<SceneSummary, ClientError> {
+    /// [`Client::within`]), [`SceneError::BatchTooLarge`] (more poses,
+    /// members, allowed pairs and steps together than the server's
+    /// [`ServerInfo::max_batch`](crate::ServerInfo::max_batch) in one step),
+    /// [`SceneError::NonFinitePose`], [`SceneError::BadQuaternion`],
+    /// [`SceneError::OutOfLimits`]; and the connection faults of every call.
+    pub fn into_rows(self, rows: &mut [SceneRow]) -> Result<SceneSummary, SceneError> {
         let max_rows = rows.len();
         self.run(max_rows, |got| {
             rows[..got.len()].copy_from_slice(got);
@@ -541,7 +539,7 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     ///
     /// # Errors
     /// As [`SceneQuery::into_rows`].
-    pub fn into_pairs(self, pairs: &mut [ScenePair]) -> Result<SceneSummary, ClientError> {
+    pub fn into_pairs(self, pairs: &mut [ScenePair]) -> Result<SceneSummary, SceneError> {
         let max_rows = pairs.len();
         self.run(max_rows, |got| {
             for (out, row) in pairs.iter_mut().zip(got) {
@@ -560,7 +558,7 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
         mut self,
         max_rows: usize,
         read: impl FnOnce(&[SceneRow]),
-    ) -> Result<SceneSummary, ClientError> {
+    ) -> Result<SceneSummary, SceneError> {
         self.request.max_rows = u32::try_from(max_rows).unwrap_or(u32::MAX);
         let (members, allowed, poses) = (self.members, self.allowed, self.poses);
         let (steps, per_step, step_count) = match self.steps {
@@ -666,14 +664,16 @@ impl Client {
         count: usize,
         item: impl FnMut(usize) -> Item,
         read: impl FnOnce(&[SceneRow]),
-    ) -> Result<SceneSummary, ClientError> {
-        self.ensure_connected(Instant::now() + self.timeout)?;
-        if let Some(limits) = self.request_limits()
-            && limits.must_split(request, count)
-        {
-            return self.scene_split(request, count, item, read, limits);
-        }
-        self.scene_once(request, count, item, read)
+    ) -> Result<SceneSummary, SceneError> {
+        self.ensure_connected(Instant::now() + self.timeout)
+            .map_err(op_error::<SceneError>)?;
+        let outcome = match self.request_limits() {
+            Some(limits) if limits.must_split(request, count) => {
+                self.scene_split(request, count, item, read, limits)
+            }
+            _ => self.scene_once(request, count, item, read),
+        };
+        outcome.map_err(op_error)
     }
 
     /// One scene request: [`Client::scene_with`] for what one request takes.
@@ -780,12 +780,12 @@ mod tests {
             objects: &ids,
             poses: &poses[..5],
         };
-        assert!(matches!(odd.count(), Err(ClientError::InvalidArgument(_))));
+        assert_eq!(odd.count(), Err(SceneError::PartialSteps));
         let none = Steps::Poses {
             objects: &[],
             poses: &[],
         };
-        assert!(matches!(none.count(), Err(ClientError::InvalidArgument(_))));
+        assert_eq!(none.count(), Err(SceneError::PartialSteps));
     }
 
     #[test]

@@ -5,7 +5,7 @@ use std::ffi::{CString, c_char};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-use rust_client::{Client, ClientError, ErrorCode};
+use rust_client::{Client, ErrorCode};
 
 use crate::args::{opt_str, out};
 use crate::handle::{gjkd_client, with_client};
@@ -72,8 +72,7 @@ pub unsafe extern "C" fn gjkd_connect(
         let client = Client::builder(service)
             .timeout(timeout)
             .connect_timeout(connect_timeout)
-            .connect()
-            .map_err(ClientError::from)?;
+            .connect()?;
         *slot = Box::into_raw(Box::new(gjkd_client::new(client)));
         Ok(())
     })

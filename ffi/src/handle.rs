@@ -14,7 +14,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use rust_client::{Client, ClientError, ErrorCode, Item, ItemResult, ObjectId};
+use rust_client::{Client, Item, ItemResult, ObjectId, QueryError};
 
 use crate::status::{Failure, gjkd_status};
 use crate::types::gjkd_registration_options;
@@ -115,7 +115,7 @@ impl gjkd_client {
                 Ok(()) => start = end,
                 // The server may have restarted with a smaller limit: the
                 // client knows the new one after its reconnect.
-                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
+                Err(QueryError::BatchTooLarge) if self.max_batch() < max => {}
                 Err(e) => return Err(e.into()),
             }
         }
@@ -141,7 +141,7 @@ impl gjkd_client {
             match chunk {
                 Ok(()) => start = end,
                 // As in `run`.
-                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
+                Err(QueryError::BatchTooLarge) if self.max_batch() < max => {}
                 Err(e) => return Err(e.into()),
             }
         }
@@ -177,7 +177,7 @@ impl gjkd_client {
                     written += n;
                 }
                 // As in `run`.
-                Err(ClientError::Rejected(ErrorCode::BatchTooLarge)) if self.max_batch() < max => {}
+                Err(QueryError::BatchTooLarge) if self.max_batch() < max => {}
                 Err(e) => return Err(e.into()),
             }
         }

@@ -5,7 +5,7 @@ use std::ffi::c_char;
 use std::path::Path;
 
 use nalgebra::{Isometry3, Point3};
-use rust_client::{ClientError, ErrorCode, Mesh, MeshMode};
+use rust_client::{Mesh, MeshMode, RegisterError};
 
 use crate::args::{checked_pose, opt_str, out, req_str, slice};
 use crate::handle::{gjkd_client, with_client};
@@ -68,7 +68,7 @@ fn register(
         .client
         .register_mesh(name.unwrap_or(""), &mesh, mode, &pose)
     {
-        Err(ClientError::Rejected(ErrorCode::NameTaken)) if c.registration.reuse_names => {
+        Err(RegisterError::NameTaken) if c.registration.reuse_names => {
             // The object of that name, as it is: what it was made of is
             // not known here.
             let id = c.client.lookup(name.unwrap_or(""))?;

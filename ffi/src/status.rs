@@ -111,8 +111,12 @@ impl Failure {
     }
 }
 
-impl From<ClientError> for Failure {
-    fn from(e: ClientError) -> Self {
+impl<E: Into<ClientError>> From<E> for Failure {
+    /// Every operation's error (`RegisterError`, `QueryError`, ...) read
+    /// through the umbrella `ClientError`, so that one fault has one status
+    /// and one code whichever call met it.
+    fn from(e: E) -> Self {
+        let e: ClientError = e.into();
         let status = match &e {
             ClientError::ServerGone(_) => GJKD_ERR_SERVER_GONE,
             ClientError::Timeout(_) => GJKD_ERR_TIMEOUT,
@@ -340,5 +344,36 @@ mod tests {
         }
         assert_eq!(code_name(22), "GJKD_CODE_INVALID_ROBOT");
         assert_eq!(code_name(16), "GJKD_CODE_UNKNOWN_NAME");
+    }
+
+    #[test]
+    fn operation_errors_have_the_status_and_code_of_the_same_client_error() {
+        use rust_client::{
+            ConnectError, LookupError, PoseError, QueryError, RegisterError, RobotError, SceneError,
+        };
+        /// The failure of `e` is that of its `ClientError`, word for word.
+        fn same<E: Clone + Into<ClientError>>(e: E) -> Failure {
+            let via = Failure::from(e.clone().into());
+            let f = Failure::from(e);
+            assert_eq!(
+                (f.status, f.code, &f.message),
+                (via.status, via.code, &via.message)
+            );
+            f
+        }
+        let f = same(RegisterError::NameTaken);
+        assert_eq!((f.status, f.code), (GJKD_ERR_REJECTED, 17));
+        let f = same(PoseError::NonFinitePose);
+        assert_eq!((f.status, f.code), (GJKD_ERR_REJECTED, 2));
+        let f = same(QueryError::ResultBufferTooSmall { needed: 2, got: 1 });
+        assert_eq!((f.status, f.code), (GJKD_ERR_INVALID_ARGUMENT, 0));
+        let f = same(LookupError::NameTooLong);
+        assert_eq!((f.status, f.code), (GJKD_ERR_INVALID_ARGUMENT, 0));
+        let f = same(RobotError::UnknownJoint("j".into()));
+        assert_eq!((f.status, f.code), (GJKD_ERR_INVALID_ARGUMENT, 16));
+        let f = same(RobotError::UnknownRobot);
+        assert_eq!((f.status, f.code), (GJKD_ERR_REJECTED, 16));
+        let f = same(SceneError::Connection(ConnectError::ServerGone("s".into())));
+        assert_eq!((f.status, f.code), (GJKD_ERR_SERVER_GONE, 0));
     }
 }

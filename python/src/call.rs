@@ -7,10 +7,13 @@ use pyo3::prelude::*;
 /// A holder of a Rust client that runs calls on it with the GIL released.
 pub trait RustCall {
     /// Runs `call` on the Rust client; the outer error is the holder's
-    /// own (a closed client), the inner one the call's.
-    fn call<R>(
+    /// own (a closed client), the inner one the call's, whichever
+    /// operation's error it was (`RegisterError`, `QueryError`, ...), read
+    /// as the umbrella [`ClientError`]: one fault, one Python exception
+    /// and code (`errors::client`).
+    fn call<R, E: Into<ClientError>>(
         &mut self,
         py: Python<'_>,
-        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,
+        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, E>,
     ) -> PyResult<Result<R, ClientError>>;
 }

@@ -81,7 +81,11 @@ impl Answerer for Connection {
     }
 
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
-        self.run(|client| client.query_batch(items, results))
+        self.run(|client| {
+            client
+                .query_batch(items, results)
+                .map_err(ClientError::from)
+        })
     }
 
     fn answer_gradients(
@@ -90,8 +94,12 @@ impl Answerer for Connection {
         results: &mut [ItemResult],
         gradients: &mut [Gradient],
     ) -> Result<(), ClientError> {
-        self.run(|client| client.query_batch_gradients(items, results, gradients))
-            .map(|_| ())
+        self.run(|client| {
+            client
+                .query_batch_gradients(items, results, gradients)
+                .map(|_| ())
+                .map_err(ClientError::from)
+        })
     }
 
     fn refresh_limit(&mut self) -> bool {
@@ -136,19 +144,40 @@ fn seconds(py: Python<'_>, field: &str, s: f64) -> PyResult<Duration> {
 }
 
 impl RustCall for Client {
-    fn call<R>(
+    fn call<R, E: Into<ClientError>>(
         &mut self,
         py: Python<'_>,
-        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,
+        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, E>,
     ) -> PyResult<Result<R, ClientError>> {
         let client = OnThisThread::new(self.inner_client(py)?);
         let call = OnThisThread::new(call);
         Ok(py
             .detach(move || {
                 let (client, call) = (client.into_inner(), call.into_inner());
-                OnThisThread::new(call(client))
+                OnThisThread::new(call(client).map_err(Into::into))
             })
             .into_inner())
+    }
+}
+
+/// Registers `g`, named at `pose` (the identity without one), or unnamed
+/// and then moved to `pose` if there is one.
+fn register_at(
+    c: &mut gjkd_client::Client,
+    g: &gjkd_client::Geometry<'_>,
+    name: Option<&str>,
+    pose: Option<nalgebra::Isometry3<f64>>,
+) -> Result<gjkd_client::ObjectId, ClientError> {
+    let iso = pose.unwrap_or_else(nalgebra::Isometry3::identity);
+    match name {
+        Some(n) => Ok(c.register_named(n, g, &iso)?),
+        None => {
+            let id = c.register(g)?;
+            if pose.is_some() {
+                c.set_pose(id, &iso)?;
+            }
+            Ok(id)
+        }
     }
 }
 
@@ -185,28 +214,12 @@ impl Backend for Client {
         let result = match what {
             Registration::Convex(shape) => {
                 let g = shape.geometry();
-                self.call(py, |c| match name {
-                    Some(n) => c.register_named(n, &g, &iso),
-                    None => c.register(&g).and_then(|id| {
-                        if pose.is_some() {
-                            c.set_pose(id, &iso)?;
-                        }
-                        Ok(id)
-                    }),
-                })?
+                self.call(py, |c| register_at(c, &g, name, pose.map(|_| iso)))?
             }
             Registration::Compound(pieces) => {
                 let list = pieces.client_pieces();
                 let g = gjkd_client::Geometry::Compound(&list);
-                self.call(py, |c| match name {
-                    Some(n) => c.register_named(n, &g, &iso),
-                    None => c.register(&g).and_then(|id| {
-                        if pose.is_some() {
-                            c.set_pose(id, &iso)?;
-                        }
-                        Ok(id)
-                    }),
-                })?
+                self.call(py, |c| register_at(c, &g, name, pose.map(|_| iso)))?
             }
         };
         result
@@ -267,7 +280,7 @@ backend_methods!(Client, {
         let connected = py
             .detach(move || OnThisThread::new(builder.connect()))
             .into_inner();
-        let inner = connected.map_err(|e| errors::client(py, e.into(), None))?;
+        let inner = connected.map_err(|e| errors::client(py, e, None))?;
         let max_batch = inner
             .server_info()
             .map_or(DEFAULT_MAX_BATCH, |i| i.max_batch as usize);

@@ -151,8 +151,12 @@ pub fn refused(
     .into_err(py)
 }
 
-/// The exception of a failed client call.
-pub fn client(py: Python<'_>, e: ClientError, field: Option<&str>) -> PyErr {
+/// The exception of a failed client call: any operation's error
+/// (`RegisterError`, `QueryError`, ...), read through the umbrella
+/// [`ClientError`], so that one fault is one class with one `code`
+/// whichever call met it.
+pub fn client(py: Python<'_>, e: impl Into<ClientError>, field: Option<&str>) -> PyErr {
+    let e: ClientError = e.into();
     let (kind, code) = match &e {
         ClientError::ServerGone(_) => (Kind::ServerGone, None),
         ClientError::Timeout(_) => (Kind::Timeout, None),

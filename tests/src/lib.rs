@@ -435,9 +435,9 @@ impl Drop for LoadProcess {
     }
 }
 
-/// Whether `e` says the server is gone.
-pub fn is_gone(e: &ClientError) -> bool {
-    matches!(e, ClientError::ServerGone(_))
+/// Whether `e`, any operation's error, says the server is gone.
+pub fn is_gone<E: Clone + Into<ClientError>>(e: &E) -> bool {
+    matches!(e.clone().into(), ClientError::ServerGone(_))
 }
 
 /// `call` retried while it reports the server gone, up to thirty seconds: a
@@ -445,7 +445,10 @@ pub fn is_gone(e: &ClientError) -> bool {
 ///
 /// # Panics
 /// On any other error, or when the server is still gone after thirty seconds.
-pub fn once_reached<T>(mut call: impl FnMut() -> Result<T, ClientError>) -> T {
+pub fn once_reached<T, E>(mut call: impl FnMut() -> Result<T, E>) -> T
+where
+    E: Clone + Into<ClientError> + std::fmt::Display,
+{
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         match call() {
@@ -655,7 +658,10 @@ impl Solid {
     }
 
     /// Registers it through the client's typed calls.
-    pub fn register(&self, client: &mut Client) -> Result<gjkd_client::ObjectId, ClientError> {
+    pub fn register(
+        &self,
+        client: &mut Client,
+    ) -> Result<gjkd_client::ObjectId, gjkd_client::RegisterError> {
         match self {
             Solid::Sphere(r) => client.register_sphere(*r),
             Solid::Capsule(a, b, r) => client.register_capsule(*a, *b, *r),

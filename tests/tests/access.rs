@@ -123,8 +123,8 @@ fn the_default_state_directory_is_owner_only() {
     assert_eq!(dir_mode.expect("directory") & 0o777, 0o700);
 }
 
-fn rejected<T: std::fmt::Debug>(r: Result<T, ClientError>) -> ErrorCode {
-    match r {
+fn rejected<T: std::fmt::Debug, E: Into<ClientError>>(r: Result<T, E>) -> ErrorCode {
+    match r.map_err(Into::into) {
         Err(ClientError::Rejected(code)) => code,
         other => panic!("expected a rejection, got {other:?}"),
     }

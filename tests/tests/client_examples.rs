@@ -97,7 +97,7 @@ fn robot_arm_runs() {
     );
     assert!(out.contains("gripper to crate 0.150000000000"), "{out}");
     assert!(
-        out.contains("reach 0.9 refused: joint position outside its limits"),
+        out.contains("reach 0.9 refused: a joint position is outside its limits"),
         "{out}"
     );
 }

@@ -39,8 +39,8 @@ impl Can {
     }
 }
 
-fn rejected<T: std::fmt::Debug>(r: Result<T, ClientError>) -> ErrorCode {
-    match r {
+fn rejected<T: std::fmt::Debug, E: Into<ClientError>>(r: Result<T, E>) -> ErrorCode {
+    match r.map_err(Into::into) {
         Err(ClientError::Rejected(code)) => code,
         other => panic!("expected a rejection, got {other:?}"),
     }

@@ -245,3 +245,57 @@ fn readme_gradients_example_runs() -> Result<(), gjkd_client::ClientError> {
     assert!((matrix[0] + 0.8).abs() < 1e-9);
     Ok(())
 }
+
+#[test]
+fn readme_errors_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-errors", &["--no-persist"]);
+    let service = server.service.as_str();
+    // --- from README.md, "Every call has a timeout", twice: the second
+    // registration of the name meets its own variant ---
+    use gjkd_client::{Client, ConnectError, Geometry, RegisterError};
+    use nalgebra::Isometry3;
+
+    let mut client = Client::connect(service)?;
+    let mut said = Vec::new();
+    for _ in 0..2 {
+        let ball = Geometry::Sphere { radius: 0.1 };
+        match client.register_named("ball", &ball, &Isometry3::identity()) {
+            Ok(id) => said.push(format!("registered {id}")),
+            Err(RegisterError::NameTaken) => said.push("someone else's ball".to_owned()),
+            Err(RegisterError::Connection(ConnectError::ServerGone(s))) => {
+                said.push(format!("no server on {s}"))
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    assert!(said[0].starts_with("registered "), "{said:?}");
+    assert_eq!(said[1], "someone else's ball");
+    Ok(())
+}
+
+#[test]
+fn crate_errors_example_runs() -> Result<(), gjkd_client::ClientError> {
+    let server = Server::start("doc-crate-errors", &["--no-persist"]);
+    let service = server.service.as_str();
+    // --- from client/src/lib.rs, crate docs, "Errors", twice: the second
+    // time the name is taken and the object found by it ---
+    use gjkd_client::{Client, Geometry, QueryError, QueryOptions, RegisterError};
+    use nalgebra::Isometry3;
+
+    let mut client = Client::connect(service)?;
+    let mut ids = Vec::new();
+    for _ in 0..2 {
+        let ball = Geometry::Sphere { radius: 0.5 };
+        let id = match client.register_named("ball", &ball, &Isometry3::identity()) {
+            Err(RegisterError::NameTaken) => client.lookup("ball")?,
+            other => other?,
+        };
+        match client.distance(id, id, &QueryOptions::default()) {
+            Err(QueryError::UnknownObject) => println!("removed meanwhile"),
+            other => println!("{:?}", other?.distance),
+        }
+        ids.push(id);
+    }
+    assert_eq!(ids[0], ids[1]);
+    Ok(())
+}

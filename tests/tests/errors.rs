@@ -3,15 +3,16 @@
 use std::time::Duration;
 
 use gjkd_client::{
-    Client, ClientError, ErrorCode, Geometry, Item, ItemResult, ObjectId, Piece, QueryOptions,
+    Client, ClientError, ErrorCode, Geometry, Item, ItemResult, ObjectId, Piece, QueryError,
+    QueryOptions, RegisterError, ShapeError,
 };
 use gjkd_e2e::Server;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 const TIMEOUT: Duration = Duration::from_secs(5);
 
-fn rejected(r: Result<impl std::fmt::Debug, ClientError>) -> ErrorCode {
-    match r {
+fn rejected<E: Into<ClientError>>(r: Result<impl std::fmt::Debug, E>) -> ErrorCode {
+    match r.map_err(Into::into) {
         Err(ClientError::Rejected(code)) => code,
         other => panic!("expected a rejection, got {other:?}"),
     }
@@ -230,18 +231,18 @@ fn invalid_geometry() {
         offset: Isometry3::identity(),
         geometry: Geometry::Compound(&bad_offset),
     }];
-    assert!(matches!(
+    assert_eq!(
         client.register_compound(&nested),
-        Err(ClientError::InvalidArgument(_))
-    ));
-    assert!(matches!(
+        Err(RegisterError::InvalidShape(ShapeError::CompoundIsNested))
+    );
+    assert_eq!(
         client.register_named(
             &"n".repeat(65),
             &Geometry::Sphere { radius: 1.0 },
             &Isometry3::identity()
         ),
-        Err(ClientError::InvalidArgument(_))
-    ));
+        Err(RegisterError::NameTooLong)
+    );
     let named = client
         .register_named(
             "twin",
@@ -282,7 +283,7 @@ fn bad_batches() {
     );
     assert_eq!(
         client.query_batch(&[item; 3], &mut results[..2]),
-        Err(ClientError::ResultBufferTooSmall { needed: 3, got: 2 })
+        Err(QueryError::ResultBufferTooSmall { needed: 3, got: 2 })
     );
     client
         .query_batch(&[item; 64], &mut results)

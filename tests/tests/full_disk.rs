@@ -91,8 +91,8 @@ fn serve_on_tmpfs(size: &str, name: &str) -> Option<(Tmpfs, Server)> {
     Some((tmpfs, server))
 }
 
-fn storage_full<T>(r: &Result<T, ClientError>) -> bool {
-    matches!(r, Err(ClientError::Rejected(ErrorCode::StorageFull)))
+fn storage_full<T, E: Clone + Into<ClientError>>(r: &Result<T, E>) -> bool {
+    matches!(r, Err(e) if e.clone().into() == ClientError::Rejected(ErrorCode::StorageFull))
 }
 
 #[test]

@@ -6,7 +6,9 @@
 
 use std::time::Duration;
 
-use gjkd_client::{Client, ClientError, ErrorCode, Geometry, ObjectId, QueryOptions};
+use gjkd_client::{
+    Client, ClientError, Geometry, ObjectId, QueryOptions, RegisterError, ShapeError,
+};
 use gjkd_e2e::Server;
 use nalgebra::{Isometry3, Point3, Vector3};
 use proptest::prelude::*;
@@ -75,37 +77,38 @@ impl Call {
     /// What the documentation says the call gives: `Ok(())` or the error.
     /// The values drawn keep clear of the bound (within 1e299 or beyond
     /// 1e301), so the reach is judged by the largest vertex alone.
-    fn documented(&self) -> Result<(), ClientError> {
+    fn documented(&self) -> Result<(), RegisterError> {
         if let Call::Cuboid(h, _) = self
             && h.iter().any(|&c| c < 0.0)
         {
-            return Err(ClientError::InvalidArgument("a half extent is negative"));
+            return Err(RegisterError::InvalidShape(
+                ShapeError::HalfExtentIsNegative,
+            ));
         }
         let (vertices, radius) = self.parts();
-        let refused = |code| Err(ClientError::Rejected(code));
         if vertices.is_empty() {
-            return refused(ErrorCode::EmptyVertices);
+            return Err(RegisterError::EmptyVertices);
         }
         if !(radius.is_finite() && radius >= 0.0) {
-            return refused(ErrorCode::InvalidRadius);
+            return Err(RegisterError::InvalidRadius);
         }
         if vertices
             .iter()
             .any(|v| !v.coords.iter().all(|c| c.is_finite()))
         {
-            return refused(ErrorCode::NonFiniteVertex);
+            return Err(RegisterError::NonFiniteVertex);
         }
         if radius > BOUND {
-            return refused(ErrorCode::InvalidRadius);
+            return Err(RegisterError::InvalidRadius);
         }
         let reach = vertices.iter().map(|v| v.coords.amax()).fold(0.0, f64::max);
         if reach > BOUND || reach + radius > BOUND {
-            return refused(ErrorCode::NonFiniteVertex);
+            return Err(RegisterError::NonFiniteVertex);
         }
         Ok(())
     }
 
-    fn register(&self, client: &mut Client) -> Result<ObjectId, ClientError> {
+    fn register(&self, client: &mut Client) -> Result<ObjectId, RegisterError> {
         match self {
             Call::Sphere(r) => client.register_sphere(*r),
             Call::Capsule(a, b, r) => client.register_capsule(*a, *b, *r),
@@ -149,7 +152,12 @@ fn accepted_registrations_can_be_queried_and_refused_ones_say_why() {
                     client.remove(id).expect("removed");
                     accepted.set(accepted.get() + 1);
                 }
-                Err(e) => prop_assert_eq!(Err(e), want, "{:?}", c),
+                Err(e) => {
+                    // The umbrella error carries the same code.
+                    let code = e.code();
+                    prop_assert_eq!(ClientError::from(e.clone()).code(), code);
+                    prop_assert_eq!(Err(e), want, "{:?}", c);
+                }
             }
             Ok(())
         })

@@ -21,8 +21,8 @@ const URDF: &str = r#"<robot name="arm">
     <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
 </robot>"#;
 
-fn rejected<T: std::fmt::Debug>(r: Result<T, ClientError>) -> ErrorCode {
-    match r {
+fn rejected<T: std::fmt::Debug, E: Into<ClientError>>(r: Result<T, E>) -> ErrorCode {
+    match r.map_err(Into::into) {
         Err(ClientError::Rejected(code)) => code,
         other => panic!("expected a refusal, got {other:?}"),
     }

@@ -7,7 +7,7 @@
 //! refuses the flag.
 
 use gjkd_client::{
-    Client, ClientError, ErrorCode, Group, ObjectId, QueryOptions, ScenePair, Status, Steps,
+    Client, ClientError, Group, ObjectId, QueryOptions, SceneError, ScenePair, Status, Steps,
 };
 use gjkd_e2e::Server;
 use gjkd_testkit::minkowski_depth::minkowski_depth;
@@ -282,10 +282,7 @@ fn a_continuous_path_refuses_signed_rows() -> Result<(), ClientError> {
         .signed_distance()
         .continuous(steps, 1e-6)
         .into_contacts(&mut contacts);
-    assert!(
-        matches!(refused, Err(ClientError::Rejected(ErrorCode::Malformed))),
-        "{refused:?}"
-    );
+    assert!(matches!(refused, Err(SceneError::Malformed)), "{refused:?}");
     // The same path without the flag is answered.
     let clear = client
         .within(Group::Members(&moving), 0.1)

@@ -12,7 +12,9 @@ use gjkd_proto::{PathMode, SceneRow, scene_flags};
 use super::{SceneQuery, Steps};
 #[cfg(feature = "robots")]
 use crate::RobotHandle;
-use crate::{Answer, Client, ClientError, ErrorCode, ObjectId};
+#[cfg(feature = "robots")]
+use crate::SceneError;
+use crate::{Answer, Client, ErrorCode, ObjectId};
 
 /// The first contact along one segment of a continuous path.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,14 +89,16 @@ impl<'a> SceneQuery<'_, 'a> {
     /// segment that touches, in segment order.
     ///
     /// # Errors
-    /// As [`SceneQuery::into_rows`], and [`ErrorCode::InvalidOptions`] for
-    /// a bracket that is not a finite number `> 0`, [`ErrorCode::Malformed`]
-    /// for fewer than two steps, a segment along which nothing moves, or a
-    /// question other than [`Client::within`].
+    /// As [`SceneQuery::into_rows`], and
+    /// [`SceneError::InvalidOptions`](crate::SceneError::InvalidOptions)
+    /// for a bracket that is not a finite number `> 0`,
+    /// [`SceneError::Malformed`](crate::SceneError::Malformed) for fewer
+    /// than two steps, a segment along which nothing moves, or a question
+    /// other than [`Client::within`].
     pub fn into_contacts(
         self,
         contacts: &mut [Contact],
-    ) -> Result<super::SceneSummary, ClientError> {
+    ) -> Result<super::SceneSummary, crate::SceneError> {
         let max_rows = contacts.len();
         self.run(max_rows, |got| {
             for (out, row) in contacts.iter_mut().zip(got) {
@@ -129,10 +133,10 @@ impl Client {
     /// ```
     ///
     /// # Errors
-    /// [`ClientError::InvalidArgument`] when `from` and `to` are not one
-    /// position per joint; as [`SceneQuery::into_contacts`] otherwise
-    /// ([`ErrorCode::OutOfLimits`], [`ErrorCode::NonFinitePose`],
-    /// [`ErrorCode::Malformed`] for `from == to`).
+    /// [`SceneError::EdgeEnds`] when `from` and `to` are not one position
+    /// per joint; as [`SceneQuery::into_contacts`] otherwise
+    /// ([`SceneError::OutOfLimits`], [`SceneError::NonFinitePose`],
+    /// [`SceneError::Malformed`] for `from == to`).
     #[cfg(feature = "robots")]
     pub fn edge_contact(
         &mut self,
@@ -141,12 +145,10 @@ impl Client {
         to: &[f64],
         margin: f64,
         bracket: f64,
-    ) -> Result<Option<Contact>, ClientError> {
+    ) -> Result<Option<Contact>, SceneError> {
         let joints = robot.positions.len();
         if from.len() != joints || to.len() != joints {
-            return Err(ClientError::InvalidArgument(
-                "an edge's ends need one position per joint",
-            ));
+            return Err(SceneError::EdgeEnds);
         }
         let both: Vec<f64> = from.iter().chain(to).copied().collect();
         let mut contact = [Contact::default()];

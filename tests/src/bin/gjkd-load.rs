@@ -196,9 +196,12 @@ fn main() {
                 let outcome = if round.is_multiple_of(20) {
                     let k = (round / 20) as usize % load.zoo.len();
                     let solid = load.zoo[k].clone();
-                    solid.register(&mut load.client).map(|id| {
-                        say(&format!("REG {} {k}", id.raw()));
-                    })
+                    solid
+                        .register(&mut load.client)
+                        .map(|id| {
+                            say(&format!("REG {} {k}", id.raw()));
+                        })
+                        .map_err(ClientError::from)
                 } else {
                     load.step()
                 };

@@ -276,7 +276,7 @@ impl From<&SceneRow> for ScenePair {
             a: ObjectId::from_raw(row.a),
             b: (row.b != 0).then(|| ObjectId::from_raw(row.b)),
             step: row.step,
-            answer: row.result.answer(),
+            answer: row.result.answer_with(Some(&row.gradient)),
         }
     }
 }

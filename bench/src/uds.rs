@@ -3,7 +3,8 @@
 //! the way an ordinary socket server would carry them.
 //!
 //! A request is an 8-byte header (item count, zero) followed by the items as
-//! they lie in memory; a reply is a [`ReplyHeader`] followed by the results.
+//! they lie in memory; a reply is the error and count of a [`ReplyHeader`]
+//! (8 bytes) followed by the results (pairs only: no gradients).
 //! The server is a separate process, like the iceoryx2 servers it is
 //! compared with: `gjkd bench latency` starts this executable as
 //! `gjkd bench uds-server --socket PATH [--cpu N]` ([`UdsServer`]), pinned
@@ -31,8 +32,8 @@ use gjkd_server::engine::state::State;
 // a field's) and accepting any bit pattern (every field is an integer or a
 // float), which the wire format already promises for shared memory.
 const _: () = assert!(std::mem::size_of::<Item>() == 160);
-const _: () = assert!(std::mem::size_of::<ItemResult>() == 296);
-const _: () = assert!(std::mem::size_of::<ReplyHeader>() == 8);
+const _: () = assert!(std::mem::size_of::<ItemResult>() == 152);
+const _: () = assert!(std::mem::size_of::<ReplyHeader>() == 16);
 
 fn items_bytes(items: &[Item]) -> &[u8] {
     // SAFETY: `Item` is `repr(C)` plain data without padding (asserted above),
@@ -210,13 +211,14 @@ fn serve_connection(mut conn: UnixStream, state: &mut State) -> std::io::Result<
                 ReplyHeader {
                     error: ErrorCode::Ok as u32,
                     count: count as u32,
+                    ..ReplyHeader::default()
                 }
             }
             Err(code) => {
                 reply.clear();
                 ReplyHeader {
                     error: code as u32,
-                    count: 0,
+                    ..ReplyHeader::default()
                 }
             }
         };

@@ -14,11 +14,11 @@ use crate::open_failure::{NameTakenBy, OpenFailure, name_taken_by};
 use crate::path_split::{RequestLimits, SplitScratch};
 use crate::{ClientError, ipc_err, scene};
 use gjkd_proto::{
-    AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, ReplyHeader,
+    AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ReplyEntry, ReplyHeader,
     ServerInfo, Vertex, WaitMode, admin_service_name, query_service_name, wake_service_name,
 };
 
-type QueryPort = IoxClient<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
+type QueryPort = IoxClient<ipc::Service, [Item], (), [ReplyEntry], ReplyHeader>;
 type AdminPort = IoxClient<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>;
 
 /// Open ports to one server incarnation.
@@ -32,7 +32,7 @@ pub(crate) struct Connection {
     pub(crate) admin: AdminPort,
     pub(crate) wake: Notifier<ipc::Service>,
     pub(crate) query_service:
-        request_response::PortFactory<ipc::Service, [Item], (), [ItemResult], ReplyHeader>,
+        request_response::PortFactory<ipc::Service, [Item], (), [ReplyEntry], ReplyHeader>,
     pub(crate) admin_service:
         request_response::PortFactory<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>,
     pub(crate) _wake_service: event::PortFactory<ipc::Service>,
@@ -266,7 +266,7 @@ impl Client {
         let query_service = self
             .node
             .service_builder(&name(query_service_name(&self.service))?)
-            .request_response::<[Item], [ItemResult]>()
+            .request_response::<[Item], [ReplyEntry]>()
             .response_user_header::<ReplyHeader>()
             .open()
             .map_err(|e| self.open_failed(&query_service_name(&self.service), e.into()))?;

@@ -217,6 +217,10 @@ pub use gjkd_proto::{
 /// [`QueryOptions::signed_distance`].
 pub use gjkd_proto::SignedDistance;
 
+/// A pair item's gradient as the query reply carries it, for
+/// [`Client::query_batch_read_gradients`].
+pub use gjkd_proto::GradientRow;
+
 // The crate's own plumbing, shared by the files that make up `Client`.
 pub(crate) use connection::Waited;
 pub(crate) use error::{ipc_err, reply_accepted};

@@ -17,6 +17,12 @@ use crate::{ClientError, ConnectError};
 /// What the client says when a name does not fit [`MAX_NAME_LEN`].
 pub(crate) const NAME_TOO_LONG: &str = "name longer than MAX_NAME_LEN";
 
+/// What the client says when an item asks for a gradient the call has no
+/// room for ([`QueryError::NoRoomForGradient`]).
+pub(crate) const NO_GRADIENT_BUFFER: &str = "an item asks for a gradient (item_flags::GRADIENT) \
+     the call has no room for: use query_batch_gradients with a buffer as long as the items \
+     that ask";
+
 /// Why a registration ([`Client::register`], [`Client::register_named`],
 /// the `register_*` shorthands, `Client::register_mesh`) failed. Nothing
 /// is stored then, except after a connection fault (see
@@ -229,6 +235,13 @@ pub enum QueryError {
     /// The server failed in a way that is its own fault; it keeps serving.
     #[error("the server failed to answer the query")]
     Internal,
+    /// An item asks for a gradient ([`Item::with_gradient`](crate::Item::with_gradient))
+    /// that the call has no room for: a call without a gradient buffer
+    /// ([`Client::query_batch`]), or a buffer shorter than the items that
+    /// ask ([`Client::query_batch_gradients`]); found before anything is
+    /// sent.
+    #[error("an item asks for a gradient the call has no room for")]
+    NoRoomForGradient,
     /// No server could be reached, or not in time: see [`ConnectError`].
     #[error(transparent)]
     Connection(#[from] ConnectError),
@@ -243,6 +256,7 @@ refusals! {
         QueryError::ResultBufferTooSmall { needed, got } => {
             ClientError::ResultBufferTooSmall { needed, got }
         },
+        QueryError::NoRoomForGradient => ClientError::InvalidArgument(NO_GRADIENT_BUFFER),
         QueryError::Connection(e) => e.into(),
     }
 }
@@ -596,6 +610,7 @@ mod tests {
             QueryError::EmptyBatch => Some(C::EmptyBatch),
             QueryError::BatchTooLarge => Some(C::BatchTooLarge),
             QueryError::Internal => Some(C::Internal),
+            QueryError::NoRoomForGradient => None,
             QueryError::Connection(gone()) => None,
             PoseReadError::BatchTooLarge => Some(C::BatchTooLarge),
             PoseReadError::Internal => Some(C::Internal),
@@ -653,6 +668,10 @@ mod tests {
         assert_eq!(
             ClientError::from(QueryError::ResultBufferTooSmall { needed: 3, got: 2 }),
             ClientError::ResultBufferTooSmall { needed: 3, got: 2 }
+        );
+        assert_eq!(
+            ClientError::from(QueryError::NoRoomForGradient),
+            ClientError::InvalidArgument(NO_GRADIENT_BUFFER)
         );
         // A connection fault reads the same in every error.
         let e = QueryError::Connection(ConnectError::Timeout(Duration::from_secs(1)));

@@ -8,10 +8,22 @@ use nalgebra::Isometry3;
 
 #[cfg(doc)]
 use crate::ServerInfo;
+use gjkd_proto::{Gradient, GradientRow, ReplyEntry, item_flags};
+
+use crate::op_error::NO_GRADIENT_BUFFER;
 use crate::{
     Answer, Client, ClientError, ErrorCode, Item, ItemResult, ObjectId, PoseError, QueryError,
     QueryOptions, Waited, ipc_err, op_error, reply_accepted,
 };
+
+/// The query error of a failure of the shared plumbing: a gradient asked
+/// with no room for it is the caller's, the rest as [`op_error`] says.
+fn query_error(e: ClientError) -> QueryError {
+    match e {
+        ClientError::InvalidArgument(NO_GRADIENT_BUFFER) => QueryError::NoRoomForGradient,
+        e => op_error(e),
+    }
+}
 
 impl Client {
     /// Stores a new pose for `id`, used by every later query (of any client)
@@ -71,10 +83,13 @@ impl Client {
     /// queries after it. Each result has its own error code (see
     /// [`ItemResult::answer`]); the call itself fails only if the whole
     /// request does. Allocates nothing of its own (iceoryx2 0.10 makes one
-    /// small allocation per request for its loan bookkeeping).
+    /// small allocation per request for its loan bookkeeping). Items that
+    /// ask for a gradient go through [`Client::query_batch_gradients`].
     ///
     /// # Errors
-    /// [`QueryError::ResultBufferTooSmall`]; [`QueryError::EmptyBatch`] or
+    /// [`QueryError::ResultBufferTooSmall`];
+    /// [`QueryError::NoRoomForGradient`] when an item asks for a gradient
+    /// (nothing is sent); [`QueryError::EmptyBatch`] or
     /// [`QueryError::BatchTooLarge`] (more than [`ServerInfo::max_batch`]
     /// items); and the connection faults.
     pub fn query_batch(
@@ -88,7 +103,60 @@ impl Client {
                 got: results.len(),
             });
         }
-        self.batch(items, results).map_err(op_error)
+        self.batch(items, results).map_err(query_error)
+    }
+
+    /// As [`Client::query_batch`], and the gradient of the `k`-th item that
+    /// asks for one ([`Item::with_gradient`], see [`Gradient`]) into
+    /// `gradients[k]`, a buffer the caller owns and keeps from call to
+    /// call ([`Gradient::NONE`] for an item that failed). Only the items
+    /// that ask carry a gradient, in the reply too. Returns how many
+    /// gradients were written.
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`], and [`QueryError::NoRoomForGradient`]
+    /// when `gradients` is shorter than the items that ask for one
+    /// (nothing is sent).
+    pub fn query_batch_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<usize, QueryError> {
+        if results.len() < items.len() {
+            return Err(QueryError::ResultBufferTooSmall {
+                needed: items.len(),
+                got: results.len(),
+            });
+        }
+        let asked = ReplyEntry::gradients_asked(items);
+        if asked > gradients.len() {
+            return Err(QueryError::NoRoomForGradient);
+        }
+        self.batch_gradients(items, results, gradients)
+            .map_err(query_error)?;
+        Ok(asked)
+    }
+
+    /// [`Client::query_batch_gradients`] for the calls built on it
+    /// (`gradients` has room for every gradient asked).
+    pub(crate) fn batch_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Taken,
+            |payload, rows| {
+                results[..payload.len()].copy_from_slice(payload);
+                for (out, row) in gradients.iter_mut().zip(rows) {
+                    *out = row.gradient;
+                }
+            },
+        )
     }
 
     /// [`Client::query_batch`] for the calls built on it, which say what
@@ -101,7 +169,8 @@ impl Client {
         self.round_trip(
             items.len(),
             Source::<fn(usize) -> Item>::Slice(items),
-            |payload| results[..payload.len()].copy_from_slice(payload),
+            Gradients::Refused,
+            |payload, _| results[..payload.len()].copy_from_slice(payload),
         )
     }
 
@@ -118,8 +187,34 @@ impl Client {
         items: &[Item],
         read: impl FnOnce(&[ItemResult]),
     ) -> Result<(), QueryError> {
-        self.round_trip(items.len(), Source::<fn(usize) -> Item>::Slice(items), read)
-            .map_err(op_error)
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Refused,
+            |results, _| read(results),
+        )
+        .map_err(query_error)
+    }
+
+    /// As [`Client::query_batch_read`], for items that may ask for
+    /// gradients: `read` gets the results and, straight from the
+    /// response's shared memory too, the gradient rows, one per item that
+    /// asked, in item order ([`GradientRow::item`] names it).
+    ///
+    /// # Errors
+    /// As [`Client::query_batch`], but for gradients.
+    pub fn query_batch_read_gradients(
+        &mut self,
+        items: &[Item],
+        read: impl FnOnce(&[ItemResult], &[GradientRow]),
+    ) -> Result<(), QueryError> {
+        self.round_trip(
+            items.len(),
+            Source::<fn(usize) -> Item>::Slice(items),
+            Gradients::Taken,
+            read,
+        )
+        .map_err(query_error)
     }
 
     /// As [`Client::query_batch`], but item `i` of the `count` items is
@@ -137,17 +232,20 @@ impl Client {
         item: impl FnMut(usize) -> Item,
         read: impl FnOnce(&[ItemResult]),
     ) -> Result<(), QueryError> {
-        self.round_trip(count, Source::Fn(item), read)
-            .map_err(op_error)
+        self.round_trip(count, Source::Fn(item), Gradients::Refused, |results, _| {
+            read(results)
+        })
+        .map_err(query_error)
     }
 
     /// Sends `count` items from `source` as one request and hands the
-    /// results to `read`.
+    /// results and the gradient rows to `read`.
     fn round_trip<F: FnMut(usize) -> Item>(
         &mut self,
         count: usize,
         source: Source<'_, F>,
-        read: impl FnOnce(&[ItemResult]),
+        gradients: Gradients,
+        read: impl FnOnce(&[ItemResult], &[GradientRow]),
     ) -> Result<(), ClientError> {
         let deadline = Instant::now() + self.timeout;
         self.ensure_connected(deadline)?;
@@ -165,6 +263,16 @@ impl Client {
                 Source::Slice(items) => loan.write_from_slice(items),
                 Source::Fn(item) => loan.write_from_fn(item),
             };
+            // A gradient asked with nowhere to go is refused before anything
+            // is sent (one pass over the flags, branch-free).
+            if matches!(gradients, Gradients::Refused)
+                && request.payload().iter().fold(0, |acc, i| acc | i.flags) & item_flags::GRADIENT
+                    != 0
+            {
+                return Err(Waited::Failed(ClientError::InvalidArgument(
+                    NO_GRADIENT_BUFFER,
+                )));
+            }
             let pending = request
                 .send()
                 .map_err(|e| conn.send_failed(&self.node, "query send", e))?;
@@ -178,21 +286,35 @@ impl Client {
                 let header = *response.user_header();
                 reply_accepted(header.error)?;
                 let payload = response.payload();
-                if payload.len() != count {
+                let rows = header.gradients as usize;
+                let split = ReplyEntry::split(payload, count)
+                    .filter(|_| header.count as usize == count && payload.len() == count + rows);
+                let Some((results, gradient_rows)) = split else {
                     return Err(ClientError::Protocol(format!(
-                        "{} results for {} items",
+                        "{} entries ({} results, {} gradients) for {} items",
                         payload.len(),
+                        header.count,
+                        rows,
                         count
                     )));
-                }
+                };
                 if let Some(read) = read.take() {
-                    read(payload);
+                    read(results, gradient_rows);
                 }
                 Ok(Some(()))
             })
         })();
         self.settle(outcome)
     }
+}
+
+/// Whether a call takes the gradients its items ask for.
+#[derive(Clone, Copy)]
+enum Gradients {
+    /// It has nowhere to put them: an item that asks is refused.
+    Refused,
+    /// It hands them to its reader.
+    Taken,
 }
 
 /// Where the items of a request come from.

@@ -279,7 +279,7 @@ impl From<&SceneRow> for ScenePair {
             a: ObjectId::from_raw(row.a),
             b: (row.b != 0).then(|| ObjectId::from_raw(row.b)),
             step: row.step,
-            answer: row.result.answer(),
+            answer: row.result.answer_with(Some(&row.gradient)),
         }
     }
 }
@@ -383,7 +383,7 @@ impl<'c, 'a> SceneQuery<'c, 'a> {
     }
 
     /// Every row also carries its distance's gradient
-    /// ([`SceneRow`]'s `result.gradient`, [`Answer::gradient`]) with respect
+    /// ([`SceneRow::gradient`], [`Answer::gradient`]) with respect
     /// to the coordinates that move its `a` (see [`crate::gradient_matrix`]);
     /// `base` adds a robot base's twist. Rows the server would answer
     /// from a motion bound or an early exit are asked to convergence.
@@ -840,6 +840,7 @@ mod tests {
             step: 4,
             reserved: 0,
             result: ItemResult::default(),
+            gradient: gjkd_proto::Gradient::NONE,
             s_lo: 0.0,
             s_hi: 0.0,
         };

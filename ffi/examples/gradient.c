@@ -60,13 +60,19 @@ int main(int argc, char **argv) {
     gjkd_pair_query row = gjkd_pair_query_of(rod, ball, NULL);
     row.flags |= GJKD_PAIR_GRADIENT; /* | GJKD_PAIR_GRADIENT_BASE */
     gjkd_result result;
-    check(gjkd_query_pairs(c, &row, 1, &result), "gjkd_query_pairs");
+    gjkd_gradient gradient; /* one per row that asks; keep it from call to call */
+    size_t gradients = 0;
+    check(gjkd_query_pairs_gradients(c, &row, 1, &result, &gradient, 1, &gradients),
+          "gjkd_query_pairs_gradients");
     expect("rod-ball distance", result.distance, 0.35);
-    expect("d distance / d j", result.gradient.values[0], -0.8);
-    printf("pair columns           %u\n", result.gradient.columns);
-    failures += result.gradient.columns != 1;
-    failures += !(result.gradient.flags & GJKD_GRADIENT_PRESENT);
-    failures += (result.gradient.flags & GJKD_GRADIENT_NOT_UNIQUE) != 0;
+    expect("d distance / d j", gradient.values[0], -0.8);
+    printf("pair columns           %u\n", gradient.columns);
+    failures += gradients != 1;
+    failures += gradient.columns != 1;
+    failures += !(gradient.flags & GJKD_GRADIENT_PRESENT);
+    failures += (gradient.flags & GJKD_GRADIENT_NOT_UNIQUE) != 0;
+    /* Without a gradient array the row is refused, nothing sent. */
+    failures += gjkd_query_pairs(c, &row, 1, &result) != GJKD_ERR_INVALID_ARGUMENT;
 
     /* Every pair within 1 m, each row with its gradient. */
     gjkd_scene_options options = gjkd_scene_options_default();

@@ -71,7 +71,7 @@
 #define GJKD_GRADIENT_COLUMNS 16
 
 // `gjkd_pair_query::flags` bit (OR it in): also the distance's gradient,
-// into the result's `gradient`.
+// into the caller's gradient array of `gjkd_query_pairs_gradients()`.
 #define GJKD_PAIR_GRADIENT (1 << 8)
 
 // `gjkd_pair_query::flags` bit, with `GJKD_PAIR_GRADIENT`: when `a` is a
@@ -618,25 +618,6 @@ typedef struct gjkd_pair_query {
   uint32_t reserved;
 } gjkd_pair_query;
 
-// The gradient of a pair's distance `d` with respect to the coordinates
-// that move its object `a`: `values[k] = ∂d/∂x_k` for `k < columns`. When
-// `a` is a robot link, the coordinates are the robot's moving joints (in
-// `gjkd_robot_joint_name()` order; a self-collision pair's other link
-// moves too), then, with the base asked, the base twist `[v, ω]` (world
-// frame, turning about the base origin); for any other object, its
-// pose's twist. `error` bounds each entry's error from the distance's
-// certified interval.
-typedef struct gjkd_gradient {
-  // `∂d/∂x_k`, zero beyond `columns`.
-  double values[GJKD_GRADIENT_COLUMNS];
-  // Entries in use; 0 when not asked.
-  uint32_t columns;
-  // `GJKD_GRADIENT_*` bits.
-  uint32_t flags;
-  // A bound on each entry's error from the distance's interval.
-  double error;
-} gjkd_gradient;
-
 // The answer row of one pair of a `gjkd_query_pairs()` batch, laid out
 // as the server writes it (so a batch's answers are copied into the
 // caller's array in one piece). Distances are after radii; points in world
@@ -678,10 +659,26 @@ typedef struct gjkd_result {
   double signed_lower;
   // Certified upper bound on the signed distance (when flagged).
   double signed_upper;
-  // The distance's gradient, with `GJKD_PAIR_GRADIENT` in the row's
-  // flags (`columns` 0 otherwise).
-  struct gjkd_gradient gradient;
 } gjkd_result;
+
+// The gradient of a pair's distance `d` with respect to the coordinates
+// that move its object `a`: `values[k] = ∂d/∂x_k` for `k < columns`. When
+// `a` is a robot link, the coordinates are the robot's moving joints (in
+// `gjkd_robot_joint_name()` order; a self-collision pair's other link
+// moves too), then, with the base asked, the base twist `[v, ω]` (world
+// frame, turning about the base origin); for any other object, its
+// pose's twist. `error` bounds each entry's error from the distance's
+// certified interval.
+typedef struct gjkd_gradient {
+  // `∂d/∂x_k`, zero beyond `columns`.
+  double values[GJKD_GRADIENT_COLUMNS];
+  // Entries in use; 0 when not asked.
+  uint32_t columns;
+  // `GJKD_GRADIENT_*` bits.
+  uint32_t flags;
+  // A bound on each entry's error from the distance's interval.
+  double error;
+} gjkd_gradient;
 
 // Options of a scene query; start from `gjkd_scene_options_default()`.
 typedef struct gjkd_scene_options {
@@ -1552,7 +1549,9 @@ struct gjkd_pair_query gjkd_pair_query_of(gjkd_id a,
 // `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
 // than any array; a row not made by `gjkd_pair_query_of()`, or whose
 // `flags` has bits other than those it set and `GJKD_POSE_A |
-// GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);
+// GJKD_POSE_B` (a row asking `GJKD_PAIR_GRADIENT` goes through
+// `gjkd_query_pairs_gradients()`), or whose `reserved` is not 0:
+// nothing is sent);
 // `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks answered
 // before are written, the others left as they were).
 //
@@ -1563,6 +1562,30 @@ enum gjkd_status gjkd_query_pairs(struct gjkd_client *client,
                                   const struct gjkd_pair_query *queries,
                                   size_t count,
                                   struct gjkd_result *out);
+
+// As `gjkd_query_pairs()`, for rows that may ask for their distance's
+// gradient (`row.flags |= GJKD_PAIR_GRADIENT`, and
+// `GJKD_PAIR_GRADIENT_BASE`): the gradient of the `k`-th row that asks
+// goes into `gradients[k]` (an array the caller owns and keeps from call
+// to call; a row that failed gets `columns` and `flags` 0), and
+// `*written` (if not NULL) is set to the number of gradients written.
+// Only the rows that ask carry a gradient, in the reply too: rows that
+// ask none cost what they cost in `gjkd_query_pairs()`.
+//
+// Errors: those of `gjkd_query_pairs()`, and
+// `GJKD_ERR_INVALID_ARGUMENT` when `gradient_count` is less than the rows
+// that ask (nothing is sent); `gradients` may be NULL when none asks.
+//
+// # Safety
+// As `gjkd_query_pairs()`; `gradients` NULL or `gradient_count` writable
+// rows; `written` NULL or writable.
+enum gjkd_status gjkd_query_pairs_gradients(struct gjkd_client *client,
+                                            const struct gjkd_pair_query *queries,
+                                            size_t count,
+                                            struct gjkd_result *out,
+                                            struct gjkd_gradient *gradients,
+                                            size_t gradient_count,
+                                            size_t *written);
 
 // The default scene options: default tolerance and iteration cap, warm
 // starts and motion bounds on, no accepted accuracy, no cut-off.

@@ -72,6 +72,8 @@ using Options = gjkd_query_options;
 using PairQuery = gjkd_pair_query;
 /// An answer row of Client::query_pairs() (`error` 0 when answered).
 using Result = gjkd_result;
+/// A distance gradient (GJKD_PAIR_GRADIENT rows, scene rows' `gradient`).
+using Gradient = gjkd_gradient;
 /// A convex shape (see sphere(), capsule(), box(), polytope()).
 using Shape = gjkd_shape;
 /// A piece of a compound: an offset and a convex shape.
@@ -774,6 +776,28 @@ public:
     void query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out) {
         if (out.size() != queries.size()) out.resize(queries.size());
         query_pairs(queries.data(), queries.size(), out.data());
+    }
+    /// As query_pairs(), for rows that may ask for their gradient
+    /// (`row.flags |= GJKD_PAIR_GRADIENT`): the gradient of the k-th row
+    /// that asks into `gradients[k]` (room for `gradient_count`); returns
+    /// how many were written. Only rows that ask carry one.
+    std::size_t query_pairs(const PairQuery *queries, std::size_t count, Result *out,
+                            Gradient *gradients, std::size_t gradient_count) {
+        std::size_t written = 0;
+        check(gjkd_query_pairs_gradients(handle_, queries, count, out, gradients, gradient_count,
+                                         &written));
+        return written;
+    }
+    /// As above with vectors: `out` resized to match `queries`, `gradients`
+    /// to the rows that ask (both allocate only when growing).
+    std::size_t query_pairs(const std::vector<PairQuery> &queries, std::vector<Result> &out,
+                            std::vector<Gradient> &gradients) {
+        if (out.size() != queries.size()) out.resize(queries.size());
+        std::size_t asked = 0;
+        for (const PairQuery &q : queries) asked += (q.flags & GJKD_PAIR_GRADIENT) != 0;
+        if (gradients.size() < asked) gradients.resize(asked);
+        return query_pairs(queries.data(), queries.size(), out.data(), gradients.data(),
+                           gradients.size());
     }
 
 #ifdef GJKD_HAS_SPAN

@@ -1,4 +1,5 @@
-//! Distance gradients: a pair row's (`GJKD_PAIR_GRADIENT`) and a scene
+//! Distance gradients: a pair row's (`GJKD_PAIR_GRADIENT`, answered by
+//! `gjkd_query_pairs_gradients()`) and a scene
 //! row's (`gjkd_scene_options::gradients`), with respect to the
 //! coordinates that move the pair's first object.
 
@@ -11,7 +12,7 @@ pub const GJKD_GRADIENT_COLUMNS: usize = 16;
 const _: () = assert!(GJKD_GRADIENT_COLUMNS == GRADIENT_COLUMNS);
 
 /// `gjkd_pair_query::flags` bit (OR it in): also the distance's gradient,
-/// into the result's `gradient`.
+/// into the caller's gradient array of `gjkd_query_pairs_gradients()`.
 pub const GJKD_PAIR_GRADIENT: u32 = 1 << 8;
 const _: () = assert!(GJKD_PAIR_GRADIENT == item_flags::GRADIENT);
 

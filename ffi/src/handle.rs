@@ -149,6 +149,42 @@ impl gjkd_client {
     }
 }
 
+impl gjkd_client {
+    /// As [`gjkd_client::run_slices`], and the gradient of the `k`-th item
+    /// that asks for one into `gradients[k]` (long enough for all of
+    /// them); returns how many were written.
+    ///
+    /// # Errors
+    /// As [`gjkd_client::run_slices`].
+    pub fn run_slices_gradients(
+        &mut self,
+        items: &[Item],
+        out: &mut [ItemResult],
+        gradients: &mut [gjkd_proto::Gradient],
+    ) -> Result<usize, Failure> {
+        let (mut start, mut written) = (0, 0);
+        while start < items.len() {
+            let max = self.max_batch();
+            let end = items.len().min(start + max);
+            let chunk = self.client.query_batch_gradients(
+                &items[start..end],
+                &mut out[start..end],
+                &mut gradients[written..],
+            );
+            match chunk {
+                Ok(n) => {
+                    start = end;
+                    written += n;
+                }
+                // As in `run`.
+                Err(QueryError::BatchTooLarge) if self.max_batch() < max => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        Ok(written)
+    }
+}
+
 /// Gives the handle back when a call ends, also by a panic.
 struct Release<'a>(&'a AtomicBool);
 

@@ -2,11 +2,14 @@
 //! out as the server reads its requests, and a `gjkd_result` row per pair
 //! out, laid out as it writes its answers, so that a batch is copied in one
 //! piece each way between the caller's memory and shared memory, as the
-//! Rust client's `query_batch` does.
+//! Rust client's `query_batch` does. Gradients, asked row by row
+//! (`GJKD_PAIR_GRADIENT`), come apart, into a `gjkd_gradient` array of
+//! the caller's (`gjkd_query_pairs_gradients()`): a row that asks none
+//! carries none, in the reply too.
 
 use std::mem::offset_of;
 
-use gjkd_proto::{ItemKind, Pose, item_flags};
+use gjkd_proto::{Gradient, ItemKind, Pose, ReplyEntry, item_flags};
 use rust_client::{Item, ItemResult};
 
 use crate::args::{slice, slice_mut};
@@ -46,9 +49,11 @@ const ROW_FLAGS: u32 = item_flags::POSE_A
     | item_flags::MARGIN
     | item_flags::WARM_START
     | item_flags::SINGLE_PRECISION
-    | item_flags::SIGNED_DISTANCE
-    | item_flags::GRADIENT
-    | item_flags::GRADIENT_BASE;
+    | item_flags::SIGNED_DISTANCE;
+
+/// `flags` bits a row of `gjkd_query_pairs_gradients()` may carry: those
+/// of `gjkd_query_pairs()` and the gradient's.
+const GRADIENT_ROW_FLAGS: u32 = ROW_FLAGS | item_flags::GRADIENT | item_flags::GRADIENT_BASE;
 
 /// One pair of a `gjkd_query_pairs()` batch, laid out as the request the
 /// server reads (so a batch of rows is copied into it in one piece). Make
@@ -148,9 +153,6 @@ pub struct gjkd_result {
     pub signed_lower: f64,
     /// Certified upper bound on the signed distance (when flagged).
     pub signed_upper: f64,
-    /// The distance's gradient, with `GJKD_PAIR_GRADIENT` in the row's
-    /// flags (`columns` 0 otherwise).
-    pub gradient: gjkd_gradient,
 }
 
 // `gjkd_result` is `ItemResult` under a C name: same size, alignment and
@@ -173,7 +175,6 @@ const _: () = {
     assert!(offset_of!(gjkd_result, signed_distance) == offset_of!(ItemResult, signed_distance));
     assert!(offset_of!(gjkd_result, signed_lower) == offset_of!(ItemResult, signed_lower));
     assert!(offset_of!(gjkd_result, signed_upper) == offset_of!(ItemResult, signed_upper));
-    assert!(offset_of!(gjkd_result, gradient) == offset_of!(ItemResult, gradient));
 };
 
 /// A row asking the distance of `a` and `b` at their stored poses, with
@@ -239,7 +240,9 @@ pub unsafe extern "C" fn gjkd_pair_query_of(
 /// `GJKD_ERR_BUSY`, `GJKD_ERR_INVALID_ARGUMENT` (a count larger
 /// than any array; a row not made by `gjkd_pair_query_of()`, or whose
 /// `flags` has bits other than those it set and `GJKD_POSE_A |
-/// GJKD_POSE_B`, or whose `reserved` is not 0: nothing is sent);
+/// GJKD_POSE_B` (a row asking `GJKD_PAIR_GRADIENT` goes through
+/// `gjkd_query_pairs_gradients()`), or whose `reserved` is not 0:
+/// nothing is sent);
 /// `GJKD_ERR_SERVER_GONE`, `GJKD_ERR_TIMEOUT` (rows of the chunks answered
 /// before are written, the others left as they were).
 ///
@@ -262,11 +265,80 @@ pub unsafe extern "C" fn gjkd_query_pairs(
                 }
                 let queries = slice(queries, count, "queries")?;
                 let out = slice_mut(out, count, "out")?.ok_or_else(|| Failure::null("out"))?;
-                check_rows(queries)?;
+                check_rows(queries, ROW_FLAGS)?;
                 c.run_slices(as_items(queries), as_item_results(out))
             })
         }
     })
+}
+
+/// As `gjkd_query_pairs()`, for rows that may ask for their distance's
+/// gradient (`row.flags |= GJKD_PAIR_GRADIENT`, and
+/// `GJKD_PAIR_GRADIENT_BASE`): the gradient of the `k`-th row that asks
+/// goes into `gradients[k]` (an array the caller owns and keeps from call
+/// to call; a row that failed gets `columns` and `flags` 0), and
+/// `*written` (if not NULL) is set to the number of gradients written.
+/// Only the rows that ask carry a gradient, in the reply too: rows that
+/// ask none cost what they cost in `gjkd_query_pairs()`.
+///
+/// Errors: those of `gjkd_query_pairs()`, and
+/// `GJKD_ERR_INVALID_ARGUMENT` when `gradient_count` is less than the rows
+/// that ask (nothing is sent); `gradients` may be NULL when none asks.
+///
+/// # Safety
+/// As `gjkd_query_pairs()`; `gradients` NULL or `gradient_count` writable
+/// rows; `written` NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn gjkd_query_pairs_gradients(
+    client: *mut gjkd_client,
+    queries: *const gjkd_pair_query,
+    count: usize,
+    out: *mut gjkd_result,
+    gradients: *mut gjkd_gradient,
+    gradient_count: usize,
+    written: *mut usize,
+) -> gjkd_status {
+    guard("gjkd_query_pairs_gradients", || {
+        // SAFETY: the caller's promises.
+        unsafe {
+            if let Some(w) = written.as_mut() {
+                *w = 0;
+            }
+            with_client(client, |c| {
+                if count == 0 {
+                    return Ok(());
+                }
+                let queries = slice(queries, count, "queries")?;
+                let out = slice_mut(out, count, "out")?.ok_or_else(|| Failure::null("out"))?;
+                check_rows(queries, GRADIENT_ROW_FLAGS)?;
+                let items = as_items(queries);
+                let asked = ReplyEntry::gradients_asked(items);
+                let gradients = match slice_mut(gradients, gradient_count, "gradients")? {
+                    Some(g) => g,
+                    None if asked == 0 => &mut [],
+                    None => return Err(Failure::null("gradients")),
+                };
+                if gradients.len() < asked {
+                    return Err(Failure::invalid(format!(
+                        "gradient_count {gradient_count}: {asked} rows ask for a gradient"
+                    )));
+                }
+                let n =
+                    c.run_slices_gradients(items, as_item_results(out), as_gradients(gradients))?;
+                if let Some(w) = written.as_mut() {
+                    *w = n;
+                }
+                Ok(())
+            })
+        }
+    })
+}
+
+/// The caller's gradient rows as the wire's gradients (same layout).
+fn as_gradients(out: &mut [gjkd_gradient]) -> &mut [Gradient] {
+    // SAFETY: same size, alignment and field offsets (asserted in
+    // `gradient.rs`), every bit pattern valid in both.
+    unsafe { std::slice::from_raw_parts_mut(out.as_mut_ptr().cast(), out.len()) }
 }
 
 /// The caller's rows as the wire's items (same layout).
@@ -285,9 +357,9 @@ fn as_item_results(out: &mut [gjkd_result]) -> &mut [ItemResult] {
 /// Refuses the first row that is not a distance query or has bits the API
 /// does not define, by index: such a row could change what the server
 /// stores, or ask what this call does not document.
-fn check_rows(queries: &[gjkd_pair_query]) -> Result<(), Failure> {
+fn check_rows(queries: &[gjkd_pair_query], allowed: u32) -> Result<(), Failure> {
     let distance = ItemKind::Distance as u32;
-    let bad = |q: &gjkd_pair_query| (q.kind ^ distance) | (q.flags & !ROW_FLAGS) | q.reserved;
+    let bad = |q: &gjkd_pair_query| (q.kind ^ distance) | (q.flags & !allowed) | q.reserved;
     // One branch-free pass first: rows are almost always right.
     if queries.iter().fold(0, |acc, q| acc | bad(q)) == 0 {
         return Ok(());
@@ -299,10 +371,15 @@ fn check_rows(queries: &[gjkd_pair_query]) -> Result<(), Failure> {
             "queries[{i}]: kind {} is not a distance query: make rows with gjkd_pair_query_of()",
             q.kind
         )
-    } else if q.flags & !ROW_FLAGS != 0 {
+    } else if q.flags & !allowed & GRADIENT_ROW_FLAGS != 0 {
         format!(
-            "queries[{i}]: flags {:#x} has bits other than GJKD_POSE_A | GJKD_POSE_B and \
-             those of gjkd_pair_query_of()",
+            "queries[{i}]: asks for a gradient (GJKD_PAIR_GRADIENT): use \
+             gjkd_query_pairs_gradients()"
+        )
+    } else if q.flags & !allowed != 0 {
+        format!(
+            "queries[{i}]: flags {:#x} has bits other than GJKD_POSE_A | GJKD_POSE_B, \
+             GJKD_PAIR_GRADIENT | GJKD_PAIR_GRADIENT_BASE and those of gjkd_pair_query_of()",
             q.flags
         )
     } else {

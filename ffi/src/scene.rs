@@ -381,7 +381,7 @@ fn scene_row(row: &SceneRow) -> gjkd_scene_row {
         step: row.step,
         error: row.result.error,
         answer: gjkd_answer::from(&row.result),
-        gradient: gjkd_gradient::from(&row.result.gradient),
+        gradient: gjkd_gradient::from(&row.gradient),
         s_lo: row.s_lo,
         s_hi: row.s_hi,
     }

@@ -263,7 +263,6 @@ fn rows_equal_the_rust_clients_answers_over_several_chunks() {
             signed_distance: want.signed_distance,
             signed_lower: want.signed_lower,
             signed_upper: want.signed_upper,
-            gradient: Default::default(),
         };
         assert_eq!(bits(got), bits(&want_row), "row {i}");
         assert_eq!(
@@ -413,6 +412,33 @@ fn whole_call_errors_are_reported_and_send_nothing() {
             GJKD_ERR_INVALID_ARGUMENT,
             "reserved 1 is not 0",
         );
+        // A row asking for a gradient needs the gradient call, and room
+        // for every gradient asked.
+        let asks = [
+            good[0],
+            gjkd_pair_query {
+                flags: good[0].flags | GJKD_PAIR_GRADIENT,
+                ..good[0]
+            },
+        ];
+        assert_fails(
+            gjkd_query_pairs(c, asks.as_ptr(), 2, o),
+            GJKD_ERR_INVALID_ARGUMENT,
+            "queries[1]: asks for a gradient",
+        );
+        let mut written = 7;
+        assert_fails(
+            gjkd_query_pairs_gradients(c, asks.as_ptr(), 2, o, null_mut(), 0, &mut written),
+            GJKD_ERR_NULL_POINTER,
+            "gradients is NULL",
+        );
+        let mut room: [gjkd_gradient; 0] = [];
+        assert_fails(
+            gjkd_query_pairs_gradients(c, asks.as_ptr(), 2, o, room.as_mut_ptr(), 0, &mut written),
+            GJKD_ERR_INVALID_ARGUMENT,
+            "gradient_count 0: 1 rows ask for a gradient",
+        );
+        assert_eq!(written, 0);
         // A count of 0 does nothing, whatever the arrays.
         ok(gjkd_query_pairs(c, null(), 0, null_mut()));
     }

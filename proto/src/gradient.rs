@@ -1,5 +1,7 @@
 //! The gradient of a pair's distance with respect to the coordinates that
-//! move its first object, as it travels in an [`ItemResult`](crate::ItemResult).
+//! move its first object, as it travels in a query reply's gradient
+//! section ([`GradientRow`](crate::GradientRow)) or a scene row
+//! ([`SceneRow::gradient`](crate::SceneRow::gradient)).
 //!
 //! Asked with [`item_flags::GRADIENT`](crate::item_flags::GRADIENT) on a
 //! pair query or [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS)

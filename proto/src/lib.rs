@@ -11,7 +11,7 @@
 //!
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
-//! | [`query_service_name`] `{service}/v3/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ItemResult`]`]` |
+//! | [`query_service_name`] `{service}/v3/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ReplyEntry`]`]` (results, then gradients) |
 //! | [`admin_service_name`] `{service}/v3/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
 //! | [`scene_service_name`] `{service}/v3/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
 //! | [`poses_service_name`] `{service}/v3/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
@@ -53,6 +53,7 @@ mod item;
 mod item_body;
 mod pose;
 mod poses;
+mod reply_entry;
 mod result;
 mod scene;
 mod shape;
@@ -70,6 +71,7 @@ pub use item::{Item, ItemKind, Precision, QueryOptions, item_flags};
 pub use item_body::{ItemBody, JointsBody, PairBody};
 pub use pose::{MAX_TRANSLATION, Pose, UNIT_TOLERANCE};
 pub use poses::{PosesReply, StoredPose};
+pub use reply_entry::{GradientRow, ReplyEntry};
 pub use result::{Answer, ItemResult, ReplyHeader, SignedDistance, Status, result_flags};
 pub use scene::{
     DEFAULT_BRACKET, PathMode, SceneKind, SceneReply, SceneRequest, SceneRow, scene_flags,
@@ -86,7 +88,10 @@ pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
 /// item's body is a pair view or a joints view ([`ItemBody`]), robot text
 /// travels as bytes ([`AdminChunk`]), results carry the signed distance
 /// and the gradient, scene requests the continuous mode and its bracket,
-/// and stored poses are read back on a service of their own.
+/// and stored poses are read back on a service of their own. A query
+/// reply's gradients travel after its results, only for the items that
+/// ask ([`ReplyEntry`]), and a scene row's beside its result
+/// ([`SceneRow::gradient`]).
 pub const PROTOCOL_VERSION: u32 = 3;
 
 /// Service name used when none is given: `"gjkd"`.

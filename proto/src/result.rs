@@ -104,10 +104,6 @@ pub struct ItemResult {
     pub signed_lower: f64,
     /// Certified upper bound on the signed distance (when flagged).
     pub signed_upper: f64,
-    /// The distance's gradient, when asked
-    /// ([`item_flags::GRADIENT`](crate::item_flags::GRADIENT),
-    /// [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS)).
-    pub gradient: Gradient,
 }
 
 impl ItemResult {
@@ -129,7 +125,6 @@ impl ItemResult {
             signed_distance: 0.0,
             signed_lower: 0.0,
             signed_upper: 0.0,
-            gradient: Gradient::NONE,
         }
     }
 
@@ -139,8 +134,17 @@ impl ItemResult {
     }
 
     /// The answer of a distance query, or the item's error. A successful pose
-    /// update reads as an answer with status `None`.
+    /// update reads as an answer with status `None`. The gradient travels
+    /// apart ([`GradientRow`](crate::GradientRow)): the answer's is `None`;
+    /// [`ItemResult::answer_with`] joins one in.
     pub fn answer(&self) -> Result<Answer, ErrorCode> {
+        self.answer_with(None)
+    }
+
+    /// As [`ItemResult::answer`], with `gradient` (the item's, from the
+    /// reply's gradient section) as [`Answer::gradient`] when it is
+    /// present.
+    pub fn answer_with(&self, gradient: Option<&Gradient>) -> Result<Answer, ErrorCode> {
         match self.error_code() {
             ErrorCode::Ok => Ok(Answer {
                 distance: self.distance,
@@ -162,7 +166,7 @@ impl ItemResult {
                         upper: self.signed_upper,
                     },
                 ),
-                gradient: self.gradient.is_present().then_some(self.gradient),
+                gradient: gradient.filter(|g| g.is_present()).copied(),
             }),
             code => Err(code),
         }
@@ -210,7 +214,9 @@ pub struct Answer {
     /// `point_a`, `point_b` and `normal` are then its witnesses and
     /// direction, also when the shapes overlap.
     pub signed: Option<SignedDistance>,
-    /// The distance's gradient, when asked (see [`Gradient`]).
+    /// The distance's gradient, when asked (see [`Gradient`]) and joined
+    /// in by [`ItemResult::answer_with`] (the client's
+    /// `distance_gradient` does).
     pub gradient: Option<Gradient>,
 }
 
@@ -227,8 +233,9 @@ pub struct SignedDistance {
     pub upper: f64,
 }
 
-/// Response header of the query service: whole-request errors. When `error`
-/// is not [`ErrorCode::Ok`] the result slice is empty.
+/// Response header of the query service: whole-request errors, and how
+/// the reply's slice of [`ReplyEntry`](crate::ReplyEntry)s divides. When `error` is not
+/// [`ErrorCode::Ok`] the slice is empty.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("gjkd.v3.ReplyHeader")]
@@ -236,6 +243,13 @@ pub struct ReplyHeader {
     /// [`ErrorCode`] wire value: [`ErrorCode::EmptyBatch`],
     /// [`ErrorCode::BatchTooLarge`], or [`ErrorCode::Ok`].
     pub error: u32,
-    /// Number of results that follow.
+    /// Number of results that follow: the slice's first `count` entries,
+    /// one per item.
     pub count: u32,
+    /// Number of gradients after the results: one per item flagged
+    /// [`item_flags::GRADIENT`](crate::item_flags::GRADIENT), in item
+    /// order.
+    pub gradients: u32,
+    /// Zero.
+    pub reserved: u32,
 }

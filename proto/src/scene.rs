@@ -18,7 +18,7 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
-use crate::{DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, ErrorCode, ItemResult};
+use crate::{DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, ErrorCode, Gradient, ItemResult};
 
 /// The question of a [`SceneRequest`]; the wire values of
 /// [`SceneRequest::kind`].
@@ -152,7 +152,8 @@ pub mod scene_flags {
     pub const SELF_PAIRS: u32 = 1 << 10;
     /// Every row also carries its distance's gradient with respect to the
     /// coordinates that move its `a` object (see
-    /// [`Gradient`](crate::Gradient)), at the row's step.
+    /// [`Gradient`](crate::Gradient)), at the row's step, in
+    /// [`SceneRow::gradient`](super::SceneRow::gradient).
     pub const GRADIENTS: u32 = 1 << 7;
     /// With [`GRADIENTS`], rows of robot links: the base pose's twist too.
     pub const GRADIENT_BASE: u32 = 1 << 8;
@@ -315,6 +316,9 @@ pub struct SceneRow {
     /// With [`scene_flags::SIGNED_DISTANCE`], its signed-distance fields
     /// hold the pair's signed distance.
     pub result: ItemResult,
+    /// The pair's gradient with [`scene_flags::GRADIENTS`] (see
+    /// [`Gradient`]); [`Gradient::NONE`] otherwise.
+    pub gradient: Gradient,
     /// [`PathMode::Continuous`]: every pose of the segment before this `s`
     /// is certified clear (0 otherwise).
     pub s_lo: f64,

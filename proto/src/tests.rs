@@ -165,10 +165,14 @@ fn vertices_cast_to_chunks_and_back() {
 fn wire_sizes_are_stable() {
     assert_eq!(std::mem::size_of::<Pose>(), 56);
     assert_eq!(std::mem::size_of::<Item>(), 160);
-    // 152 bytes of answer (the signed distance's three included) and 144 of gradient (16 columns, count, flags,
-    // error bound).
+    // 152 bytes of answer (the signed distance's three included); the
+    // gradient (16 columns, count, flags, error bound) travels apart, in a
+    // reply entry of the same size with its item's index.
     assert_eq!(std::mem::size_of::<crate::Gradient>(), 144);
-    assert_eq!(std::mem::size_of::<ItemResult>(), 296);
+    assert_eq!(std::mem::size_of::<ItemResult>(), 152);
+    assert_eq!(std::mem::size_of::<crate::GradientRow>(), 152);
+    assert_eq!(std::mem::size_of::<crate::ReplyEntry>(), 152);
+    assert_eq!(std::mem::size_of::<crate::SceneRow>(), 336);
     assert_eq!(std::mem::size_of::<Vertex>(), 24);
     assert_eq!(std::mem::size_of::<AdminChunk>(), 24);
     assert_eq!(std::mem::size_of::<ItemBody>(), 80);

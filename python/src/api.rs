@@ -4,14 +4,14 @@
 
 use pyo3::prelude::*;
 
-use gjkd_client::{ClientError, ErrorCode, Item, ItemResult, ObjectId};
+use gjkd_client::{ClientError, ErrorCode, Gradient, Item, ItemResult, ObjectId};
 
 use nalgebra::Isometry3;
 
 use crate::arrays::{Ids, Poses, id_array, pose, pose_array};
 use crate::batch::{Answer, Distances, RequestArrays, options, set_pose_a, set_pose_b};
 use crate::errors::{self, invalid};
-use crate::runner::{run_items, run_pairs};
+use crate::runner::{run_gradient, run_items, run_pairs};
 use crate::server_lib::check_pose;
 use crate::shape::{Pieces, Registration, Shape};
 
@@ -225,15 +225,23 @@ pub fn distance(
     if let Some(p) = pose(pose_b, "pose_b")? {
         set_pose_b(&mut item, p);
     }
-    let mut out = ItemResult::default();
-    let mut check = |_: usize, r: &ItemResult| -> Result<(), ClientError> {
-        out = *r;
-        Ok(())
-    };
     let (answerer, buffers) = backend.parts(py)?;
-    run_items(py, answerer, buffers, 1, &move |_| item, &mut check)
-        .map_err(|e| errors::client(py, e, None))?;
+    let (out, gradient) = if args.gradient.is_some() {
+        // The gradient travels apart from the result: this path has room
+        // for it, the batch runner none.
+        run_gradient(py, answerer, item).map_err(|e| errors::client(py, e, None))?
+    } else {
+        let mut out = ItemResult::default();
+        let mut check = |_: usize, r: &ItemResult| -> Result<(), ClientError> {
+            out = *r;
+            Ok(())
+        };
+        run_items(py, answerer, buffers, 1, &move |_| item, &mut check)
+            .map_err(|e| errors::client(py, e, None))?;
+        (out, Gradient::NONE)
+    };
     match out.error_code() {
+        ErrorCode::Ok if args.gradient.is_some() => Ok(Answer::with_gradient(out, gradient)),
         ErrorCode::Ok => Ok(Answer::new(out)),
         code => {
             let field = match code {

@@ -7,7 +7,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyAnyMethods, PyDict};
 
-use gjkd_client::{Item, ItemResult, ObjectId, Precision, QueryOptions};
+use gjkd_client::{Gradient, Item, ItemResult, ObjectId, Precision, QueryOptions};
 use gjkd_proto::{Pose, result_flags};
 
 use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array, pose_array};
@@ -540,12 +540,20 @@ impl Writer<'_> {
 #[derive(Clone, Copy)]
 pub struct Answer {
     r: ItemResult,
+    /// The gradient, [`Gradient::NONE`] when not asked.
+    g: Gradient,
 }
 
 impl Answer {
     /// The answer in `r`, which holds no error.
     pub fn new(r: ItemResult) -> Self {
-        Answer { r }
+        Answer::with_gradient(r, Gradient::NONE)
+    }
+
+    /// The answer in `r`, which holds no error, with its gradient `g`
+    /// (which travels apart from the result).
+    pub fn with_gradient(r: ItemResult, g: Gradient) -> Self {
+        Answer { r, g }
     }
 
     /// Whether the signed-distance fields hold an answer.
@@ -644,7 +652,7 @@ impl Answer {
     /// when not asked. For overlapping objects, the signed distance's.
     #[getter]
     fn gradient<'py>(&self, py: Python<'py>) -> Option<Bound<'py, numpy::PyArray1<f64>>> {
-        let g = &self.r.gradient;
+        let g = &self.g;
         g.is_present()
             .then(|| numpy::PyArray1::from_slice(py, g.as_slice()))
     }
@@ -652,13 +660,13 @@ impl Answer {
     /// gradient is a one-sided one.
     #[getter]
     fn gradient_not_unique(&self) -> bool {
-        self.r.gradient.is_not_unique()
+        self.g.is_not_unique()
     }
     /// A bound on each gradient entry's error from the distance's
     /// certified interval.
     #[getter]
     fn gradient_error(&self) -> f64 {
-        self.r.gradient.error
+        self.g.error
     }
 
     fn __repr__(&self) -> String {

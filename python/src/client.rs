@@ -5,7 +5,7 @@ use std::time::Duration;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gjkd_client::{ClientError, Item, ItemResult};
+use gjkd_client::{ClientError, Gradient, Item, ItemResult};
 
 use gjkd_client::{LimitMode, RobotHandle, SceneSummary};
 use gjkd_proto::{Pose, SceneRequest, SceneRow};
@@ -59,20 +59,49 @@ struct Connection {
     max_batch: usize,
 }
 
+impl Connection {
+    /// Runs `call` on the client, then learns the server's batch limit as
+    /// last heard (a reconnect may have changed it).
+    fn run<R>(
+        &mut self,
+        call: impl FnOnce(&mut gjkd_client::Client) -> Result<R, ClientError>,
+    ) -> Result<R, ClientError> {
+        let Some(client) = self.inner.as_mut() else {
+            return Err(ClientError::Protocol("the client is closed".into()));
+        };
+        let outcome = call(client);
+        if let Some(info) = client.server_info() {
+            self.max_batch = info.max_batch as usize;
+        }
+        outcome
+    }
+}
+
 impl Answerer for Connection {
     fn max_batch(&self) -> usize {
         self.max_batch
     }
 
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
-        let Some(client) = self.inner.as_mut() else {
-            return Err(ClientError::Protocol("the client is closed".into()));
-        };
-        let outcome = client.query_batch(items, results);
-        if let Some(info) = client.server_info() {
-            self.max_batch = info.max_batch as usize;
-        }
-        outcome.map_err(ClientError::from)
+        self.run(|client| {
+            client
+                .query_batch(items, results)
+                .map_err(ClientError::from)
+        })
+    }
+
+    fn answer_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
+        self.run(|client| {
+            client
+                .query_batch_gradients(items, results, gradients)
+                .map(|_| ())
+                .map_err(ClientError::from)
+        })
     }
 
     fn refresh_limit(&mut self) -> bool {

@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 
-use gjkd_client::{ClientError, Item, ItemResult, LimitMode, RobotHandle, SceneSummary};
+use gjkd_client::{ClientError, Gradient, Item, ItemResult, LimitMode, RobotHandle, SceneSummary};
 use gjkd_proto::{AdminOp, AdminRequest, Pose, SceneRequest, SceneRow};
 use nalgebra::Isometry3;
 
@@ -59,6 +59,16 @@ impl Answerer for LocalStore {
 
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError> {
         self.store.handle(items, results);
+        Ok(())
+    }
+
+    fn answer_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError> {
+        self.store.handle_gradients(items, results, gradients);
         Ok(())
     }
 }

@@ -4,7 +4,7 @@
 
 use pyo3::prelude::*;
 
-use gjkd_client::{ClientError, Item, ItemResult};
+use gjkd_client::{ClientError, Gradient, Item, ItemResult};
 
 use crate::batch::{Distances, Request, Writer};
 
@@ -17,6 +17,17 @@ pub trait Answerer {
     /// # Errors
     /// A failure of the whole call.
     fn answer(&mut self, items: &[Item], results: &mut [ItemResult]) -> Result<(), ClientError>;
+    /// As [`Answerer::answer`], for items that may ask for a gradient: the
+    /// `k`-th one's into `gradients[k]` (room for all of them).
+    ///
+    /// # Errors
+    /// A failure of the whole call.
+    fn answer_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) -> Result<(), ClientError>;
     /// Called after a chunk was refused as too large: learn the new limit.
     /// `false` if it did not change (then the error is reported).
     fn refresh_limit(&mut self) -> bool {
@@ -105,6 +116,26 @@ fn run_chunks(
         start = end;
     }
     Ok(())
+}
+
+/// Answers one pair `item` that asks for its gradient, the GIL released:
+/// its result and its gradient.
+///
+/// # Errors
+/// A failure of the whole call.
+pub fn run_gradient(
+    py: Python<'_>,
+    answerer: &mut dyn Answerer,
+    item: Item,
+) -> Result<(ItemResult, Gradient), ClientError> {
+    let job = OnThisThread::new(answerer);
+    py.detach(move || {
+        let answerer = job.into_inner();
+        let mut result = [ItemResult::default()];
+        let mut gradient = [Gradient::NONE];
+        answerer.answer_gradients(&[item], &mut result, &mut gradient)?;
+        Ok((result[0], gradient[0]))
+    })
 }
 
 /// Sends the items `make(i)` for `i` in `0..n`, in chunks, the GIL

@@ -532,7 +532,7 @@ impl SceneRows {
                         s_hi[i] = row.s_hi;
                         writer.write(i, std::slice::from_ref(&row.result));
                         if columns > 0 {
-                            let g = &row.result.gradient;
+                            let g = &row.gradient;
                             let out = &mut gradient[i * columns..(i + 1) * columns];
                             out.fill(0.0);
                             let got = g.as_slice();

@@ -4,8 +4,8 @@
 //! serving command (`python -m gjkd serve`).
 
 use gjkd_proto::{
-    AdminChunk, AdminRequest, ErrorCode, Item, ItemResult, Pose, SceneReply, SceneRequest,
-    SceneRow, WaitMode,
+    AdminChunk, AdminRequest, ErrorCode, Gradient, GradientRow, Item, ItemResult, Pose, SceneReply,
+    SceneRequest, SceneRow, WaitMode,
 };
 use nalgebra::Isometry3;
 
@@ -24,6 +24,9 @@ pub use gjkd_server::engine::state::Limits;
 /// The server's object store and request handlers, without any IPC.
 pub struct Store {
     state: gjkd_server::engine::state::State,
+    /// The gradient section of the last request with gradients, kept so
+    /// that a request allocates nothing once it has grown.
+    gradient_rows: Vec<GradientRow>,
 }
 
 /// The client identity `gjkd.Local` uses with the handlers: the owner of
@@ -41,6 +44,7 @@ impl Store {
     pub fn new(limits: Limits) -> Self {
         Store {
             state: gjkd_server::engine::state::State::new(limits, WaitMode::Spin, 1),
+            gradient_rows: Vec::new(),
         }
     }
 
@@ -88,6 +92,25 @@ impl Store {
     /// The id of the object named `name`.
     pub fn lookup(&self, name: &str) -> Option<u64> {
         self.state.lookup(name)
+    }
+
+    /// As [`Store::handle`], and the gradient of the `k`-th item that asks
+    /// for one into `gradients[k]` (room for all of them), as a server's
+    /// reply carries them.
+    pub fn handle_gradients(
+        &mut self,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [Gradient],
+    ) {
+        let rows = &mut self.gradient_rows;
+        rows.clear();
+        rows.resize(gradients.len(), GradientRow::default());
+        self.state
+            .handle_with_gradients(LOCAL_CLIENT, items, results, rows);
+        for (out, row) in gradients.iter_mut().zip(rows.iter()) {
+            *out = row.gradient;
+        }
     }
 
     /// Objects held.

@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 
 use gjkd_proto::{
     AdminChunk, AdminOp, AdminReply, AdminRequest, ErrorCode, Item, ItemResult, PosesReply,
-    ReplyHeader, SceneReply, SceneRequest, SceneRow, StoredPose, WaitMode, admin_service_name,
-    poses_service_name, query_service_name, scene_service_name, wake_service_name,
+    ReplyEntry, ReplyHeader, SceneReply, SceneRequest, SceneRow, StoredPose, WaitMode,
+    admin_service_name, poses_service_name, query_service_name, scene_service_name,
+    wake_service_name,
 };
 use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::listener::Listener;
@@ -22,7 +23,7 @@ use tracing::{debug, error, info, warn};
 use crate::engine::{Limits, State};
 use crate::wait::{Idle, WaitPolicy};
 
-type QueryServer = IoxServer<ipc::Service, [Item], (), [ItemResult], ReplyHeader>;
+type QueryServer = IoxServer<ipc::Service, [Item], (), [ReplyEntry], ReplyHeader>;
 type AdminServer = IoxServer<ipc::Service, [AdminChunk], AdminRequest, AdminReply, ()>;
 type PosesServer = IoxServer<ipc::Service, [u64], (), [StoredPose], PosesReply>;
 type PosesService = iceoryx2::service::port_factory::request_response::PortFactory<
@@ -44,7 +45,7 @@ type QueryService = iceoryx2::service::port_factory::request_response::PortFacto
     ipc::Service,
     [Item],
     (),
-    [ItemResult],
+    [ReplyEntry],
     ReplyHeader,
 >;
 type AdminService = iceoryx2::service::port_factory::request_response::PortFactory<
@@ -183,7 +184,7 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     let clients = limits.max_clients;
     let query_service = node
         .service_builder(&query_name)
-        .request_response::<[Item], [ItemResult]>()
+        .request_response::<[Item], [ReplyEntry]>()
         .response_user_header::<ReplyHeader>()
         .max_clients(clients)
         .max_servers(1)
@@ -275,7 +276,8 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
         // A static segment: a growing one makes iceoryx2 size every client's
         // connection for all the segments it might grow into, which makes
         // connecting slow (hundreds of ms for 128 clients in a debug build).
-        .initial_max_slice_len(limits.max_batch)
+        // Room for `max_batch` results and as many gradients.
+        .initial_max_slice_len(limits.max_batch.saturating_mul(2))
         .allocation_strategy(AllocationStrategy::Static)
         // iceoryx2 reserves for streams of responses per request; gjkd sends
         // exactly one, so each client needs one chunk per active request, and
@@ -617,12 +619,15 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
                 debug!(len = items.len(), ?code, "batch rejected");
                 let header = ReplyHeader {
                     error: code as u32,
-                    count: 0,
+                    ..ReplyHeader::default()
                 };
                 refuse("query", &request, header);
                 return;
             }
-            let reply = match request.loan_slice_uninit(items.len()) {
+            // The results, then a gradient for each item that asks: a
+            // pair that asks none carries none.
+            let gradients = ReplyEntry::gradients_asked(items);
+            let reply = match request.loan_slice_uninit(items.len() + gradients) {
                 Ok(r) => r,
                 Err(e) => {
                     warn!(error = ?e, len = items.len(), "cannot loan reply");
@@ -633,24 +638,31 @@ fn serve_queries(query: &QueryServer, state: &mut State) -> usize {
             // reply from the client's cache in one sweep whose misses overlap.
             // Writing each result straight in after its GJK run measured slower
             // on batches, each write then missing alone.
-            let mut reply = reply.write_from_fn(|_| ItemResult::default());
+            let mut reply = reply.write_from_fn(|_| ReplyEntry::default());
             *reply.user_header_mut() = ReplyHeader {
                 error: ErrorCode::Ok as u32,
                 count: items.len() as u32,
+                gradients: gradients as u32,
+                reserved: 0,
             };
-            let results = reply.payload_mut();
             let answered = guarded(
                 "query",
                 || {
-                    state.handle(client, items, results);
+                    if let Some((results, rows)) =
+                        ReplyEntry::split_mut(reply.payload_mut(), items.len())
+                    {
+                        state.handle_with_gradients(client, items, results, rows);
+                    }
                     true
                 },
                 || false,
             );
-            if !answered {
-                for r in reply.payload_mut() {
-                    *r = ItemResult::error(ErrorCode::Internal);
-                }
+            if !answered
+                && let Some((results, rows)) =
+                    ReplyEntry::split_mut(reply.payload_mut(), items.len())
+            {
+                results.fill(ItemResult::error(ErrorCode::Internal));
+                rows.fill(gjkd_proto::GradientRow::default());
             }
             delivered("query", reply.send());
         },

@@ -13,8 +13,8 @@ use files::Rng;
 use gjk::{Convex, Shape};
 use gjkd_model::{LimitMode, PackagePath, RobotModel};
 use gjkd_proto::{
-    Item, ItemResult, ObjectId, PathMode, QueryOptions, SceneKind, SceneRequest, SceneRow,
-    WaitMode, gradient_flags, item_flags, scene_flags,
+    Gradient, GradientRow, Item, ItemResult, ObjectId, PathMode, QueryOptions, SceneKind,
+    SceneRequest, SceneRow, WaitMode, gradient_flags, item_flags, scene_flags,
 };
 use gjkd_server::engine::robots::NewRobot;
 use gjkd_server::engine::state::{Limits, NewObject, Owner, State};
@@ -207,7 +207,21 @@ fn set_joints(s: &mut Scene, q: &[f64], base: &Isometry3<f64>) {
     assert!(results.iter().all(|r| r.error == 0), "{results:?}");
 }
 
-fn pair_with_gradient(s: &mut State, a: u64, b: u64, base: bool) -> ItemResult {
+/// A pair's result with the gradient that travels apart from it.
+#[derive(Debug)]
+struct WithGradient {
+    result: ItemResult,
+    gradient: Gradient,
+}
+
+impl std::ops::Deref for WithGradient {
+    type Target = ItemResult;
+    fn deref(&self) -> &ItemResult {
+        &self.result
+    }
+}
+
+fn pair_with_gradient(s: &mut State, a: u64, b: u64, base: bool) -> WithGradient {
     let mut item = Item::distance(
         ObjectId::from_raw(a),
         ObjectId::from_raw(b),
@@ -218,9 +232,14 @@ fn pair_with_gradient(s: &mut State, a: u64, b: u64, base: bool) -> ItemResult {
         item.flags |= item_flags::GRADIENT_BASE;
     }
     let mut out = [ItemResult::default()];
-    s.handle(1, &[item], &mut out);
+    let mut rows = [GradientRow::default()];
+    s.handle_with_gradients(1, &[item], &mut out, &mut rows);
     assert_eq!(out[0].error, 0, "{:?}", out[0]);
-    out[0]
+    assert_eq!(rows[0].item, 0);
+    WithGradient {
+        result: out[0],
+        gradient: rows[0].gradient,
+    }
 }
 
 /// Twisted pose: `Translation(c + v) · Rotation(ω) · Translation(−c) · pose`.
@@ -234,7 +253,7 @@ fn twisted(pose: &Isometry3<f64>, twist: &[f64; 6]) -> Isometry3<f64> {
 
 /// Compares a gradient against its finite differences; returns whether it
 /// was judged (the distance positive and the witness unique).
-fn judge(got: &ItemResult, want: &[f64], what: &str) -> bool {
+fn judge(got: &WithGradient, want: &[f64], what: &str) -> bool {
     let g = got.gradient;
     assert!(g.is_present(), "{what}");
     assert_eq!(g.as_slice().len(), want.len(), "{what}");
@@ -441,7 +460,7 @@ fn scene_rows_carry_the_pair_query_gradients() {
         assert!(!step_rows.is_empty());
         for row in step_rows {
             let pair = pair_with_gradient(&mut s.state, row.a, row.b, false);
-            let g = row.result.gradient;
+            let g = row.gradient;
             assert_eq!(g.columns as usize, dof);
             assert_eq!(g.flags & gradient_flags::PRESENT, gradient_flags::PRESENT);
             for (x, y) in g.as_slice().iter().zip(pair.gradient.as_slice()) {
@@ -460,14 +479,14 @@ fn scene_rows_carry_the_pair_query_gradients() {
     assert_eq!(reply.error, 0);
     for row in &rows[..reply.total as usize] {
         let pair = pair_with_gradient(&mut s.state, row.a, row.b, true);
-        assert_eq!(row.result.gradient.columns as usize, dof + 6);
-        assert!(row.result.gradient.has_base());
-        assert_eq!(row.result.gradient.as_slice(), pair.gradient.as_slice());
+        assert_eq!(row.gradient.columns as usize, dof + 6);
+        assert!(row.gradient.has_base());
+        assert_eq!(row.gradient.as_slice(), pair.gradient.as_slice());
     }
     // Without the flag, no gradient.
     request.flags = 0;
     s.state.scene(1, &request, &[], &mut rows);
-    assert!(!rows[0].result.gradient.is_present());
+    assert!(!rows[0].gradient.is_present());
 }
 
 /// Parallel faces: a box above a box, face to face, has witness points
@@ -530,8 +549,66 @@ fn gradients_that_cannot_be_given_are_refused() {
     .with_pose_a(&Isometry3::translation(0.0, 0.0, 3.0));
     item.flags |= item_flags::GRADIENT;
     let mut out = [ItemResult::default()];
+    let mut rows = [GradientRow::default()];
+    s.state
+        .handle_with_gradients(1, &[item], &mut out, &mut rows);
+    assert_eq!(out[0].error, gjkd_proto::ErrorCode::InvalidOptions as u32);
+    assert_eq!(rows[0].gradient, Gradient::NONE);
+    // Without room for its gradient, a pair that asks is refused too,
+    // where the same pair without the pose is answered with room.
+    item.flags &= !item_flags::POSE_A;
     s.state.handle(1, &[item], &mut out);
     assert_eq!(out[0].error, gjkd_proto::ErrorCode::InvalidOptions as u32);
+    s.state
+        .handle_with_gradients(1, &[item], &mut out, &mut rows);
+    assert_eq!(out[0].error, 0);
+    assert!(rows[0].gradient.is_present());
+}
+
+/// The gradient section holds one row per item that asks, in item order,
+/// each naming its item, also for an item that failed; items that do not
+/// ask take none.
+#[test]
+fn gradient_rows_follow_the_items_that_ask() {
+    let mut rng = Rng(5);
+    let mut s = scene(real("ur5"), Isometry3::identity(), &mut rng, 0.5);
+    let link = s.links.iter().flatten().next().copied().unwrap();
+    let obstacle = s.obstacles[0].0;
+    let pair = Item::distance(
+        ObjectId::from_raw(link),
+        ObjectId::from_raw(obstacle),
+        &QueryOptions::cold(),
+    );
+    let ghost = Item::distance(
+        ObjectId::from_raw(link),
+        ObjectId::from_raw(12345),
+        &QueryOptions::cold(),
+    );
+    let items = [
+        pair,
+        pair.with_gradient(false),
+        ghost.with_gradient(false),
+        pair,
+        pair.with_gradient(true),
+    ];
+    assert_eq!(gjkd_proto::ReplyEntry::gradients_asked(&items), 3);
+    let mut out = [ItemResult::default(); 5];
+    let mut rows = [GradientRow::default(); 3];
+    s.state
+        .handle_with_gradients(1, &items, &mut out, &mut rows);
+    assert_eq!(rows.map(|r| r.item), [1, 2, 4]);
+    assert_eq!(out[2].error, gjkd_proto::ErrorCode::UnknownObject as u32);
+    assert_eq!(rows[1].gradient, Gradient::NONE);
+    let alone = pair_with_gradient(&mut s.state, link, obstacle, false);
+    assert_eq!(rows[0].gradient, alone.gradient);
+    assert!(rows[2].gradient.has_base());
+    assert_eq!(
+        rows[2].gradient.as_slice()[..alone.gradient.as_slice().len()],
+        *alone.gradient.as_slice()
+    );
+    // The distances are the same as without gradients.
+    assert!(out.iter().all(|r| r.error == 0 || r.error == out[2].error));
+    assert_eq!(out[0].distance, out[1].distance);
 }
 
 /// Overlapping pairs: the gradient of the signed distance (minus the

@@ -151,7 +151,7 @@ fn a_server_half_set_up_is_waited_for_not_called_incompatible() {
     let node = node();
     let _query = node
         .service_builder(&ServiceName::new(&query_service_name(&service)).unwrap())
-        .request_response::<[gjkd_proto::Item], [gjkd_proto::ItemResult]>()
+        .request_response::<[gjkd_proto::Item], [gjkd_proto::ReplyEntry]>()
         .response_user_header::<gjkd_proto::ReplyHeader>()
         .create()
         .expect("gjkd's own query service");

@@ -194,7 +194,9 @@ fn readme_gradients_example_runs() -> Result<(), gjkd_client::ClientError> {
     let server = Server::start("doc-gradients", &["--no-persist"]);
     let service = server.service.as_str();
     // --- from README.md, "Gradients" ---
-    use gjkd_client::{Client, PackagePath, QueryOptions, SceneRow, gradient_matrix};
+    use gjkd_client::{
+        Client, Gradient, Item, ItemResult, PackagePath, QueryOptions, SceneRow, gradient_matrix,
+    };
     use nalgebra::Isometry3;
 
     let mut client = Client::connect(service)?;
@@ -218,6 +220,18 @@ fn readme_gradients_example_runs() -> Result<(), gjkd_client::ClientError> {
     let gradient = answer.gradient.expect("asked");
     assert!((answer.distance - 0.35).abs() < 1e-9);
     assert!((gradient.as_slice()[0] + 0.8).abs() < 1e-9 && !gradient.is_not_unique());
+
+    // A batch: only the items that ask carry a gradient, the k-th that asks
+    // into gradients[k] (buffers of yours, kept from call to call).
+    let plain = Item::distance(rod, ball, &QueryOptions::default());
+    let items = [plain, plain.with_gradient(false)];
+    let mut results = [ItemResult::default(); 2];
+    let mut gradients = [Gradient::NONE; 1];
+    assert_eq!(
+        client.query_batch_gradients(&items, &mut results, &mut gradients)?,
+        1
+    );
+    assert!((gradients[0].as_slice()[0] + 0.8).abs() < 1e-9);
 
     // Every pair within 1 m, each row with its gradient, copied into one
     // (rows, dof) array.

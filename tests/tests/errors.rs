@@ -168,9 +168,17 @@ fn invalid_options() {
     let mut flags = Item::distance(probe.a, probe.b, &base);
     flags.flags = u32::MAX;
     let mut results = [ItemResult::default(); 2];
+    // Every bit asks a gradient too: refused by the client without room
+    // for it, answered Malformed by the server with room.
+    assert_eq!(
+        client.query_batch(&[unknown, flags], &mut results),
+        Err(QueryError::NoRoomForGradient)
+    );
+    let mut gradient = [gjkd_client::Gradient::NONE];
     client
-        .query_batch(&[unknown, flags], &mut results)
+        .query_batch_gradients(&[unknown, flags], &mut results, &mut gradient)
         .expect("request");
+    assert_eq!(gradient[0], gjkd_client::Gradient::NONE);
     assert_eq!(results[0].answer().unwrap_err(), ErrorCode::Malformed);
     assert_eq!(results[1].answer().unwrap_err(), ErrorCode::Malformed);
     probe.check(&mut client);

@@ -1,5 +1,6 @@
-//! `Client::query_batch` allocates nothing of its own once connected:
-//! checked with a global allocator that counts this thread's allocations.
+//! `Client::query_batch` and `query_batch_gradients` allocate nothing of
+//! their own once connected: checked with a global allocator that counts
+//! this thread's allocations.
 //!
 //! iceoryx2 0.10 itself makes exactly one small allocation per request: each
 //! loan creates an `Rc` for its bookkeeping
@@ -12,7 +13,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::time::{Duration, Instant};
 
-use gjkd_client::{Item, ItemResult, QueryOptions};
+use gjkd_client::{Gradient, Item, ItemResult, QueryOptions};
 use gjkd_e2e::Server;
 use nalgebra::{Isometry3, Vector3};
 
@@ -69,9 +70,25 @@ fn batches_and_single_queries_allocate_nothing_of_their_own() {
         })
         .collect();
     let mut results = vec![ItemResult::default(); items.len()];
+    // Every other item asks for its gradient, into the caller's buffer.
+    let asking: Vec<Item> = items
+        .iter()
+        .enumerate()
+        .map(|(k, i)| {
+            if k % 2 == 1 {
+                i.with_gradient(false)
+            } else {
+                *i
+            }
+        })
+        .collect();
+    let mut gradients = vec![Gradient::NONE; items.len() / 2];
     // The first calls may set up connections to the server's ports.
     for _ in 0..10 {
         client.query_batch(&items, &mut results).expect("batch");
+        client
+            .query_batch_gradients(&asking, &mut results, &mut gradients)
+            .expect("gradients");
         client
             .distance(a, b, &QueryOptions::default())
             .expect("single");
@@ -102,6 +119,11 @@ fn batches_and_single_queries_allocate_nothing_of_their_own() {
                 .distance(a, b, &QueryOptions::default())
                 .expect("single");
         });
+        measure(&mut || {
+            client
+                .query_batch_gradients(&asking, &mut results, &mut gradients)
+                .expect("gradients");
+        });
     }
     assert!(fast_calls > 0, "every call waited on the slow path");
     assert!(
@@ -110,4 +132,13 @@ fn batches_and_single_queries_allocate_nothing_of_their_own() {
     );
     let d = results[0].answer().expect("ok").distance;
     assert!((d - 1.2).abs() < 1e-9, "{d}");
+    // The sphere moves off along x, away from the box: moving the box
+    // (A) along +x closes the gap one for one.
+    assert!(
+        gradients
+            .iter()
+            .all(|g| g.columns == 6 && (g.values[0] + 1.0).abs() < 1e-9),
+        "{:?}",
+        gradients[0]
+    );
 }

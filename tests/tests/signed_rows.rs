@@ -309,8 +309,9 @@ fn overlap_gradients(
     };
     let item = gjkd_client::Item::distance(crate_, ball, &options).with_gradient(false);
     let mut out = [gjkd_client::ItemResult::default()];
-    client.query_batch(&[item], &mut out)?;
-    let pair = out[0].answer().expect("answered");
+    let mut gradient = [gjkd_client::Gradient::NONE];
+    client.query_batch_gradients(&[item], &mut out, &mut gradient)?;
+    let pair = out[0].answer_with(Some(&gradient[0])).expect("answered");
     let mut pairs = [ScenePair::default(); 2];
     let got = client
         .within(crate_, 0.0)

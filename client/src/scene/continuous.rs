@@ -43,7 +43,7 @@ impl From<&SceneRow> for Contact {
             b: ObjectId::from_raw(row.b),
             s_lo: row.s_lo,
             s_hi: row.s_hi,
-            answer: row.result.answer(),
+            answer: row.result.answer_with(Some(&row.gradient)),
         }
     }
 }

@@ -17,11 +17,30 @@ use super::checks::{map_gjk_error, status_code};
 /// The wire code of gjk's error.
 pub(crate) fn run_pair(
     workspace: &mut gjk::Workspace,
+    a: (&Shape, &Isometry3<f64>),
+    b: (&Shape, &Isometry3<f64>),
+    options: &gjk::Options,
+    warm: Option<&gjk::WarmStart>,
+) -> Result<(ItemResult, gjk::WarmStart), ErrorCode> {
+    let mut result = ItemResult::default();
+    let next = run_pair_into(workspace, a, b, options, warm, &mut result)?;
+    Ok((result, next))
+}
+
+/// As [`run_pair`], the answer written into `out` (untouched on an error):
+/// the query service's path, where a result moved by value costs a
+/// `memcpy` a pair, written in place none.
+///
+/// # Errors
+/// As [`run_pair`].
+pub(crate) fn run_pair_into(
+    workspace: &mut gjk::Workspace,
     (a, pose_a): (&Shape, &Isometry3<f64>),
     (b, pose_b): (&Shape, &Isometry3<f64>),
     options: &gjk::Options,
     warm: Option<&gjk::WarmStart>,
-) -> Result<(ItemResult, gjk::WarmStart), ErrorCode> {
+    out: &mut ItemResult,
+) -> Result<gjk::WarmStart, ErrorCode> {
     let mut query = |warm: Option<&gjk::WarmStart>| {
         gjk::distance_in(workspace, a, pose_a, b, pose_b, options, warm)
     };
@@ -37,7 +56,7 @@ pub(crate) fn run_pair(
     if answer.backup_used {
         flags |= result_flags::BACKUP_USED;
     }
-    let result = ItemResult {
+    *out = ItemResult {
         distance: answer.distance,
         lower: answer.lower,
         upper: answer.upper,
@@ -53,7 +72,6 @@ pub(crate) fn run_pair(
         signed_distance: 0.0,
         signed_lower: 0.0,
         signed_upper: 0.0,
-        gradient: gjkd_proto::Gradient::NONE,
     };
-    Ok((result, answer.warm_start))
+    Ok(answer.warm_start)
 }

@@ -41,8 +41,10 @@ pub(crate) struct Stance<'a> {
     pub base: bool,
 }
 
-/// Writes into `result` the gradient of its distance with respect to the
-/// coordinates that move `a` (see `gjkd_proto::Gradient`). `depth` is the
+/// Writes into `out` the gradient of `result`'s distance with respect to
+/// the coordinates that move `a` (see `gjkd_proto::Gradient`); an
+/// overlapping pair's `result.penetration` may rise to the depth's lower
+/// bound found on the way. `depth` is the
 /// pair's signed distance when the caller computed it (a pair that asked
 /// for it and may overlap): its direction is then the gradient's, and
 /// `result`'s normal (already the depth's) is not read as a distance's.
@@ -50,8 +52,10 @@ pub(crate) struct Stance<'a> {
 /// # Errors
 /// [`ErrorCode::InvalidOptions`] when `a`'s robot has more coordinates
 /// than [`GRADIENT_COLUMNS`].
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn fill(
     result: &mut ItemResult,
+    out: &mut Gradient,
     a: Side<'_>,
     b: Side<'_>,
     robots: &Robots,
@@ -137,7 +141,7 @@ pub(crate) fn fill(
         None => flags |= gradient_flags::NO_DIRECTION,
     }
     gradient.flags = flags;
-    result.gradient = gradient;
+    *out = gradient;
     Ok(())
 }
 

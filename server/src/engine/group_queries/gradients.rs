@@ -93,6 +93,7 @@ impl State {
             };
             if let Err(code) = gradient::fill(
                 &mut row.result,
+                &mut row.gradient,
                 a,
                 b,
                 &self.robots,

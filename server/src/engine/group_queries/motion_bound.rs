@@ -86,7 +86,6 @@ pub(crate) fn bounded_result(bound: &PairBound, w: &Widened, a: &Entry, b: &Entr
         signed_distance: 0.0,
         signed_lower: 0.0,
         signed_upper: 0.0,
-        gradient: gjkd_proto::Gradient::NONE,
     }
 }
 

@@ -60,6 +60,7 @@ pub(crate) fn within_of(
                 step,
                 reserved: 0,
                 result,
+                gradient: gjkd_proto::Gradient::NONE,
                 s_lo: 0.0,
                 s_hi: 0.0,
             });

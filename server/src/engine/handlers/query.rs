@@ -1,11 +1,11 @@
 //! The query service's handler: pair distances, pose and joint updates, in
 //! the order the client sent them.
 
-use gjkd_proto::{ErrorCode, Item, ItemKind, ItemResult, item_flags};
+use gjkd_proto::{ErrorCode, Gradient, GradientRow, Item, ItemKind, ItemResult, item_flags};
 
 use crate::engine::checks::check_pose;
 use crate::engine::gradient::{self, Side, Stance};
-use crate::engine::pair_query::run_pair;
+use crate::engine::pair_query::run_pair_into;
 use crate::engine::signed_pair::add_signed_distance;
 use crate::engine::state::State;
 use crate::engine::warm_cache::PairKey;
@@ -15,10 +15,43 @@ impl State {
     /// which keys its warm-start cache): `results[i]` answers `items[i]`,
     /// items applied in order. `results` must be as long as `items`; extra
     /// results are left alone and a short buffer answers only what fits.
+    /// With no room for gradients, an item that asks for one
+    /// ([`item_flags::GRADIENT`]) fails with [`ErrorCode::InvalidOptions`];
+    /// [`State::handle_with_gradients`] answers it.
     pub fn handle(&mut self, client: u128, items: &[Item], results: &mut [ItemResult]) {
+        self.handle_with_gradients(client, items, results, &mut []);
+    }
+
+    /// As [`State::handle`], and the gradient of the `k`-th item that asks
+    /// for one ([`item_flags::GRADIENT`]) into `gradients[k]`, with the
+    /// item's index ([`Gradient::NONE`] when the item failed): the query
+    /// reply's gradient section ([`gjkd_proto::ReplyEntry`]), sized by
+    /// [`gjkd_proto::ReplyEntry::gradients_asked`]. An item asking beyond
+    /// `gradients` fails with [`ErrorCode::InvalidOptions`].
+    pub fn handle_with_gradients(
+        &mut self,
+        client: u128,
+        items: &[Item],
+        results: &mut [ItemResult],
+        gradients: &mut [GradientRow],
+    ) {
         self.stats.requests += 1;
-        for (item, out) in items.iter().zip(results.iter_mut()) {
-            *out = self.item(client, item);
+        let mut rows = gradients.iter_mut();
+        for (index, (item, out)) in items.iter().zip(results.iter_mut()).enumerate() {
+            // Only items that ask take a row, so the section holds exactly
+            // the gradients asked, whatever became of their items.
+            let row = if item.flags & item_flags::GRADIENT != 0 {
+                rows.next().map(|row| {
+                    *row = GradientRow {
+                        item: index as u32,
+                        ..GradientRow::default()
+                    };
+                    &mut row.gradient
+                })
+            } else {
+                None
+            };
+            self.item(client, item, out, row);
             self.stats.items += 1;
             if out.error != 0 {
                 self.stats.item_errors += 1;
@@ -37,7 +70,16 @@ impl State {
         }
     }
 
-    fn item(&mut self, client: u128, item: &Item) -> ItemResult {
+    /// Writes one item's answer into `out`, and its gradient into
+    /// `gradient` (its row's, when it asks for one and there is room).
+    /// Written in place: a result moved by value costs a `memcpy` a pair.
+    fn item(
+        &mut self,
+        client: u128,
+        item: &Item,
+        out: &mut ItemResult,
+        gradient: Option<&mut Gradient>,
+    ) {
         // Unknown flag bits and a non-zero reserved word are refused rather
         // than ignored, so that a later protocol version can give them a
         // meaning without old servers silently answering something else.
@@ -46,28 +88,27 @@ impl State {
         // so a joint item's body is never read as a pair's.
         let known = item_flags::ALL & !item_flags::END_STEP;
         if item.flags & !known != 0 {
-            return ItemResult::error(ErrorCode::Malformed);
+            *out = ItemResult::error(ErrorCode::Malformed);
+            return;
         }
-        match ItemKind::from_raw(item.kind) {
+        let outcome = match ItemKind::from_raw(item.kind) {
             Some(ItemKind::SetPose | ItemKind::Distance) if item.pair().reserved != 0 => {
-                ItemResult::error(ErrorCode::Malformed)
+                Err(ErrorCode::Malformed)
             }
-            Some(ItemKind::SetPose) => match self.set_pose(item) {
-                Ok(()) => ItemResult::default(),
-                Err(e) => ItemResult::error(e),
-            },
-            Some(ItemKind::Distance) => self
-                .distance(client, item)
-                .unwrap_or_else(ItemResult::error),
-            Some(ItemKind::SetJoints) => match self.robots.set_joints(&mut self.store, item) {
-                Ok(()) => ItemResult::default(),
-                Err(e) => ItemResult::error(e),
-            },
+            Some(ItemKind::SetPose) => self.set_pose(item).map(|()| *out = ItemResult::default()),
+            Some(ItemKind::Distance) => self.distance(client, item, out, gradient),
+            Some(ItemKind::SetJoints) => self
+                .robots
+                .set_joints(&mut self.store, item)
+                .map(|()| *out = ItemResult::default()),
             // Group members, allowed pairs and path steps mean something
             // only in a scene request.
             Some(ItemKind::Member | ItemKind::Allow | ItemKind::Step) | None => {
-                ItemResult::error(ErrorCode::Malformed)
+                Err(ErrorCode::Malformed)
             }
+        };
+        if let Err(code) = outcome {
+            *out = ItemResult::error(code);
         }
     }
 
@@ -78,7 +119,15 @@ impl State {
         self.store.set_pose(item.a, check_pose(&item.pose_a)?)
     }
 
-    fn distance(&mut self, client: u128, item: &Item) -> Result<ItemResult, ErrorCode> {
+    /// Answers a pair item into `out` (left partly written on an error,
+    /// which the caller overwrites).
+    fn distance(
+        &mut self,
+        client: u128,
+        item: &Item,
+        out: &mut ItemResult,
+        gradient: Option<&mut Gradient>,
+    ) -> Result<(), ErrorCode> {
         let warm_on = item.flags & item_flags::WARM_START != 0;
         let pair = item.pair();
         let options = gjk::Options {
@@ -118,6 +167,9 @@ impl State {
         };
         let warm = if warm_on { self.cache.get(&key) } else { None };
         let wants_gradient = item.flags & item_flags::GRADIENT != 0;
+        if wants_gradient && gradient.is_none() {
+            return Err(ErrorCode::InvalidOptions);
+        }
         // A link's gradient is taken at its robot's configuration: a pose
         // of this query only would not be where its joints put it.
         let overridden =
@@ -127,29 +179,26 @@ impl State {
         {
             return Err(ErrorCode::InvalidOptions);
         }
-        let (mut result, next) = run_pair(
+        let next = run_pair_into(
             &mut self.workspace,
             (&a.shape, &pose_a),
             (&b.shape, &pose_b),
             &options,
             warm.as_ref(),
+            out,
         )?;
         // The signed distance first: a gradient of a pair that may
         // overlap reads its direction from the same depth, computed once.
         let depth = if item.flags & item_flags::SIGNED_DISTANCE != 0 {
-            add_signed_distance(
-                &mut result,
-                (&a.shape, &pose_a),
-                (&b.shape, &pose_b),
-                &options,
-            )?
+            add_signed_distance(out, (&a.shape, &pose_a), (&b.shape, &pose_b), &options)?
         } else {
             None
         };
-        if wants_gradient {
+        if let Some(gradient) = gradient {
             self.gradient_poses.reset();
             gradient::fill(
-                &mut result,
+                out,
+                gradient,
                 Side {
                     id: item.a,
                     shape: &a.shape,
@@ -173,7 +222,7 @@ impl State {
         if warm_on {
             self.cache.put(key, next);
         }
-        Ok(result)
+        Ok(())
     }
 }
 

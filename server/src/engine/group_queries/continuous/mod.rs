@@ -148,6 +148,7 @@ impl State {
                     step: k as u32,
                     reserved: 0,
                     result: hit.result,
+                    gradient: gjkd_proto::Gradient::NONE,
                     s_lo: hit.lo,
                     s_hi: hit.hi,
                 });

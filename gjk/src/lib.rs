@@ -48,7 +48,7 @@ pub use overlap::penetration_bound;
 pub use query::distance_in_baseline;
 pub use query::{
     Answer, Options, Precision, Status, WarmStart, Workspace, distance, distance_between,
-    distance_between_in, distance_in,
+    distance_between_compounds, distance_between_compounds_in, distance_between_in, distance_in,
 };
 pub use separation::separation_bound;
 pub use shape::{Compound, Convex, Shape};

@@ -233,7 +233,7 @@ impl Simplex {
                     _ => {
                         let (list, len) = WITH_NEW[n_us][self.all as usize & 15];
                         for &mask in list.iter().take(len as usize) {
-                            self.cofactors(mask as usize);
+                            by_mask!(mask as usize, M => self.cofactors_of::<M>());
                         }
                     }
                 }
@@ -261,7 +261,12 @@ impl Simplex {
         step!(0 1 2 3 4 5 6 7);
     }
 
-    /// [`cofactors`](Self::cofactors) for a subset known at compile time.
+    /// (5.6): `Δ_j(Y_s ∪ {y_j}) = Σ_{i∈I_s} Δ_i(Y_s)(y_i·y_k - y_i·y_j)`,
+    /// `k = min I_s`, for the subset `MASK`. Its one form takes the subset
+    /// at compile time: the unrolled updates name constant subsets, and a
+    /// subset known only at run time goes through `by_mask!`. (A run-time
+    /// `mask` argument, inlined with a constant, left the subset tables'
+    /// lookups unfolded: measurably more instructions a query.)
     #[inline(always)]
     fn cofactors_of<const MASK: usize>(&mut self) {
         let (mem, len) = const { MEMBERS[MASK] };
@@ -425,38 +430,6 @@ impl Simplex {
         let nn = n.norm_squared();
         // A triangle flat to the last bit has no plane: the weights decide.
         (nn > 0.0).then(|| n * (n.dot(&yi) / nn))
-    }
-
-    /// (5.6): `Δ_j(Y_s ∪ {y_j}) = Σ_{i∈I_s} Δ_i(Y_s)(y_i·y_k - y_i·y_j)`,
-    /// `k = min I_s`.
-    #[inline]
-    fn cofactors(&mut self, mask: usize) {
-        // The `& 15` and `& 3` cost nothing and let the compiler drop every
-        // bounds check in this, the subalgorithm's innermost loop.
-        let mask = mask & 15;
-        let (mem, len) = MEMBERS[mask];
-        if len == 1 {
-            self.delta[mask][mem[0] as usize & 3] = 1.0;
-            return;
-        }
-        for &j in &mem[..len as usize] {
-            let j = j as usize & 3;
-            let sub = mask & !(1 << j);
-            let (smem, slen) = MEMBERS[sub];
-            let k = smem[0] as usize & 3;
-            let mut acc = 0.0;
-            for &i in &smem[..slen as usize] {
-                let i = i as usize & 3;
-                acc += self.delta[sub][i] * (self.dot[i][k] - self.dot[i][j]);
-            }
-            self.delta[mask][j] = acc;
-        }
-        if len == 3 {
-            self.check_thin(mask);
-        }
-        if len == 4 {
-            self.check_sliver();
-        }
     }
 
     /// Whether `Y` is affinely independent by a clear margin: `Δ(Y)` is the

@@ -1,5 +1,9 @@
 //! The distance of a union (2.3), (2.8): the nearest of its piece pairs,
-//! searched so that pairs that cannot win stop early or do not run.
+//! searched so that pairs that cannot win stop early or do not run. Generic
+//! over the shapes' [`Pieces`]: the stored [`Shape`](crate::Shape)s of
+//! [`distance`](crate::distance) and the compounds of any support maps of
+//! [`distance_between_compounds`](crate::distance_between_compounds) run
+//! the same search, monomorphised.
 
 use nalgebra::{Isometry3, Vector3};
 
@@ -9,7 +13,8 @@ use super::warm_start::PieceSimplex;
 use super::{Answer, Query, Status, WarmStart};
 use crate::johnson::Simplex;
 use crate::numeric::robust_norm;
-use crate::shape::Convex;
+use crate::shape::Pieces;
+use crate::support_map::SupportMap;
 
 /// A certified lower bound on the distance between piece `convex_a` placed
 /// by `offset_a` and piece `convex_b` placed by `placed_b`, both in A's body
@@ -20,34 +25,35 @@ use crate::shape::Convex;
 /// costs a set-up and an iteration at least. NaN (from a NaN axis) passes no
 /// cutoff, so it skips nothing.
 #[inline(always)]
-pub(super) fn axis_gap(
-    convex_a: &Convex,
+pub(super) fn axis_gap<A: SupportMap, B: SupportMap>(
+    convex_a: &A,
     offset_a: &Isometry3<f64>,
-    convex_b: &Convex,
+    convex_b: &B,
     placed_b: &Isometry3<f64>,
     axis: &Vector3<f64>,
 ) -> f64 {
     let axis_in_a = offset_a.rotation.inverse_transform_vector(axis);
     let axis_in_b = placed_b.rotation.inverse_transform_vector(axis);
     let ((_, top_point), (_, bottom_point)) = (
-        convex_a.support_point(&axis_in_a),
-        convex_b.support_point(&-axis_in_b),
+        convex_a.local_support(&axis_in_a),
+        convex_b.local_support(&-axis_in_b),
     );
-    let top_a = (axis_in_a.dot(&convex_a.centroid().coords) + axis_in_a.dot(&top_point))
+    let top_a = (axis_in_a.dot(&convex_a.centre().coords) + axis_in_a.dot(&top_point))
         + axis.dot(&offset_a.translation.vector);
-    let bottom_b = (axis_in_b.dot(&convex_b.centroid().coords) + axis_in_b.dot(&bottom_point))
+    let bottom_b = (axis_in_b.dot(&convex_b.centre().coords) + axis_in_b.dot(&bottom_point))
         + axis.dot(&placed_b.translation.vector);
-    let gap = (bottom_b - top_a) - (convex_a.radius() + convex_b.radius());
+    let gap = (bottom_b - top_a) - (convex_a.rounding() + convex_b.rounding());
     // Each product and sum above errs by a few ε of the magnitudes involved,
     // the rotated axes by a few ε of their length 1, and a support search may
     // miss the maximum by a near-tie's last bit: 64 ε of every magnitude, as
     // a pair's own slack. The axis is unit to a few ε, which scales the gap.
-    let magnitude = convex_a.reach()
-        + convex_b.reach()
+    // (`centre_norm + size` is a convex piece's reach.)
+    let magnitude = (convex_a.centre_norm() + convex_a.size())
+        + (convex_b.centre_norm() + convex_b.size())
         + robust_norm(&offset_a.translation.vector)
         + robust_norm(&placed_b.translation.vector)
-        + convex_a.radius()
-        + convex_b.radius();
+        + convex_a.rounding()
+        + convex_b.rounding();
     (gap - 64.0 * f64::EPSILON * magnitude) * (1.0 - 8.0 * f64::EPSILON)
 }
 
@@ -65,9 +71,9 @@ pub(super) fn axis_gap(
 /// itself, and the piece pairs' runs, inlined in it, take more instructions
 /// in SSE2 code.
 #[inline(always)]
-pub(super) fn search_compound<const AVX2: bool>(
+pub(super) fn search_compound<const AVX2: bool, A: Pieces, B: Pieces>(
     simplex: &mut Simplex,
-    query: &Query<'_>,
+    query: &Query<'_, A, B>,
     rel: &Isometry3<f64>,
     warm: Option<&WarmStart>,
 ) -> (Answer, f64) {
@@ -83,9 +89,9 @@ cpu_forms! { entry
     /// [`search_compound_body`] for any CPU; the AVX2 form out of line too,
     /// so that the convex pair's path around its call stays as it was.
     #[inline(never)]
-    pub(super) fn search_compound_base / search_compound_avx2 (
+    pub(super) fn search_compound_base / search_compound_avx2 <A: Pieces, B: Pieces> (
         simplex: &mut Simplex,
-        query: &Query<'_>,
+        query: &Query<'_, A, B>,
         rel: &Isometry3<f64>,
         warm: Option<&WarmStart>
     ) -> (Answer, f64) => search_compound_body
@@ -101,9 +107,9 @@ const ON_STACK: usize = 16;
 
 /// The body of [`search_compound`], inlined into each of its compiled forms.
 #[inline(always)]
-pub(super) fn search_compound_body<const AVX2: bool>(
+pub(super) fn search_compound_body<const AVX2: bool, A: Pieces, B: Pieces>(
     simplex: &mut Simplex,
-    query: &Query<'_>,
+    query: &Query<'_, A, B>,
     rel: &Isometry3<f64>,
     warm: Option<&WarmStart>,
 ) -> (Answer, f64) {
@@ -256,9 +262,9 @@ impl PairTally {
     /// Counts a pair's `run` (with its certified lower bound `pair_lower`):
     /// its status, or `None` when it was pruned.
     #[inline(always)]
-    fn add(
+    fn add<A: SupportMap, B: SupportMap>(
         &mut self,
-        pair: &ConvexPair<'_>,
+        pair: &ConvexPair<'_, A, B>,
         run: &RunOutcome,
         pair_lower: f64,
         tolerance: f64,
@@ -324,7 +330,11 @@ fn union_status(out: &Answer, margin: Option<f64>, early: bool, trouble: Option<
 /// (ties by piece indices, so that the order is the same whichever way the
 /// pairs come).
 #[inline(always)]
-fn order_by_sphere_gap(query: &Query<'_>, rel: &Isometry3<f64>, order: &mut [Candidate]) {
+fn order_by_sphere_gap<A: Pieces, B: Pieces>(
+    query: &Query<'_, A, B>,
+    rel: &Isometry3<f64>,
+    order: &mut [Candidate],
+) {
     let (a, b) = (query.a, query.b);
     // B's pieces outside, so that each centre is placed in A's frame once.
     let mut slot = order.iter_mut();
@@ -335,8 +345,8 @@ fn order_by_sphere_gap(query: &Query<'_>, rel: &Isometry3<f64>, order: &mut [Can
             let convex_a = a.convex_piece(piece_a).expect("index below piece_count");
             let centre_a = a.piece_centre(piece_a).expect("index below piece_count");
             let gap = crate::numeric::robust_norm(&(centre_b - centre_a))
-                - (convex_a.size() + convex_a.radius())
-                - (convex_b.size() + convex_b.radius());
+                - (convex_a.size() + convex_a.rounding())
+                - (convex_b.size() + convex_b.rounding());
             if let Some(entry) = slot.next() {
                 *entry = (gap, piece_a as u32, piece_b as u32);
             }

@@ -4,6 +4,7 @@
 mod answer;
 mod between;
 mod compound;
+mod compound_between;
 pub(crate) mod core_run;
 mod full_step;
 mod numerical_algorithm;
@@ -25,6 +26,7 @@ use crate::support_map::SupportMap;
 
 pub use answer::Answer;
 pub use between::{distance_between, distance_between_in};
+pub use compound_between::{distance_between_compounds, distance_between_compounds_in};
 pub use options::{Options, Precision, Status};
 pub use warm_start::WarmStart;
 
@@ -288,7 +290,7 @@ fn distance_body<const AVX2: bool>(
         ),
         _ => {
             let (answer, stuck_width) =
-                search_compound::<AVX2>(&mut workspace.simplex, query, &rel, warm);
+                search_compound::<AVX2, _, _>(&mut workspace.simplex, query, &rel, warm);
             (answer, if swapped { f64::INFINITY } else { stuck_width })
         }
     };

@@ -1,7 +1,8 @@
 //! The simplex a query hands back for the next query of the same pair.
 
 use crate::johnson::Simplex;
-use crate::shape::Shape;
+use crate::shape::Pieces;
+use crate::support_map::SupportMap;
 
 /// One piece pair's final simplex: its pieces and vertex index pairs (a
 /// cylinder's entries are codes of its support points, see
@@ -23,7 +24,7 @@ impl PieceSimplex {
     /// (an empty entry always fits). Branch-free over the pairs: one
     /// comparison each, folded into one flag.
     #[inline]
-    pub(super) fn fits_shapes(&self, a: &Shape, b: &Shape) -> bool {
+    pub(super) fn fits_shapes<A: Pieces, B: Pieces>(&self, a: &A, b: &B) -> bool {
         if self.len == 0 {
             return true;
         }

@@ -9,12 +9,14 @@
 //! One form a file: [`polytope`] (the vertex sets, with one file per support
 //! search strategy), [`cylinder`] (a closed form), [`compound`] (unions);
 //! [`convex`] holds the stored convex type that dispatches to the first two,
-//! and this file the [`Shape`] a query takes.
+//! and this file the [`Shape`] a query takes; [`pieces`] what a union's
+//! search reads of either.
 
 mod build;
 pub(crate) mod compound;
 pub(crate) mod convex;
 pub(crate) mod cylinder;
+pub(crate) mod pieces;
 pub(crate) mod polytope;
 pub(crate) mod reach;
 #[cfg(test)]
@@ -24,6 +26,7 @@ use nalgebra::{Isometry3, Point3};
 
 pub use compound::Compound;
 pub use convex::Convex;
+pub(crate) use pieces::Pieces;
 pub(crate) use reach::shift_is_in_range;
 
 /// Anything the query accepts: one convex piece or a union of them.

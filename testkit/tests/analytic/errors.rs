@@ -73,7 +73,7 @@ fn constructor_errors() {
     assert!(Convex::sphere(0.0).is_ok());
     assert!(Convex::cuboid(v(0., 0., 0.), 0.0).is_ok());
     assert_eq!(
-        no_panic("empty compound", || Compound::new(vec![])),
+        no_panic("empty compound", || Compound::<Convex>::new(vec![])),
         Err(Error::EmptyCompound)
     );
     let piece = Convex::sphere(1.0).unwrap();

@@ -15,7 +15,6 @@
 
 use nalgebra::Vector3;
 
-use super::kinks::cylinder_of;
 use crate::query::pair::{ConvexPair, rotate, rotate_back};
 use crate::shape::cylinder;
 use crate::support_map::SupportMap;
@@ -32,8 +31,7 @@ impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
     /// the other shape's support point along the axis is not beyond the cap
     /// or does not project inside it.
     pub(super) fn cap_seed(&self, k: usize, u: &Vector3<f64>) -> Option<[[u32; 2]; 3]> {
-        let shape = self.shapes()[k];
-        let (r, h) = cylinder_of(shape)?;
+        let (r, h) = self.cylinder_at(k)?;
         let (r, h) = (r * self.scale, h * self.scale);
         let pairs = if k == 0 {
             let side = axis_sign(u.z)?;

@@ -27,7 +27,7 @@
 
 use nalgebra::Vector3;
 
-use super::kinks::{Kinks, Solve, cylinder_of};
+use super::kinks::{Kinks, Solve};
 use crate::query::pair::ConvexPair;
 use crate::shape::cylinder;
 use crate::support_map::SupportMap;
@@ -110,7 +110,7 @@ impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
         let mut rims: [Rim; 2] = [(Vector3::zeros(), 0.0); 2];
         let mut rim_count = 0;
         let axes = self.axes();
-        for (k, (shape, feature)) in self.shapes().into_iter().zip(features).enumerate() {
+        for (k, feature) in features.into_iter().enumerate() {
             let sign = if k == 0 { -self.scale } else { self.scale };
             match feature {
                 Feature::Side => {}
@@ -120,13 +120,13 @@ impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
                         return None;
                     }
                     linear +=
-                        self.in_pair_frame(k, shape.local_point(kinks.keys[0] as usize)) * sign;
+                        self.in_pair_frame(k, self.point_at(k, kinks.keys[0] as usize)) * sign;
                 }
                 Feature::Vertex(index) => {
-                    linear += self.in_pair_frame(k, shape.local_point(index as usize)) * sign;
+                    linear += self.in_pair_frame(k, self.point_at(k, index as usize)) * sign;
                 }
                 Feature::Rim(top) => {
-                    let (r, h) = cylinder_of(shape)?;
+                    let (r, h) = self.cylinder_at(k)?;
                     let axis = axes[k];
                     let cap = if top { h } else { -h };
                     linear += axis * (cap * sign);
@@ -432,20 +432,20 @@ impl<A: SupportMap, B: SupportMap> ConvexPair<'_, A, B> {
         supports: [(usize, Vector3<f64>); 2],
         features: [Feature; 2],
     ) -> bool {
-        self.shapes()
+        supports
             .into_iter()
-            .zip(supports)
             .zip(features)
             .zip(kinks)
-            .all(|(((shape, (index, d)), feature), kinks)| {
+            .enumerate()
+            .all(|(k, (((index, d), feature), kinks))| {
                 let key = index as u32;
                 match feature {
                     Feature::Side => true,
                     Feature::Edge => kinks.has(key),
                     Feature::Face => {
                         kinks.has(key) || {
-                            let rise = shape.local_point(index)
-                                - shape.local_point(kinks.keys[0] as usize);
+                            let rise =
+                                self.point_at(k, index) - self.point_at(k, kinks.keys[0] as usize);
                             d.dot(&rise).abs() <= FACE_TIE * rise.norm()
                         }
                     }

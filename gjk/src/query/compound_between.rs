@@ -1,0 +1,160 @@
+//! [`distance_between_compounds`]: the distance between two unions of
+//! convex pieces of any [`SupportMap`] types, (2.3) and (2.8). The same
+//! search over piece pairs as [`distance`](crate::distance)'s compounds
+//! (warm pairs first, each pair cut off by the best upper bound so far,
+//! pairs proved farther by a bounding sphere or a separating axis not run),
+//! monomorphised for each pair of piece types, with the same certified
+//! bounds, margins and warm start.
+
+use nalgebra::Isometry3;
+
+use super::compound::search_compound;
+use super::recovery::recover_with;
+use super::{
+    Answer, Options, Query, WarmStart, Workspace, is_suspect, relative_pose, with_spare_workspace,
+};
+use crate::Error;
+use crate::shape::Compound;
+use crate::support_map::SupportMap;
+
+/// The distance between the compounds `a` at `pose_a` and `b` at `pose_b`,
+/// their pieces known by their [`SupportMap`]s: the least distance over
+/// piece pairs, with the pieces that realise it
+/// ([`Answer::pieces`]), its nearest points, certified bounds (the lower
+/// bound is the least over the piece pairs' lower bounds, so it holds for
+/// the union) and a warm start that names the nearest piece pair and the
+/// runner-up. A single shape is a compound of one piece at the identity.
+/// For two compounds of [`Convex`](crate::Convex) pieces the answer is
+/// [`distance`](crate::distance)'s, bit for bit.
+///
+/// ```
+/// use gjk::{Compound, Convex, Options, distance_between_compounds};
+/// use nalgebra::Isometry3;
+///
+/// // Two balls side by side against one ball: the nearer of the two wins.
+/// let ball = Convex::sphere(0.5)?;
+/// let pair = Compound::new(vec![
+///     (Isometry3::translation(-2.0, 0.0, 0.0), ball.clone()),
+///     (Isometry3::translation(2.0, 0.0, 0.0), ball.clone()),
+/// ])?;
+/// let one = Compound::new(vec![(Isometry3::identity(), ball)])?;
+/// let answer = distance_between_compounds(
+///     &pair, &Isometry3::identity(), &one, &Isometry3::translation(4.0, 0.0, 0.0),
+///     &Options::default(), None,
+/// )?;
+/// assert_eq!(answer.pieces, [1, 0]);
+/// assert!((answer.distance - 1.0).abs() < 1e-12);
+/// # Ok::<(), gjk::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`distance`](crate::distance): [`Error::WarmStartOutOfRange`] for a
+/// warm start naming a piece the compounds do not have, or an index not
+/// below its piece's [`index_count`](SupportMap::index_count).
+pub fn distance_between_compounds<A: SupportMap, B: SupportMap>(
+    a: &Compound<A>,
+    pose_a: &Isometry3<f64>,
+    b: &Compound<B>,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
+    with_spare_workspace(|workspace| {
+        distance_between_compounds_in(workspace, a, pose_a, b, pose_b, options, warm)
+    })
+}
+
+/// [`distance_between_compounds`] in a caller's [`Workspace`]: the same
+/// answer, bit for bit.
+///
+/// # Errors
+/// As [`distance_between_compounds`].
+pub fn distance_between_compounds_in<A: SupportMap, B: SupportMap>(
+    workspace: &mut Workspace,
+    a: &Compound<A>,
+    pose_a: &Isometry3<f64>,
+    b: &Compound<B>,
+    pose_b: &Isometry3<f64>,
+    options: &Options,
+    warm: Option<&WarmStart>,
+) -> Result<Answer, Error> {
+    let query = Query::new(a, pose_a, b, pose_b, options, warm);
+    #[cfg(target_arch = "x86_64")]
+    if crate::has_avx2_fma() {
+        // SAFETY: the CPU supports AVX2 and FMA, checked just above.
+        return unsafe { compounds_avx2(workspace, &query) };
+    }
+    compounds_base(workspace, &query)
+}
+
+cpu_forms! { entry
+    /// [`compounds_body`] for any CPU, out of line, as `distance_base` is;
+    /// its AVX2 form is `compounds_avx2` (see [`crate::cpu`]).
+    #[inline(never)]
+    fn compounds_base / compounds_avx2 <A: SupportMap, B: SupportMap> (
+        workspace: &mut Workspace,
+        query: &Query<'_, Compound<A>, Compound<B>>
+    ) -> Result<Answer, Error> => compounds_body
+}
+
+/// The body of [`distance_between_compounds_in`], inlined into each
+/// compiled form: `distance`'s body for two unions.
+#[inline(always)]
+fn compounds_body<const AVX2: bool, A: SupportMap, B: SupportMap>(
+    workspace: &mut Workspace,
+    query: &Query<'_, Compound<A>, Compound<B>>,
+) -> Result<Answer, Error> {
+    let &Query {
+        a,
+        pose_a,
+        b,
+        pose_b,
+        options,
+        warm,
+        swapped,
+    } = query;
+    options.validate()?;
+    if let Some(w) = warm
+        && !(w.first.fits_shapes(a, b) && w.second.fits_shapes(a, b))
+    {
+        return Err(Error::WarmStartOutOfRange);
+    }
+    let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
+    let rel = relative_pose(pose_a, pose_b)?;
+    let (answer, stuck_width) =
+        search_compound::<AVX2, _, _>(&mut workspace.simplex, query, &rel, warm);
+    let stuck_width = if swapped { f64::INFINITY } else { stuck_width };
+    if is_suspect(&answer, stuck_width) {
+        return recover_compounds::<AVX2, A, B>(answer, workspace, query, stuck_width);
+    }
+    Ok(answer)
+}
+
+/// The rare ends of [`compounds_body`], as `recover_suspect_answer`'s.
+#[cold]
+#[inline(never)]
+fn recover_compounds<const AVX2: bool, A: SupportMap, B: SupportMap>(
+    answer: Answer,
+    workspace: &mut Workspace,
+    query: &Query<'_, Compound<A>, Compound<B>>,
+    stuck_width: f64,
+) -> Result<Answer, Error> {
+    recover_with(
+        answer,
+        workspace,
+        query,
+        stuck_width,
+        |workspace| {
+            let Query {
+                a,
+                pose_a,
+                b,
+                pose_b,
+                options,
+                ..
+            } = *query;
+            distance_between_compounds_in(workspace, a, pose_a, b, pose_b, options, None)
+        },
+        |workspace| compounds_body::<AVX2, B, A>(workspace, &query.swapped()),
+    )
+}

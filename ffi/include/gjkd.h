@@ -47,7 +47,7 @@
 
 // The wire protocol version this library speaks; a server of another
 // version is refused with `GJKD_ERR_VERSION_MISMATCH`.
-#define GJKD_PROTOCOL_VERSION 3
+#define GJKD_PROTOCOL_VERSION 4
 
 // Default relative tolerance of a query: 100 × machine epsilon.
 #define GJKD_DEFAULT_TOLERANCE 2.220446049250313e-14

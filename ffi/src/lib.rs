@@ -70,7 +70,7 @@ pub use types::*;
 
 /// The wire protocol version this library speaks; a server of another
 /// version is refused with `GJKD_ERR_VERSION_MISMATCH`.
-pub const GJKD_PROTOCOL_VERSION: u32 = 3;
+pub const GJKD_PROTOCOL_VERSION: u32 = 4;
 const _: () = assert!(GJKD_PROTOCOL_VERSION == gjkd_proto::PROTOCOL_VERSION);
 
 /// Default relative tolerance of a query: 100 × machine epsilon.

@@ -71,7 +71,7 @@ pub mod lookup_kind {
 /// empty for other operations.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.AdminRequest")]
+#[type_name("gjkd.v4.AdminRequest")]
 pub struct AdminRequest {
     /// [`AdminOp`] wire value.
     pub op: u32,
@@ -191,7 +191,7 @@ impl WaitMode {
 /// crate's `Client::server_info`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ServerInfo")]
+#[type_name("gjkd.v4.ServerInfo")]
 pub struct ServerInfo {
     /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION) of the server.
     pub protocol: u32,
@@ -217,7 +217,7 @@ pub struct ServerInfo {
 /// Server statistics.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ServerStats")]
+#[type_name("gjkd.v4.ServerStats")]
 pub struct ServerStats {
     /// Objects held.
     pub objects: u64,
@@ -251,7 +251,7 @@ pub struct ServerStats {
 /// The admin service's answer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.AdminReply")]
+#[type_name("gjkd.v4.AdminReply")]
 pub struct AdminReply {
     /// [`ErrorCode`] wire value.
     pub error: u32,

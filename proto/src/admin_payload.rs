@@ -20,7 +20,7 @@ pub const TEXT_CHUNK_LEN: usize = 24;
 /// are valid in either, and the slice views below cast without copying.
 #[derive(Clone, Copy, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.AdminChunk")]
+#[type_name("gjkd.v4.AdminChunk")]
 pub union AdminChunk {
     /// A vertex of a registration.
     pub vertex: Vertex,

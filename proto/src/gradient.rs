@@ -59,7 +59,7 @@ pub mod gradient_flags {
 /// [`scene_flags::GRADIENTS`](crate::scene_flags::GRADIENTS).
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.Gradient")]
+#[type_name("gjkd.v4.Gradient")]
 pub struct Gradient {
     /// `∂d/∂x_k` for `k < columns`; zero beyond.
     pub values: [f64; GRADIENT_COLUMNS],

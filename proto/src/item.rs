@@ -175,7 +175,7 @@ impl QueryOptions {
 /// [`Item::distance`] and [`Item::set_joints`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.Item")]
+#[type_name("gjkd.v4.Item")]
 pub struct Item {
     /// [`ItemKind`] wire value.
     pub kind: u32,

@@ -14,7 +14,7 @@ use crate::{JOINTS_PER_ITEM, Pose};
 /// the pose of B and the query options.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.PairBody")]
+#[type_name("gjkd.v4.PairBody")]
 pub struct PairBody {
     /// This query's pose of B with [`item_flags::POSE_B`](crate::item_flags::POSE_B).
     pub pose_b: Pose,
@@ -32,7 +32,7 @@ pub struct PairBody {
 /// joint positions `first .. first + count` of the robot.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.JointsBody")]
+#[type_name("gjkd.v4.JointsBody")]
 pub struct JointsBody {
     /// The positions (radians or metres, in the robot's joint order); only
     /// the first `count` are read.
@@ -51,7 +51,7 @@ pub struct JointsBody {
 /// [`Item::joints`](crate::Item::joints) read it without `unsafe`.
 #[derive(Clone, Copy, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ItemBody")]
+#[type_name("gjkd.v4.ItemBody")]
 pub union ItemBody {
     /// Pose updates, pair queries and scene-only items.
     pub pair: PairBody,

@@ -11,11 +11,11 @@
 //!
 //! | service name | pattern | request | response |
 //! |---|---|---|---|
-//! | [`query_service_name`] `{service}/v3/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ReplyEntry`]`]` (results, then gradients) |
-//! | [`admin_service_name`] `{service}/v3/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
-//! | [`scene_service_name`] `{service}/v3/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
-//! | [`poses_service_name`] `{service}/v3/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
-//! | [`wake_service_name`] `{service}/v3/wake` | event | | |
+//! | [`query_service_name`] `{service}/v4/query` | request-response | `[`[`Item`]`]` | [`ReplyHeader`] + `[`[`ReplyEntry`]`]` (results, then gradients) |
+//! | [`admin_service_name`] `{service}/v4/admin` | request-response | [`AdminRequest`] + `[`[`AdminChunk`]`]` | [`AdminReply`] |
+//! | [`scene_service_name`] `{service}/v4/scene` | request-response | [`SceneRequest`] + `[`[`Item`]`]` | [`SceneReply`] + `[`[`SceneRow`]`]` |
+//! | [`poses_service_name`] `{service}/v4/poses` | request-response | `[u64]` (object ids) | [`PosesReply`] + `[`[`StoredPose`]`]` |
+//! | [`wake_service_name`] `{service}/v4/wake` | event | | |
 //!
 //! Integers that encode a choice ([`Item::kind`], [`ItemResult::error`], ...)
 //! are plain `u32` on the wire, never Rust enums: any bit pattern a client
@@ -88,11 +88,12 @@ pub use shape::{PieceDesc, Vertex, piece_kind, shape_kind};
 /// item's body is a pair view or a joints view ([`ItemBody`]), robot text
 /// travels as bytes ([`AdminChunk`]), results carry the signed distance
 /// and the gradient, scene requests the continuous mode and its bracket,
-/// and stored poses are read back on a service of their own. A query
-/// reply's gradients travel after its results, only for the items that
-/// ask ([`ReplyEntry`]), and a scene row's beside its result
+/// and stored poses are read back on a service of their own. Version 4
+/// takes the gradient out of every result: a query reply's gradients
+/// travel after its results, only for the items that ask
+/// ([`ReplyEntry`], [`GradientRow`]), and a scene row's beside its result
 /// ([`SceneRow::gradient`]).
-pub const PROTOCOL_VERSION: u32 = 3;
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// Service name used when none is given: `"gjkd"`.
 pub const DEFAULT_SERVICE: &str = "gjkd";
@@ -114,7 +115,7 @@ pub const JOINTS_PER_ITEM: usize = 9;
 /// Longest object name in bytes (UTF-8).
 pub const MAX_NAME_LEN: usize = 64;
 
-/// Name of the query service of deployment `service`: `{service}/v3/query`.
+/// Name of the query service of deployment `service`: `{service}/v4/query`.
 pub fn query_service_name(service: &str) -> String {
     format!("{service}/v{PROTOCOL_VERSION}/query")
 }

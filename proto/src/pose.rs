@@ -26,7 +26,7 @@ pub const MAX_TRANSLATION: f64 = 2.6787715179656683e300;
 /// (nalgebra's coordinate order), in f64.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.Pose")]
+#[type_name("gjkd.v4.Pose")]
 pub struct Pose {
     /// Translation.
     pub translation: [f64; 3],

@@ -11,7 +11,7 @@ use crate::{ErrorCode, Pose};
 /// and base.
 #[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.StoredPose")]
+#[type_name("gjkd.v4.StoredPose")]
 pub struct StoredPose {
     /// The object asked about.
     pub id: u64,
@@ -39,7 +39,7 @@ impl StoredPose {
 /// The header of the pose service's answer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.PosesReply")]
+#[type_name("gjkd.v4.PosesReply")]
 pub struct PosesReply {
     /// [`ErrorCode`] wire value for the request as a whole:
     /// [`ErrorCode::EmptyBatch`] for no id, [`ErrorCode::BatchTooLarge`]

@@ -11,7 +11,7 @@ use crate::{Gradient, ItemResult};
 /// gradient section (see [`ReplyEntry`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.GradientRow")]
+#[type_name("gjkd.v4.GradientRow")]
 pub struct GradientRow {
     /// Index of the item it answers in the request.
     pub item: u32,
@@ -33,7 +33,7 @@ pub struct GradientRow {
 /// cast without copying.
 #[derive(Clone, Copy, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ReplyEntry")]
+#[type_name("gjkd.v4.ReplyEntry")]
 pub union ReplyEntry {
     /// An item's result.
     pub result: ItemResult,

@@ -66,7 +66,7 @@ pub mod result_flags {
 /// Read it with [`ItemResult::answer`].
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ItemResult")]
+#[type_name("gjkd.v4.ItemResult")]
 pub struct ItemResult {
     /// Distance between the (rounded) shapes, `>= 0`.
     pub distance: f64,
@@ -238,7 +238,7 @@ pub struct SignedDistance {
 /// [`ErrorCode::Ok`] the slice is empty.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.ReplyHeader")]
+#[type_name("gjkd.v4.ReplyHeader")]
 pub struct ReplyHeader {
     /// [`ErrorCode`] wire value: [`ErrorCode::EmptyBatch`],
     /// [`ErrorCode::BatchTooLarge`], or [`ErrorCode::Ok`].

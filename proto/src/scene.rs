@@ -208,7 +208,7 @@ pub mod scene_reply_flags {
 /// Request header of the scene service.
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.SceneRequest")]
+#[type_name("gjkd.v4.SceneRequest")]
 pub struct SceneRequest {
     /// [`SceneKind`] wire value.
     pub kind: u32,
@@ -295,7 +295,7 @@ impl SceneRequest {
 /// One row of a scene answer: a pair and its distance answer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.SceneRow")]
+#[type_name("gjkd.v4.SceneRow")]
 pub struct SceneRow {
     /// The group's object (the object asked about, for
     /// [`SceneKind::Nearest`]).
@@ -330,7 +330,7 @@ pub struct SceneRow {
 /// Response header of the scene service.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.SceneReply")]
+#[type_name("gjkd.v4.SceneReply")]
 pub struct SceneReply {
     /// [`ErrorCode`] wire value for the whole request; when it is not
     /// [`ErrorCode::Ok`] the row slice is empty and nothing changed.

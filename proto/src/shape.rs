@@ -8,7 +8,7 @@ use crate::Pose;
 /// A vertex on the wire.
 #[derive(Clone, Copy, Debug, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.Vertex")]
+#[type_name("gjkd.v4.Vertex")]
 pub struct Vertex {
     /// x.
     pub x: f64,
@@ -79,7 +79,7 @@ pub mod piece_kind {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, ZeroCopySend)]
 #[repr(C)]
-#[type_name("gjkd.v3.PieceDesc")]
+#[type_name("gjkd.v4.PieceDesc")]
 pub struct PieceDesc {
     /// Offset of the piece in the object's body frame.
     pub offset: Pose,

@@ -6,9 +6,9 @@ use std::mem::offset_of;
 
 #[test]
 fn names_carry_the_version() {
-    assert_eq!(query_service_name("gjkd"), "gjkd/v3/query");
-    assert_eq!(admin_service_name("x"), "x/v3/admin");
-    assert_eq!(wake_service_name("x"), "x/v3/wake");
+    assert_eq!(query_service_name("gjkd"), "gjkd/v4/query");
+    assert_eq!(admin_service_name("x"), "x/v4/admin");
+    assert_eq!(wake_service_name("x"), "x/v4/wake");
 }
 
 #[test]

@@ -40,8 +40,8 @@ impl From<Wait> for WaitMode {
 /// The flags of `gjkd serve`.
 #[derive(Args, Debug)]
 pub struct ServeArgs {
-    /// Deployment name: the services are NAME/v3/query, NAME/v3/admin,
-    /// NAME/v3/scene and NAME/v3/wake.
+    /// Deployment name: the services are NAME/v4/query, NAME/v4/admin,
+    /// NAME/v4/scene and NAME/v4/wake.
     #[arg(long, default_value = DEFAULT_SERVICE)]
     pub service: String,
     /// Scene file (TOML) of read-only named objects to load at start.

@@ -125,7 +125,7 @@ pub fn response_chunks(clients: usize) -> usize {
 /// Everything needed to start a server.
 #[derive(Clone, Debug)]
 pub struct ServeOptions {
-    /// Deployment name; the services are `{service}/v3/...`.
+    /// Deployment name; the services are `{service}/v4/...`.
     pub service: String,
     /// Wait strategy.
     pub wait: WaitMode,

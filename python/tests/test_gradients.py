@@ -16,6 +16,7 @@ from typing import Any, Iterator
 
 import numpy as np
 import pytest
+from test_robots import matrix
 
 import gjkd
 
@@ -68,17 +69,23 @@ def padded(answer: Any, columns: int) -> np.ndarray:
     return row
 
 
-def matrix(row: np.ndarray) -> np.ndarray:
-    """The ``(4, 4)`` of a ``[x, y, z, qx, qy, qz, qw]`` pose."""
-    x, y, z, w = row[3:]
-    m = np.eye(4)
-    m[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    m[:3, 3] = row[:3]
-    return m
+def judge_differences(rows: gjkd.Distances, differences: np.ndarray, pairs: np.ndarray) -> int:
+    """Checks each row's gradient against its central differences where
+    the gradient exists (apart, unique nearest points); returns how many
+    rows were judged."""
+    judged = 0
+    for i in range(len(pairs)):
+        if rows.distance[i] <= 1e-6 or rows.gradient_flags[i] & 2:
+            continue
+        got, want = rows.gradient[i], differences[i]
+        # The step's rounding: the distance to about 1e-14 over 2h.
+        assert np.linalg.norm(got - want) <= 1e-6 * np.linalg.norm(want) + 1e-7, (
+            pairs[i],
+            got,
+            want,
+        )
+        judged += 1
+    return judged
 
 
 def turned(m: np.ndarray, k: int, t: float) -> np.ndarray:
@@ -254,19 +261,7 @@ def test_batch_gradients_match_central_differences(
         minus = client.distances(pairs, warm_start=False).distance
         differences[:, k] = (plus - minus) / (2 * h)
     client.set_joints(robot, q)
-    judged = 0
-    for i in range(len(pairs)):
-        if rows.distance[i] <= 1e-6 or rows.gradient_flags[i] & 2:
-            continue
-        got, want = rows.gradient[i], differences[i]
-        # The step's rounding: the distance to about 1e-14 over 2h.
-        assert np.linalg.norm(got - want) <= 1e-6 * np.linalg.norm(want) + 1e-7, (
-            pairs[i],
-            got,
-            want,
-        )
-        judged += 1
-    assert judged > 20
+    assert judge_differences(rows, differences, pairs) > 20
 
 
 def test_a_free_object_gets_its_twist(panda: tuple[gjkd.Client, Any, list[int]]) -> None:
@@ -304,18 +299,7 @@ def test_a_free_object_gets_its_twist(panda: tuple[gjkd.Client, Any, list[int]])
         d_plus = client.distances(pairs, poses_a=plus, warm_start=False).distance
         d_minus = client.distances(pairs, poses_a=minus, warm_start=False).distance
         differences[:, k] = (d_plus - d_minus) / (2 * h)
-    judged = 0
-    for i in range(len(pairs)):
-        if rows.distance[i] <= 1e-6 or rows.gradient_flags[i] & 2:
-            continue
-        got, want = rows.gradient[i], differences[i]
-        assert np.linalg.norm(got - want) <= 1e-6 * np.linalg.norm(want) + 1e-7, (
-            pairs[i],
-            got,
-            want,
-        )
-        judged += 1
-    assert judged > 10
+    assert judge_differences(rows, differences, pairs) > 10
     # Two balls: moving the first along the line of centres, -1 per unit
     # of distance; turning a ball about its centre changes nothing.
     balls = obstacles[1::2]

@@ -188,11 +188,39 @@ class Answer:
 
 @final
 class Distances:
-    """The answers of N pair queries, one numpy array per field."""
+    """The answers of N pair queries, one numpy array per field.
 
-    def __new__(cls, n: int) -> Self:
-        """Zeroed arrays for ``n`` pairs, to pass as ``out=``."""
+    ``Distances(n, gradient_columns=c)`` with ``c > 0`` also asks every call
+    given it as ``out=`` for each pair's distance gradient, into
+    ``gradient`` ``(N, c)``, ``gradient_flags`` and ``gradient_error``, as
+    ``SceneRows(n, gradient_columns=c)`` does for scene rows: the room asks,
+    sized once and reused, so a call never asks a gradient it has no room
+    for and allocates nothing."""
+
+    def __new__(cls, n: int, gradient_columns: int = 0, gradient_base: bool = False) -> Self:
+        """Zeroed arrays for ``n`` pairs, to pass as ``out=``, with room for
+        ``gradient_columns`` (at most 16) gradient entries per pair: each
+        call filling them then asks every pair's gradient (with
+        ``gradient_base=True``, a robot base's twist too; it raises
+        ``InvalidInput`` without gradient columns). A gradient of more than
+        ``c`` columns keeps its first ``c``: size ``c`` for the widest pair
+        (a robot's ``dof``, plus 6 with ``gradient_base``; 6 for a free
+        object)."""
     def __len__(self) -> int: ...
+    @property
+    def gradient(self) -> _F64:
+        """``(N, gradient_columns)`` each pair's gradient with respect to the
+        coordinates that move its ``a`` (a robot's joints, then the base
+        twist with ``gradient_base``; another object's twist), zero beyond
+        the columns in use and in failed rows; bit for bit what
+        ``distance(a, b, gradient=True)`` answers."""
+    @property
+    def gradient_flags(self) -> _U32:
+        """``(N,)`` 1 computed, 2 not unique, 4 base included, 8 no direction
+        (0 in failed rows or without gradient columns)."""
+    @property
+    def gradient_error(self) -> _F64:
+        """``(N,)`` a bound on each pair's gradient entries' error."""
     @property
     def distance(self) -> _F64:
         """``(N,)`` distances."""
@@ -268,7 +296,10 @@ class SceneRows:
         signed_distance: bool = False,
     ) -> Self:
         """Zeroed room for ``n`` rows (and ``gradient_columns`` gradient
-        entries per row: a call then asks each row's distance gradient).
+        entries per row, at most 16: a call then asks each row's distance
+        gradient, kept in ``answers``' arrays; ``gradient_base=True``
+        without gradient columns raises ``InvalidInput``). A gradient of
+        more columns than the room keeps its first ones.
 
         ``signed_distance=True`` asks every call for each row's signed
         distance with its certified interval (``signed_distance``,
@@ -491,6 +522,8 @@ class _Objects:
         robot's moving joints (``Robot.joint_names`` order), then with
         ``gradient_base=True`` the base twist ``[v, ω]``; any other object,
         its pose's twist (world frame, turning about its origin).
+        ``gradient_base=True`` without ``gradient=True`` raises
+        ``InvalidInput``.
         """
     def distances(
         self,
@@ -509,7 +542,10 @@ class _Objects:
 
         ``signed_distance=True`` also answers each pair's signed distance
         with its certified interval (``Distances.signed_distance``,
-        ``signed_lower``, ``signed_upper``)."""
+        ``signed_lower``, ``signed_upper``). Gradients are asked by the
+        room, as for scene rows: ``out=Distances(N, gradient_columns=c)``
+        gets each pair's gradient in its ``(N, c)`` ``gradient`` array
+        (``gradient_flags``, ``gradient_error``)."""
     def register_robot(
         self,
         name: str,

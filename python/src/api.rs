@@ -227,8 +227,8 @@ pub fn distance(
     }
     let (answerer, buffers) = backend.parts(py)?;
     let (out, gradient) = if args.gradient.is_some() {
-        // The gradient travels apart from the result: this path has room
-        // for it, the batch runner none.
+        // The gradient travels apart from the result, into room of its
+        // own for this one item.
         run_gradient(py, answerer, item).map_err(|e| errors::client(py, e, None))?
     } else {
         let mut out = ItemResult::default();
@@ -274,7 +274,7 @@ pub fn distances(
     )?;
     let arrays = RequestArrays::read(pairs, poses_a, poses_b)?;
     let result = Distances::reuse_or_new(py, out, arrays.len())?;
-    let request = arrays.request(opts)?;
+    let request = arrays.request(opts, result.borrow(py).gradient_request())?;
     let (answerer, buffers) = backend.parts(py)?;
     run_pairs(py, answerer, buffers, request, &result.borrow(py))?
         .map_err(|e| errors::client(py, e, None))?;
@@ -519,7 +519,8 @@ macro_rules! backend_methods {
             /// `gradient=True` also asks the distance's gradient with
             /// respect to the coordinates that move `a` (its robot's
             /// joints, or its pose's twist; `Answer.gradient`), and
-            /// `gradient_base=True` the robot base's twist too.
+            /// `gradient_base=True` the robot base's twist too
+            /// (`gradient_base=True` alone raises `InvalidInput`).
             /// Returns an `Answer`; a refused query raises (`NotFound` for
             /// an unknown id, `InvalidInput` for a bad pose).
             #[pyo3(signature = (a, b, pose_a = None, pose_b = None, *,
@@ -542,7 +543,7 @@ macro_rules! backend_methods {
                 gradient: bool,
                 gradient_base: bool,
             ) -> PyResult<crate::batch::Answer> {
-                let gradient = gradient.then_some(gradient_base);
+                let gradient = crate::batch::gradient_asked(py, gradient, gradient_base)?;
                 let args = crate::api::QueryArgs {
                     tolerance, max_iterations, margin, warm_start, signed_distance, gradient,
                 };
@@ -563,6 +564,12 @@ macro_rules! backend_methods {
             /// `signed_distance`, `signed_lower` and `signed_upper` arrays
             /// (NaN otherwise), and an overlapping pair's depth witnesses
             /// in `point_a`, `point_b`, `normal`.
+            /// Gradients are asked by the room they go into, as for scene
+            /// rows: `out=gjkd.Distances(N, gradient_columns=c)` (with
+            /// `gradient_base=True` the base twist too) fills its
+            /// `gradient` `(N, c)`, `gradient_flags` and `gradient_error`
+            /// with each pair's gradient, bit for bit what
+            /// `distance(gradient=True)` answers.
             #[pyo3(signature = (pairs, poses_a = None, poses_b = None, *,
                 tolerance = gjkd_client::DEFAULT_TOLERANCE, max_iterations = 128,
                 margin = None, warm_start = true, signed_distance = false, out = None),

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAnyMethods, PyDict};
 
 use gjkd_client::{Gradient, Item, ItemResult, ObjectId, Precision, QueryOptions};
-use gjkd_proto::{Pose, result_flags};
+use gjkd_proto::{GRADIENT_COLUMNS, Pose, result_flags};
 
 use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array, pose_array};
 use crate::errors::invalid;
@@ -50,6 +50,47 @@ pub fn options(
         precision: Precision::Double,
         signed_distance,
     })
+}
+
+/// What `gradient=` and `gradient_base=` of a single query ask: `None`
+/// (no gradient) or `Some(base)`. The base twist alone is not a gradient
+/// asked: refused rather than ignored, so that a forgotten `gradient=True`
+/// does not pass unnoticed.
+pub fn gradient_asked(py: Python<'_>, gradient: bool, base: bool) -> PyResult<Option<bool>> {
+    if base && !gradient {
+        return Err(invalid(
+            py,
+            "gradient_base",
+            None,
+            "gradient_base=True adds the base twist to a gradient: pass gradient=True too".into(),
+        ));
+    }
+    Ok(gradient.then_some(base))
+}
+
+/// Checks the gradient room of a `Distances` or `SceneRows`: at most
+/// [`GRADIENT_COLUMNS`] columns, and `gradient_base` only with columns
+/// (without them no gradient is asked, so a base twist would be dropped
+/// without a word).
+pub fn check_gradient_room(py: Python<'_>, columns: usize, base: bool) -> PyResult<()> {
+    if columns > GRADIENT_COLUMNS {
+        return Err(invalid(
+            py,
+            "gradient_columns",
+            None,
+            format!("a row carries at most {GRADIENT_COLUMNS} gradient entries, not {columns}"),
+        ));
+    }
+    if base && columns == 0 {
+        return Err(invalid(
+            py,
+            "gradient_base",
+            None,
+            "gradient_base=True adds the base twist to a gradient: give gradient_columns > 0 too"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The arrays of a `distances` call, read and checked, held while their
@@ -110,13 +151,16 @@ impl<'py> RequestArrays<'py> {
         self.n
     }
 
-    /// The request, as slices that can be used without the GIL.
-    pub fn request(&self, options: QueryOptions) -> PyResult<Request<'_>> {
+    /// The request, as slices that can be used without the GIL; with
+    /// `gradient` `Some(base)`, every pair also asks its gradient (and
+    /// with `base` the base twist's columns).
+    pub fn request(&self, options: QueryOptions, gradient: Option<bool>) -> PyResult<Request<'_>> {
         Ok(Request {
             pairs: self.pairs.slice()?,
             poses_a: self.poses_a.as_ref().map(|p| p.poses()).transpose()?,
             poses_b: self.poses_b.as_ref().map(|p| p.poses()).transpose()?,
             options,
+            gradient,
         })
     }
 }
@@ -128,12 +172,19 @@ pub struct Request<'a> {
     poses_a: Option<Poses<'a>>,
     poses_b: Option<Poses<'a>>,
     options: QueryOptions,
+    /// `Some(base)`: every pair asks its gradient.
+    gradient: Option<bool>,
 }
 
 impl Request<'_> {
     /// Number of pairs.
     pub fn len(&self) -> usize {
         self.pairs.len() / 2
+    }
+
+    /// Whether every pair asks its gradient.
+    pub fn asks_gradients(&self) -> bool {
+        self.gradient.is_some()
     }
 
     /// Appends the items of pairs `range` to `items`.
@@ -146,6 +197,9 @@ impl Request<'_> {
         let a = ObjectId::from_raw(self.pairs.get(2 * i));
         let b = ObjectId::from_raw(self.pairs.get(2 * i + 1));
         let mut item = Item::distance(a, b, &self.options);
+        if let Some(base) = self.gradient {
+            item = item.with_gradient(base);
+        }
         if let Some(p) = &self.poses_a {
             set_pose_a(&mut item, p.get(i));
         }
@@ -198,6 +252,31 @@ pub fn set_pose_b(item: &mut Item, pose: Pose) {
 ///
 /// Pass it back as `out=` to a later call of the same `N` to reuse its
 /// arrays instead of allocating new ones.
+///
+/// `Distances(n, gradient_columns=c)` with `c > 0` also asks every call
+/// given it as `out=` for each pair's distance gradient (with
+/// `gradient_base=True`, a robot's base twist too), as `SceneRows(n,
+/// gradient_columns=c)` does for scene rows, written into:
+///
+/// - `gradient` `(N, c)` float64: row `i` holds `∂d/∂x` with respect to
+///   the coordinates that move its `a` (a robot link: the robot's moving
+///   joints in `Robot.joint_names` order, then the base twist `[v, ω]`
+///   when asked; any other object: its pose's twist), zero beyond the
+///   columns in use; for overlapping pairs, the signed distance's
+///   (`distance - penetration`). A gradient of more than `c` columns keeps
+///   its first `c`: size `c` for the widest pair (a robot's `dof`, plus 6
+///   with `gradient_base`; 6 for a free object). Failed rows hold zeros;
+/// - `gradient_flags` `(N,)` uint32: `1` computed, `2` nearest points not
+///   unique (a one-sided gradient), `4` base twist included, `8` no
+///   direction (zeros); 0 in failed rows;
+/// - `gradient_error` `(N,)` float64: a bound on each entry's error from
+///   the distance's certified interval.
+///
+/// The room asks, not a keyword of `distances`, as with `SceneRows`: the
+/// arrays are sized once for the gradient's columns and reused from call
+/// to call, so a call never asks for a gradient it has no room for, and
+/// nothing is allocated per call. Without gradient columns, `gradient` is
+/// `(N, 0)` and the flags and errors stay 0.
 #[pyclass(module = "gjkd", name = "Distances")]
 pub struct Distances {
     distance: Py<PyArray1<f64>>,
@@ -215,6 +294,13 @@ pub struct Distances {
     signed_distance: Py<PyArray1<f64>>,
     signed_lower: Py<PyArray1<f64>>,
     signed_upper: Py<PyArray1<f64>>,
+    gradient: Py<PyArray2<f64>>,
+    gradient_flags: Py<PyArray1<u32>>,
+    gradient_error: Py<PyArray1<f64>>,
+    /// Entries per row of `gradient` (0: no gradients asked).
+    gradient_columns: usize,
+    /// Gradients also carry a robot base's twist.
+    gradient_base: bool,
     len: usize,
     /// Set while a call writes the arrays: a second call given the same
     /// `out` meanwhile (from another thread) is refused.
@@ -222,7 +308,7 @@ pub struct Distances {
 }
 
 /// The field names of [`Distances`], in [`Distances::as_dict`]'s order.
-const FIELDS: [&str; 15] = [
+const FIELDS: [&str; 18] = [
     "distance",
     "lower",
     "upper",
@@ -238,32 +324,44 @@ const FIELDS: [&str; 15] = [
     "signed_distance",
     "signed_lower",
     "signed_upper",
+    "gradient",
+    "gradient_flags",
+    "gradient_error",
 ];
 
 #[pymethods]
 impl Distances {
-    /// Zeroed arrays for `n` pairs, to pass as `out=`.
+    /// Zeroed arrays for `n` pairs, to pass as `out=`, and room for
+    /// `gradient_columns` gradient entries per pair (0: no gradients
+    /// asked); `gradient_base` asks a robot base's twist too.
     #[new]
-    pub fn new(py: Python<'_>, n: usize) -> Self {
-        Distances {
-            distance: PyArray1::zeros(py, n, false).unbind(),
-            lower: PyArray1::zeros(py, n, false).unbind(),
-            upper: PyArray1::zeros(py, n, false).unbind(),
-            penetration: PyArray1::zeros(py, n, false).unbind(),
-            point_a: PyArray2::zeros(py, [n, 3], false).unbind(),
-            point_b: PyArray2::zeros(py, [n, 3], false).unbind(),
-            normal: PyArray2::zeros(py, [n, 3], false).unbind(),
-            status: PyArray1::zeros(py, n, false).unbind(),
-            iterations: PyArray1::zeros(py, n, false).unbind(),
-            pieces: PyArray2::zeros(py, [n, 2], false).unbind(),
-            error: PyArray1::zeros(py, n, false).unbind(),
-            warm_started: PyArray1::zeros(py, n, false).unbind(),
-            signed_distance: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
-            signed_lower: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
-            signed_upper: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
-            len: n,
-            busy: std::sync::atomic::AtomicBool::new(false),
-        }
+    #[pyo3(signature = (n, gradient_columns = 0, gradient_base = false))]
+    fn py_new(
+        py: Python<'_>,
+        n: usize,
+        gradient_columns: usize,
+        gradient_base: bool,
+    ) -> PyResult<Self> {
+        check_gradient_room(py, gradient_columns, gradient_base)?;
+        Ok(Distances::with_room(py, n, gradient_columns, gradient_base))
+    }
+
+    /// `(N, gradient_columns)` float64: each pair's distance gradient.
+    #[getter]
+    pub(crate) fn gradient<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.gradient.bind(py).clone()
+    }
+
+    /// `(N,)` uint32: each pair's gradient flags.
+    #[getter]
+    pub(crate) fn gradient_flags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.gradient_flags.bind(py).clone()
+    }
+
+    /// `(N,)` float64: a bound on each pair's gradient entries' error.
+    #[getter]
+    pub(crate) fn gradient_error<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.gradient_error.bind(py).clone()
     }
 
     fn __len__(&self) -> usize {
@@ -381,9 +479,54 @@ impl Distances {
 }
 
 impl Distances {
+    /// Zeroed arrays for `n` pairs, without gradients.
+    pub fn new(py: Python<'_>, n: usize) -> Self {
+        Distances::with_room(py, n, 0, false)
+    }
+
+    /// Zeroed arrays for `n` pairs and `gradient_columns` gradient entries
+    /// per pair (checked by [`check_gradient_room`]).
+    pub fn with_room(
+        py: Python<'_>,
+        n: usize,
+        gradient_columns: usize,
+        gradient_base: bool,
+    ) -> Self {
+        Distances {
+            distance: PyArray1::zeros(py, n, false).unbind(),
+            lower: PyArray1::zeros(py, n, false).unbind(),
+            upper: PyArray1::zeros(py, n, false).unbind(),
+            penetration: PyArray1::zeros(py, n, false).unbind(),
+            point_a: PyArray2::zeros(py, [n, 3], false).unbind(),
+            point_b: PyArray2::zeros(py, [n, 3], false).unbind(),
+            normal: PyArray2::zeros(py, [n, 3], false).unbind(),
+            status: PyArray1::zeros(py, n, false).unbind(),
+            iterations: PyArray1::zeros(py, n, false).unbind(),
+            pieces: PyArray2::zeros(py, [n, 2], false).unbind(),
+            error: PyArray1::zeros(py, n, false).unbind(),
+            warm_started: PyArray1::zeros(py, n, false).unbind(),
+            signed_distance: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
+            signed_lower: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
+            signed_upper: PyArray1::from_vec(py, vec![f64::NAN; n]).unbind(),
+            gradient: PyArray2::zeros(py, [n, gradient_columns], false).unbind(),
+            gradient_flags: PyArray1::zeros(py, n, false).unbind(),
+            gradient_error: PyArray1::zeros(py, n, false).unbind(),
+            gradient_columns,
+            gradient_base,
+            len: n,
+            busy: std::sync::atomic::AtomicBool::new(false),
+        }
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.len
+    }
+
+    /// The gradient every call filling these arrays asks: `None`, or
+    /// `Some(base)` (with the base twist when `base`).
+    pub fn gradient_request(&self) -> Option<bool> {
+        (self.gradient_columns > 0).then_some(self.gradient_base)
     }
 
     /// Runs `fill` with the arrays' storage to write into.
@@ -433,6 +576,11 @@ impl Distances {
             self.signed_lower.bind(py),
             self.signed_upper.bind(py),
         );
+        let (gr, gf, ge) = (
+            self.gradient.bind(py),
+            self.gradient_flags.bind(py),
+            self.gradient_error.bind(py),
+        );
         use std::sync::atomic::Ordering;
         if self.busy.swap(true, Ordering::Acquire) {
             return Err(invalid(
@@ -459,6 +607,10 @@ impl Distances {
                 signed_distance: storage(sd)?,
                 signed_lower: storage(slo)?,
                 signed_upper: storage(sup)?,
+                gradient: storage(gr)?,
+                gradient_flags: storage(gf)?,
+                gradient_error: storage(ge)?,
+                gradient_columns: self.gradient_columns,
             })
         })();
         self.busy.store(false, Ordering::Release);
@@ -502,6 +654,10 @@ pub struct Writer<'a> {
     signed_distance: &'a mut [f64],
     signed_lower: &'a mut [f64],
     signed_upper: &'a mut [f64],
+    gradient: &'a mut [f64],
+    gradient_flags: &'a mut [u32],
+    gradient_error: &'a mut [f64],
+    gradient_columns: usize,
 }
 
 impl Writer<'_> {
@@ -529,6 +685,26 @@ impl Writer<'_> {
             self.signed_distance[i] = v;
             self.signed_lower[i] = lo;
             self.signed_upper[i] = up;
+        }
+    }
+
+    /// Writes `gradients` into rows `start..start + gradients.len()`,
+    /// each cut to the room's columns; nothing when the room has no
+    /// gradient columns (none was asked).
+    pub fn write_gradients(&mut self, start: usize, gradients: &[Gradient]) {
+        let c = self.gradient_columns;
+        if c == 0 {
+            return;
+        }
+        for (k, g) in gradients.iter().enumerate() {
+            let i = start + k;
+            let out = &mut self.gradient[i * c..(i + 1) * c];
+            let got = g.as_slice();
+            let n = got.len().min(c);
+            out[..n].copy_from_slice(&got[..n]);
+            out[n..].fill(0.0);
+            self.gradient_flags[i] = g.flags;
+            self.gradient_error[i] = g.error;
         }
     }
 }

@@ -42,6 +42,9 @@ pub struct Buffers {
     pub items: Vec<Item>,
     /// Its results.
     pub results: Vec<ItemResult>,
+    /// Its gradients, when its items ask for them (each does, so the
+    /// `k`-th gradient answers the `k`-th item).
+    pub gradients: Vec<Gradient>,
 }
 
 /// A value moved into [`Python::detach`]'s closure although it is not
@@ -67,7 +70,8 @@ impl<T> OnThisThread<T> {
     }
 }
 
-/// Answers every pair of `request` into `out`, in chunks, the GIL released.
+/// Answers every pair of `request` into `out`, in chunks, the GIL released;
+/// the pairs' gradients too when `request` asks for them.
 ///
 /// # Errors
 /// The first whole-call failure; rows before its chunk are written.
@@ -103,7 +107,20 @@ fn run_chunks(
         if buffers.results.len() < len {
             buffers.results.resize(len, ItemResult::default());
         }
-        match answerer.answer(&buffers.items, &mut buffers.results[..len]) {
+        let asks = request.asks_gradients();
+        if asks && buffers.gradients.len() < len {
+            buffers.gradients.resize(len, Gradient::NONE);
+        }
+        let answered = if asks {
+            answerer.answer_gradients(
+                &buffers.items,
+                &mut buffers.results[..len],
+                &mut buffers.gradients[..len],
+            )
+        } else {
+            answerer.answer(&buffers.items, &mut buffers.results[..len])
+        };
+        match answered {
             Ok(()) => {}
             Err(ClientError::Rejected(gjkd_client::ErrorCode::BatchTooLarge))
                 if answerer.refresh_limit() =>
@@ -113,6 +130,9 @@ fn run_chunks(
             Err(e) => return Err(e),
         }
         writer.write(start, &buffers.results[..len]);
+        if asks {
+            writer.write_gradients(start, &buffers.gradients[..len]);
+        }
         start = end;
     }
     Ok(())

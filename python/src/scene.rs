@@ -2,16 +2,16 @@
 //! scene in one round trip (`clearance`, `within`, `nearest`, `path`), the
 //! rows written into a caller-owned `gjkd.SceneRows`.
 
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyAnyMethods;
 
 use gjkd_client::{ClientError, Item, ObjectId, SceneRow, Steps};
-use gjkd_proto::{GRADIENT_COLUMNS, PathMode, SceneKind, SceneRequest, scene_flags};
+use gjkd_proto::{PathMode, SceneKind, SceneRequest, scene_flags};
 
 use crate::arrays::{IdArray, Ids, PoseArray, Poses, id_array};
 use crate::backend::Backend;
-use crate::batch::Distances;
+use crate::batch::{Distances, check_gradient_room};
 use crate::errors::{self, invalid};
 use crate::robots::Robot;
 
@@ -54,12 +54,18 @@ use crate::robots::Robot;
 ///   joints in `Robot.joint_names` order, then the base twist `[v, ω]`
 ///   when asked; any other object: its pose's twist), zero beyond the
 ///   columns in use; for overlapping pairs, the signed distance's
-///   (`distance - answers.penetration`);
+///   (`distance - answers.penetration`). A gradient of more than `c`
+///   columns keeps its first `c`: size `c` for the widest row (a robot's
+///   `dof`, plus 6 with `gradient_base`; 6 for a free object);
 /// - `gradient_flags` `(n,)` uint32: `1` computed, `2` nearest points not
 ///   unique (a one-sided gradient), `4` base twist included, `8` no
 ///   direction (zeros);
 /// - `gradient_error` `(n,)` float64: a bound on each entry's error from
 ///   the distance's certified interval.
+///
+/// These are `answers`' arrays of the same names (`gjkd.Distances(n,
+/// gradient_columns=c)` asks pair queries for gradients the same way).
+/// `gradient_base=True` without gradient columns raises `InvalidInput`.
 ///
 /// `SceneRows(n, signed_distance=True)` also asks every call for each
 /// row's signed distance with its certified interval, in
@@ -78,10 +84,6 @@ pub struct SceneRows {
     s_lo: Py<PyArray1<f64>>,
     s_hi: Py<PyArray1<f64>>,
     answers: Py<Distances>,
-    gradient: Py<PyArray2<f64>>,
-    gradient_flags: Py<PyArray1<u32>>,
-    gradient_error: Py<PyArray1<f64>>,
-    gradient_base: bool,
     signed_distance: bool,
     busy: std::sync::atomic::AtomicBool,
 }
@@ -100,48 +102,40 @@ impl SceneRows {
         gradient_base: bool,
         signed_distance: bool,
     ) -> PyResult<Self> {
-        if gradient_columns > GRADIENT_COLUMNS {
-            return Err(invalid(
-                py,
-                "gradient_columns",
-                None,
-                format!(
-                    "a row carries at most {GRADIENT_COLUMNS} gradient entries, not {gradient_columns}"
-                ),
-            ));
-        }
+        check_gradient_room(py, gradient_columns, gradient_base)?;
         Ok(SceneRows {
             a: PyArray1::zeros(py, n, false).unbind(),
             b: PyArray1::zeros(py, n, false).unbind(),
             step: PyArray1::zeros(py, n, false).unbind(),
             s_lo: PyArray1::zeros(py, n, false).unbind(),
             s_hi: PyArray1::zeros(py, n, false).unbind(),
-            answers: Py::new(py, Distances::new(py, n))?,
-            gradient: PyArray2::zeros(py, [n, gradient_columns], false).unbind(),
-            gradient_flags: PyArray1::zeros(py, n, false).unbind(),
-            gradient_error: PyArray1::zeros(py, n, false).unbind(),
-            gradient_base,
+            answers: Py::new(
+                py,
+                Distances::with_room(py, n, gradient_columns, gradient_base),
+            )?,
             signed_distance,
             busy: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
-    /// `(n, gradient_columns)` float64: each row's distance gradient.
+    /// `(n, gradient_columns)` float64: each row's distance gradient
+    /// (`answers.gradient`).
     #[getter]
     fn gradient<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.gradient.bind(py).clone()
+        self.answers.bind(py).borrow().gradient(py)
     }
 
-    /// `(n,)` uint32: each row's gradient flags.
+    /// `(n,)` uint32: each row's gradient flags (`answers.gradient_flags`).
     #[getter]
     fn gradient_flags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
-        self.gradient_flags.bind(py).clone()
+        self.answers.bind(py).borrow().gradient_flags(py)
     }
 
-    /// `(n,)` float64: a bound on each row's gradient entries' error.
+    /// `(n,)` float64: a bound on each row's gradient entries' error
+    /// (`answers.gradient_error`).
     #[getter]
     fn gradient_error<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.gradient_error.bind(py).clone()
+        self.answers.bind(py).borrow().gradient_error(py)
     }
 
     fn __len__(&self, py: Python<'_>) -> usize {
@@ -457,11 +451,6 @@ impl Inputs<'_> {
 }
 
 impl SceneRows {
-    /// Gradient entries per row (0: none asked).
-    fn gradient_columns(&self, py: Python<'_>) -> usize {
-        self.gradient.bind(py).shape()[1]
-    }
-
     /// The request flags this room asks for.
     fn gradient_request_flags(&self, py: Python<'_>) -> u32 {
         let signed = if self.signed_distance {
@@ -470,10 +459,10 @@ impl SceneRows {
             0
         };
         signed
-            | match (self.gradient_columns(py), self.gradient_base) {
-                (0, _) => 0,
-                (_, false) => scene_flags::GRADIENTS,
-                (_, true) => scene_flags::GRADIENTS | scene_flags::GRADIENT_BASE,
+            | match self.answers.bind(py).borrow().gradient_request() {
+                None => 0,
+                Some(false) => scene_flags::GRADIENTS,
+                Some(true) => scene_flags::GRADIENTS | scene_flags::GRADIENT_BASE,
             }
     }
 
@@ -498,12 +487,6 @@ impl SceneRows {
             ));
         }
         let (a, b, step) = (self.a.bind(py), self.b.bind(py), self.step.bind(py));
-        let (gradient, flags, error) = (
-            self.gradient.bind(py),
-            self.gradient_flags.bind(py),
-            self.gradient_error.bind(py),
-        );
-        let columns = self.gradient_columns(py);
         let (s_lo, s_hi) = (self.s_lo.bind(py), self.s_hi.bind(py));
         let answers = self.answers.bind(py).borrow();
         let result = (|| {
@@ -512,14 +495,6 @@ impl SceneRows {
             // `Distances` does with its own.
             let (a, b, step) =
                 unsafe { (a.as_slice_mut()?, b.as_slice_mut()?, step.as_slice_mut()?) };
-            // SAFETY: as above.
-            let (gradient, flags, error) = unsafe {
-                (
-                    gradient.as_slice_mut()?,
-                    flags.as_slice_mut()?,
-                    error.as_slice_mut()?,
-                )
-            };
             // SAFETY: as above.
             let (s_lo, s_hi) = unsafe { (s_lo.as_slice_mut()?, s_hi.as_slice_mut()?) };
             answers.with_writer(py, |mut writer| {
@@ -531,16 +506,7 @@ impl SceneRows {
                         s_lo[i] = row.s_lo;
                         s_hi[i] = row.s_hi;
                         writer.write(i, std::slice::from_ref(&row.result));
-                        if columns > 0 {
-                            let g = &row.gradient;
-                            let out = &mut gradient[i * columns..(i + 1) * columns];
-                            out.fill(0.0);
-                            let got = g.as_slice();
-                            let n = got.len().min(columns);
-                            out[..n].copy_from_slice(&got[..n]);
-                            flags[i] = g.flags;
-                            error[i] = g.error;
-                        }
+                        writer.write_gradients(i, std::slice::from_ref(&row.gradient));
                     }
                 };
                 call(&mut write)

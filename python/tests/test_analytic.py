@@ -171,6 +171,7 @@ def test_result_as_dict(objects: Any) -> None:
         "distance", "lower", "upper", "penetration", "point_a", "point_b", "normal",
         "status", "iterations", "pieces", "error", "warm_started",
         "signed_distance", "signed_lower", "signed_upper",
+        "gradient", "gradient_flags", "gradient_error",
     }  # fmt: skip
     assert d["pieces"].shape == (1, 2) and d["point_a"].shape == (1, 3)
     assert d["distance"][0] == 0.0 and d["penetration"][0] > 1.9

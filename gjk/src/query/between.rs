@@ -6,12 +6,10 @@
 
 use nalgebra::Isometry3;
 
-use super::recovery::recover_with;
-use super::{
-    Answer, Options, Query, WarmStart, Workspace, is_suspect, pair_answer, relative_pose,
-    with_spare_workspace,
-};
+use super::operands::{Operands, run_in};
+use super::{Answer, Options, Query, WarmStart, Workspace, pair_answer, with_spare_workspace};
 use crate::Error;
+use crate::johnson::Simplex;
 use crate::support_map::SupportMap;
 
 /// The distance between the convex shapes `a` at `pose_a` and `b` at
@@ -67,92 +65,34 @@ pub fn distance_between_in<A: SupportMap, B: SupportMap>(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
-    let query = Query::new(a, pose_a, b, pose_b, options, warm);
-    #[cfg(target_arch = "x86_64")]
-    if crate::has_avx2_fma() {
-        // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-        return unsafe { between_avx2(workspace, &query) };
-    }
-    between_base(workspace, &query)
+    run_in(workspace, &Query::new(a, pose_a, b, pose_b, options, warm))
 }
 
-cpu_forms! { entry
-    /// [`between_body`] for any CPU, out of line, as `distance_base` is;
-    /// its AVX2 form is `between_avx2` (see [`crate::cpu`]).
-    #[inline(never)]
-    fn between_base / between_avx2 <A: SupportMap, B: SupportMap> (
-        workspace: &mut Workspace,
-        query: &Query<'_, A, B>
-    ) -> Result<Answer, Error> => between_body
-}
-
-/// The body of [`distance_between_in`], inlined into each compiled form.
-#[inline(always)]
-fn between_body<const AVX2: bool, A: SupportMap, B: SupportMap>(
-    workspace: &mut Workspace,
-    query: &Query<'_, A, B>,
-) -> Result<Answer, Error> {
-    let &Query {
-        a,
-        pose_a,
-        b,
-        pose_b,
-        options,
-        warm,
-        swapped,
-    } = query;
-    options.validate()?;
-    if let Some(w) = warm {
-        let (count_a, count_b) = (a.index_count(), b.index_count());
+impl<A: SupportMap, B: SupportMap> Operands<B> for A {
+    /// A single shape's warm start names pieces `[0, 0]`.
+    fn warm_fits(&self, b: &B, warm: &WarmStart) -> bool {
+        let (count_a, count_b) = (self.index_count(), b.index_count());
         let fits = |kept: &super::warm_start::PieceSimplex| {
             kept.len == 0 || (kept.pieces == [0, 0] && kept.fits_counts(count_a, count_b))
         };
-        if !(fits(&w.first) && fits(&w.second)) {
-            return Err(Error::WarmStartOutOfRange);
-        }
+        fits(&warm.first) && fits(&warm.second)
     }
-    let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
-    let rel = relative_pose(pose_a, pose_b)?;
-    let (answer, stuck_width) = pair_answer::<AVX2, A, B>(
-        &mut workspace.simplex,
-        (a, pose_a),
-        (b, pose_b),
-        &rel,
-        options,
-        warm,
-        swapped,
-    );
-    if is_suspect(&answer, stuck_width) {
-        return recover_between::<AVX2, A, B>(answer, workspace, query, stuck_width);
-    }
-    Ok(answer)
-}
 
-/// The rare ends of [`between_body`], as `recover_suspect_answer`'s.
-#[cold]
-#[inline(never)]
-fn recover_between<const AVX2: bool, A: SupportMap, B: SupportMap>(
-    answer: Answer,
-    workspace: &mut Workspace,
-    query: &Query<'_, A, B>,
-    stuck_width: f64,
-) -> Result<Answer, Error> {
-    recover_with(
-        answer,
-        workspace,
-        query,
-        stuck_width,
-        |workspace| {
-            let Query {
-                a,
-                pose_a,
-                b,
-                pose_b,
-                options,
-                ..
-            } = *query;
-            distance_between_in(workspace, a, pose_a, b, pose_b, options, None)
-        },
-        |workspace| between_body::<AVX2, B, A>(workspace, &query.swapped()),
-    )
+    #[inline(always)]
+    fn search<const AVX2: bool>(
+        simplex: &mut Simplex,
+        query: &Query<'_, A, B>,
+        rel: &Isometry3<f64>,
+        warm: Option<&WarmStart>,
+    ) -> (Answer, f64) {
+        pair_answer::<AVX2, A, B>(
+            simplex,
+            (query.a, query.pose_a),
+            (query.b, query.pose_b),
+            rel,
+            query.options,
+            warm,
+            query.swapped,
+        )
+    }
 }

@@ -9,11 +9,10 @@
 use nalgebra::Isometry3;
 
 use super::compound::search_compound;
-use super::recovery::recover_with;
-use super::{
-    Answer, Options, Query, WarmStart, Workspace, is_suspect, relative_pose, with_spare_workspace,
-};
+use super::operands::{Operands, run_in};
+use super::{Answer, Options, Query, WarmStart, Workspace, with_spare_workspace};
 use crate::Error;
+use crate::johnson::Simplex;
 use crate::shape::Compound;
 use crate::support_map::SupportMap;
 
@@ -78,83 +77,29 @@ pub fn distance_between_compounds_in<A: SupportMap, B: SupportMap>(
     options: &Options,
     warm: Option<&WarmStart>,
 ) -> Result<Answer, Error> {
-    let query = Query::new(a, pose_a, b, pose_b, options, warm);
-    #[cfg(target_arch = "x86_64")]
-    if crate::has_avx2_fma() {
-        // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-        return unsafe { compounds_avx2(workspace, &query) };
-    }
-    compounds_base(workspace, &query)
+    run_in(workspace, &Query::new(a, pose_a, b, pose_b, options, warm))
 }
 
-cpu_forms! { entry
-    /// [`compounds_body`] for any CPU, out of line, as `distance_base` is;
-    /// its AVX2 form is `compounds_avx2` (see [`crate::cpu`]).
-    #[inline(never)]
-    fn compounds_base / compounds_avx2 <A: SupportMap, B: SupportMap> (
-        workspace: &mut Workspace,
-        query: &Query<'_, Compound<A>, Compound<B>>
-    ) -> Result<Answer, Error> => compounds_body
-}
-
-/// The body of [`distance_between_compounds_in`], inlined into each
-/// compiled form: `distance`'s body for two unions.
-#[inline(always)]
-fn compounds_body<const AVX2: bool, A: SupportMap, B: SupportMap>(
-    workspace: &mut Workspace,
-    query: &Query<'_, Compound<A>, Compound<B>>,
-) -> Result<Answer, Error> {
-    let &Query {
-        a,
-        pose_a,
-        b,
-        pose_b,
-        options,
-        warm,
-        swapped,
-    } = query;
-    options.validate()?;
-    if let Some(w) = warm
-        && !(w.first.fits_shapes(a, b) && w.second.fits_shapes(a, b))
-    {
-        return Err(Error::WarmStartOutOfRange);
+impl<A: SupportMap, B: SupportMap> Operands<Compound<B>> for Compound<A> {
+    fn warm_fits(&self, b: &Compound<B>, warm: &WarmStart) -> bool {
+        warm.first.fits_shapes(self, b) && warm.second.fits_shapes(self, b)
     }
-    let warm = warm.filter(|w| options.warm_start && (w.first.len > 0 || w.second.len > 0));
-    let rel = relative_pose(pose_a, pose_b)?;
-    let (answer, stuck_width) =
-        search_compound::<AVX2, _, _>(&mut workspace.simplex, query, &rel, warm);
-    let stuck_width = if swapped { f64::INFINITY } else { stuck_width };
-    if is_suspect(&answer, stuck_width) {
-        return recover_compounds::<AVX2, A, B>(answer, workspace, query, stuck_width);
-    }
-    Ok(answer)
-}
 
-/// The rare ends of [`compounds_body`], as `recover_suspect_answer`'s.
-#[cold]
-#[inline(never)]
-fn recover_compounds<const AVX2: bool, A: SupportMap, B: SupportMap>(
-    answer: Answer,
-    workspace: &mut Workspace,
-    query: &Query<'_, Compound<A>, Compound<B>>,
-    stuck_width: f64,
-) -> Result<Answer, Error> {
-    recover_with(
-        answer,
-        workspace,
-        query,
-        stuck_width,
-        |workspace| {
-            let Query {
-                a,
-                pose_a,
-                b,
-                pose_b,
-                options,
-                ..
-            } = *query;
-            distance_between_compounds_in(workspace, a, pose_a, b, pose_b, options, None)
-        },
-        |workspace| compounds_body::<AVX2, B, A>(workspace, &query.swapped()),
-    )
+    #[inline(always)]
+    fn search<const AVX2: bool>(
+        simplex: &mut Simplex,
+        query: &Query<'_, Compound<A>, Compound<B>>,
+        rel: &Isometry3<f64>,
+        warm: Option<&WarmStart>,
+    ) -> (Answer, f64) {
+        let (answer, stuck_width) = search_compound::<AVX2, _, _>(simplex, query, rel, warm);
+        (
+            answer,
+            if query.swapped {
+                f64::INFINITY
+            } else {
+                stuck_width
+            },
+        )
+    }
 }

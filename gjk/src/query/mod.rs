@@ -8,6 +8,7 @@ mod compound_between;
 pub(crate) mod core_run;
 mod full_step;
 mod numerical_algorithm;
+mod operands;
 mod options;
 mod pair;
 mod penetration;

@@ -27,7 +27,7 @@ pub use signed::SignedDistance;
 
 use crate::query::core_run::Placed;
 use crate::support_map::SupportMap;
-use crate::{Answer, Error, Options, Shape, Status, Workspace, distance, distance_between};
+use crate::{Answer, Error, Shape, Status, Workspace, distance, distance_between};
 use piece_pair::piece_signed_distance;
 
 /// The signed distance between `a` at `pose_a` and `b` at `pose_b`:
@@ -61,11 +61,7 @@ pub fn signed_distance(
     pose_b: &Isometry3<f64>,
     options: &DepthOptions,
 ) -> Result<SignedDistance, Error> {
-    options.validate()?;
-    let converged = Options {
-        margin: None,
-        ..options.distance
-    };
+    let converged = options.converged_distance()?;
     let answer = distance(a, pose_a, b, pose_b, &converged, None)?;
     signed_distance_after(&answer, a, pose_a, b, pose_b, options)
 }
@@ -192,11 +188,7 @@ pub fn signed_distance_between<A: SupportMap, B: SupportMap>(
     pose_b: &Isometry3<f64>,
     options: &DepthOptions,
 ) -> Result<SignedDistance, Error> {
-    options.validate()?;
-    let converged = Options {
-        margin: None,
-        ..options.distance
-    };
+    let converged = options.converged_distance()?;
     let answer = distance_between(a, pose_a, b, pose_b, &converged, None)?;
     if let Some(apart) = proven_apart(&answer) {
         return Ok(apart);

@@ -47,4 +47,15 @@ impl DepthOptions {
         }
         Ok(())
     }
+
+    /// The distance query's options for a depth: validated, and run to
+    /// convergence (no margin), since a margin's early exit leaves the
+    /// pair's overlap undecided.
+    pub(super) fn converged_distance(&self) -> Result<Options, Error> {
+        self.validate()?;
+        Ok(Options {
+            margin: None,
+            ..self.distance
+        })
+    }
 }

@@ -18,6 +18,7 @@ use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server as IoxServer;
 use iceoryx2::prelude::*;
+use iceoryx2::service::builder::request_response::Builder as RequestResponseBuilder;
 use tracing::{debug, error, info, warn};
 
 use crate::engine::{Limits, State};
@@ -113,6 +114,29 @@ const ADMIN_POLL_EVERY: u32 = 64;
 /// Most requests a client may have in flight on one service.
 const ACTIVE_REQUESTS_PER_CLIENT: usize = 2;
 
+/// The settings every request-response service of a deployment shares: one
+/// server (this one), `limits`' clients and nodes, a request at a time in
+/// flight per client and answered once, no request without an answer.
+fn one_server<Request, RequestHeader, Response, ResponseHeader>(
+    builder: RequestResponseBuilder<Request, RequestHeader, Response, ResponseHeader, ipc::Service>,
+    limits: &Limits,
+) -> RequestResponseBuilder<Request, RequestHeader, Response, ResponseHeader, ipc::Service>
+where
+    Request: std::fmt::Debug + IceoryxSend + ?Sized,
+    RequestHeader: std::fmt::Debug + ZeroCopySend,
+    Response: std::fmt::Debug + IceoryxSend + ?Sized,
+    ResponseHeader: std::fmt::Debug + ZeroCopySend,
+{
+    builder
+        .max_clients(limits.max_clients)
+        .max_servers(1)
+        .max_nodes(limits.max_nodes)
+        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(2)
+        .max_borrowed_responses_per_pending_response(1)
+        .enable_fire_and_forget_requests(false)
+}
+
 /// Response chunks the query and scene servers preallocate for `clients`
 /// clients.
 pub fn response_chunks(clients: usize) -> usize {
@@ -182,59 +206,39 @@ fn open_endpoints(options: &ServeOptions, limits: &Limits) -> Result<Endpoints, 
     }
 
     let clients = limits.max_clients;
-    let query_service = node
-        .service_builder(&query_name)
-        .request_response::<[Item], [ReplyEntry]>()
-        .response_user_header::<ReplyHeader>()
-        .max_clients(clients)
-        .max_servers(1)
-        .max_nodes(limits.max_nodes)
-        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
-        .max_response_buffer_size(2)
-        .max_borrowed_responses_per_pending_response(1)
-        .enable_fire_and_forget_requests(false)
-        .open_or_create()
-        .map_err(ipc("query service"))?;
-    let admin_service = node
-        .service_builder(&admin_name)
-        .request_response::<[AdminChunk], AdminReply>()
-        .request_user_header::<AdminRequest>()
-        .max_clients(clients)
-        .max_servers(1)
-        .max_nodes(limits.max_nodes)
-        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
-        .max_response_buffer_size(2)
-        .max_borrowed_responses_per_pending_response(1)
-        .enable_fire_and_forget_requests(false)
-        .open_or_create()
-        .map_err(ipc("admin service"))?;
-    let scene_service = node
-        .service_builder(&scene_name)
-        .request_response::<[Item], [SceneRow]>()
-        .request_user_header::<SceneRequest>()
-        .response_user_header::<SceneReply>()
-        .max_clients(clients)
-        .max_servers(1)
-        .max_nodes(limits.max_nodes)
-        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
-        .max_response_buffer_size(2)
-        .max_borrowed_responses_per_pending_response(1)
-        .enable_fire_and_forget_requests(false)
-        .open_or_create()
-        .map_err(ipc("scene service"))?;
-    let poses_service = node
-        .service_builder(&poses_name)
-        .request_response::<[u64], [StoredPose]>()
-        .response_user_header::<PosesReply>()
-        .max_clients(clients)
-        .max_servers(1)
-        .max_nodes(limits.max_nodes)
-        .max_active_requests_per_client(ACTIVE_REQUESTS_PER_CLIENT)
-        .max_response_buffer_size(2)
-        .max_borrowed_responses_per_pending_response(1)
-        .enable_fire_and_forget_requests(false)
-        .open_or_create()
-        .map_err(ipc("poses service"))?;
+    let query_service = one_server(
+        node.service_builder(&query_name)
+            .request_response::<[Item], [ReplyEntry]>()
+            .response_user_header::<ReplyHeader>(),
+        limits,
+    )
+    .open_or_create()
+    .map_err(ipc("query service"))?;
+    let admin_service = one_server(
+        node.service_builder(&admin_name)
+            .request_response::<[AdminChunk], AdminReply>()
+            .request_user_header::<AdminRequest>(),
+        limits,
+    )
+    .open_or_create()
+    .map_err(ipc("admin service"))?;
+    let scene_service = one_server(
+        node.service_builder(&scene_name)
+            .request_response::<[Item], [SceneRow]>()
+            .request_user_header::<SceneRequest>()
+            .response_user_header::<SceneReply>(),
+        limits,
+    )
+    .open_or_create()
+    .map_err(ipc("scene service"))?;
+    let poses_service = one_server(
+        node.service_builder(&poses_name)
+            .request_response::<[u64], [StoredPose]>()
+            .response_user_header::<PosesReply>(),
+        limits,
+    )
+    .open_or_create()
+    .map_err(ipc("poses service"))?;
     let wake_service = node
         .service_builder(&wake_name)
         .event()

@@ -8,7 +8,7 @@ use gjkd_client::{ClientError, ErrorCode, Gradient, Item, ItemResult, ObjectId};
 
 use nalgebra::Isometry3;
 
-use crate::arrays::{Ids, Poses, id_array, pose, pose_array};
+use crate::arrays::{Ids, Poses, id_vector, pose, pose_array};
 use crate::batch::{Answer, Distances, RequestArrays, options, set_pose_a, set_pose_b};
 use crate::errors::{self, invalid};
 use crate::runner::{run_gradient, run_items, run_pairs};
@@ -52,15 +52,7 @@ pub fn set_poses(
     ids: &Bound<'_, PyAny>,
     poses: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
-    let id_arr = id_array(ids, "ids")?;
-    if id_arr.shape().len() != 1 {
-        return Err(invalid(
-            py,
-            "ids",
-            None,
-            format!("ids must have shape (N,), got {:?}", id_arr.shape()),
-        ));
-    }
+    let id_arr = id_vector(ids, "ids")?;
     let pose_arr = pose_array(poses, "poses")?;
     store_poses(backend, py, id_arr.slice()?, pose_arr.poses()?, "poses")
 }
@@ -74,15 +66,7 @@ pub fn poses<'py>(
     py: Python<'py>,
     ids: &Bound<'_, PyAny>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-    let id_arr = id_array(ids, "ids")?;
-    if id_arr.shape().len() != 1 {
-        return Err(invalid(
-            py,
-            "ids",
-            None,
-            format!("ids must have shape (N,), got {:?}", id_arr.shape()),
-        ));
-    }
+    let id_arr = id_vector(ids, "ids")?;
     let slice = id_arr.slice()?;
     let ids: Vec<u64> = (0..slice.len()).map(|i| slice.get(i)).collect();
     let got = if ids.is_empty() {

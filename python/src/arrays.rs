@@ -57,6 +57,21 @@ pub fn id_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<IdArray<'
     array_of::<u64>(obj, field, "uint64 (or int64)").map(IdArray::Unsigned)
 }
 
+/// [`id_array`] of shape `(N,)`: `InvalidInput` naming `field` for any
+/// other shape.
+pub fn id_vector<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<IdArray<'py>> {
+    let ids = id_array(obj, field)?;
+    if ids.shape().len() != 1 {
+        return Err(invalid(
+            obj.py(),
+            field,
+            None,
+            format!("{field} must have shape (N,), got {:?}", ids.shape()),
+        ));
+    }
+    Ok(ids)
+}
+
 /// Ids read either way.
 pub enum IdArray<'py> {
     /// From an int64 array, none negative.
